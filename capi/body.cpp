@@ -1,0 +1,236 @@
+// Bodies: creation from arrays, files and the box generator; read-back; loads; selection.
+#include "capi_internal.hpp"
+#include "mesh/mesh_io.hpp"
+
+using namespace mica_capi;
+
+namespace {
+
+mica_body_def body_defaults() {
+  mica_body_def d{};
+  d.struct_size = sizeof d;
+  d.model = MICA_MODEL_COROTATIONAL;
+  d.mass = MICA_MASS_CONSISTENT;
+  d.youngs_modulus = 1e4;
+  d.poisson_ratio = 0.3;
+  d.density = 1000;
+  return d;
+}
+
+struct BodyInput {
+  mica::BodySettings settings;
+  mica::Vec3 translation, velocity;
+};
+
+BodyInput translate(const mica_body_def* def) {
+  const mica_body_def d = read_def(def, body_defaults(), sizeof(mica_body_def), "def");
+  if (d.model != MICA_MODEL_COROTATIONAL && d.model != MICA_MODEL_LINEAR)
+    refuse(MICA_ERR_INVALID_ARGUMENT, "def->model is " + std::to_string(d.model) + ", not a MICA_MODEL_* value");
+  if (d.mass != MICA_MASS_CONSISTENT && d.mass != MICA_MASS_LUMPED)
+    refuse(MICA_ERR_INVALID_ARGUMENT, "def->mass is " + std::to_string(d.mass) + ", not a MICA_MASS_* value");
+  if (d.is_static != 0 && d.is_static != 1) refuse(MICA_ERR_INVALID_ARGUMENT, "def->is_static must be 0 or 1");
+  BodyInput in;
+  in.settings.material = {d.youngs_modulus, d.poisson_ratio, d.density};
+  in.settings.rayleigh_alpha = d.rayleigh_alpha;
+  in.settings.rayleigh_beta = d.rayleigh_beta;
+  in.settings.mass = d.mass == MICA_MASS_LUMPED ? mica::MassKind::Lumped : mica::MassKind::Consistent;
+  in.settings.corotational = d.model == MICA_MODEL_COROTATIONAL;
+  in.settings.is_static = d.is_static == 1;
+  in.translation = vec3(d.translation, "def->translation");
+  in.velocity = vec3(d.velocity, "def->velocity");
+  return in;
+}
+
+mica_status create(mica_world* world, const mica_body_def* def, const mica::TetMesh& mesh, mica_body_id* out) {
+  const BodyInput in = translate(def);
+  *out = world->world.add_body(mesh, in.settings, in.translation, in.velocity);
+  return MICA_OK;
+}
+
+void check_count(int32_t count, int32_t min, const char* name) {
+  if (count < min) refuse(MICA_ERR_INVALID_ARGUMENT, std::string(name) + " is " + std::to_string(count) + ", must be >= " + std::to_string(min));
+}
+
+// Node indices from the caller, unchecked: the core checks them against the body.
+std::vector<int32_t> node_list(const int32_t* nodes, int32_t count) { return {nodes, nodes + count}; }
+
+template <class Select>
+mica_status select_nodes(const mica::Body& b, int32_t use_rest, int32_t* out, int32_t capacity, int32_t* out_count,
+                         Select&& inside) {
+  if (use_rest != 0 && use_rest != 1) refuse(MICA_ERR_INVALID_ARGUMENT, "use_rest must be 0 or 1");
+  const mica::Vec3List& p = use_rest ? b.fem.rest : b.x;
+  std::vector<int32_t> found;
+  for (size_t i = 0; i < p.size(); ++i)
+    if (inside(p[i])) found.push_back(int32_t(i));
+  return copy_out(found.data(), int32_t(found.size()), 1, out, capacity, out_count);
+}
+
+}  // namespace
+
+extern "C" {
+
+MICA_API mica_status mica_body_def_init(mica_body_def* def, uint32_t struct_size) {
+  return init_def(def, struct_size, sizeof(mica_body_def), body_defaults());
+}
+
+MICA_API mica_status mica_body_create(mica_world* world, const mica_body_def* def, const double* nodes,
+                                      int32_t node_count, const int32_t* tets, int32_t tet_count,
+                                      mica_body_id* out_body) {
+  return guarded(world, "mica_body_create", [&] {
+    require(world, "world");
+    require(out_body, "out_body");
+    require(nodes, "nodes");
+    require(tets, "tets");
+    check_count(node_count, 4, "node_count");
+    check_count(tet_count, 1, "tet_count");
+    if (node_count > INT32_MAX / 3) refuse(MICA_ERR_INVALID_ARGUMENT, "node_count is too large");
+    mica::TetMesh mesh;
+    mesh.nodes.resize(size_t(node_count));
+    for (int32_t i = 0; i < node_count; ++i) mesh.nodes[i] = {nodes[3 * i], nodes[3 * i + 1], nodes[3 * i + 2]};
+    mesh.tets.resize(size_t(tet_count));
+    for (int32_t e = 0; e < tet_count; ++e)
+      for (int a = 0; a < 4; ++a) mesh.tets[e][a] = tets[4 * int64_t(e) + a];
+    return create(world, def, mesh, out_body);
+  });
+}
+
+MICA_API mica_status mica_body_create_from_file(mica_world* world, const mica_body_def* def, const char* path,
+                                                mica_body_id* out_body) {
+  return guarded(world, "mica_body_create_from_file", [&] {
+    require(world, "world");
+    require(out_body, "out_body");
+    require(path, "path");
+    return create(world, def, mica::load_mesh(path), out_body);
+  });
+}
+
+MICA_API mica_status mica_body_create_box(mica_world* world, const mica_body_def* def, const double lo[3],
+                                          const double hi[3], const int32_t cells[3], int32_t tets_per_cell,
+                                          mica_body_id* out_body) {
+  return guarded(world, "mica_body_create_box", [&] {
+    require(world, "world");
+    require(out_body, "out_body");
+    require(cells, "cells");
+    const mica::TetMesh mesh =
+        mica::make_box_grid(vec3(lo, "lo"), vec3(hi, "hi"), {cells[0], cells[1], cells[2]}, tets_per_cell);
+    return create(world, def, mesh, out_body);
+  });
+}
+
+MICA_API mica_status mica_body_destroy(mica_world* world, mica_body_id body) {
+  return guarded(world, "mica_body_destroy", [&] {
+    require(world, "world");
+    world->world.remove_body(body);
+    return MICA_OK;
+  });
+}
+
+MICA_API mica_status mica_body_get_counts(const mica_world* world, mica_body_id body, int32_t* node_count,
+                                          int32_t* tet_count, int32_t* triangle_count) {
+  return guarded(world, "mica_body_get_counts", [&] {
+    require(world, "world");
+    const mica::Body& b = world->world.body(body);
+    if (node_count) *node_count = b.fem.node_count();
+    if (tet_count) *tet_count = int32_t(b.tets.size());
+    if (triangle_count) *triangle_count = int32_t(b.surface.size());
+    return MICA_OK;
+  });
+}
+
+#define MICA_NODE_GETTER(function, field)                                                                 \
+  MICA_API mica_status function(const mica_world* world, mica_body_id body, double* out, int32_t capacity, \
+                                int32_t* out_count) {                                                     \
+    return guarded(world, #function, [&] {                                                                \
+      require(world, "world");                                                                            \
+      const mica::Body& b = world->world.body(body);                                                      \
+      return copy_out(b.field[0].data(), b.fem.node_count(), 3, out, capacity, out_count);               \
+    });                                                                                                   \
+  }
+MICA_NODE_GETTER(mica_body_get_positions, x)
+MICA_NODE_GETTER(mica_body_get_velocities, v)
+MICA_NODE_GETTER(mica_body_get_rest_positions, fem.rest)
+#undef MICA_NODE_GETTER
+
+MICA_API mica_status mica_body_get_surface(const mica_world* world, mica_body_id body, int32_t* out, int32_t capacity,
+                                           int32_t* out_count) {
+  return guarded(world, "mica_body_get_surface", [&] {
+    require(world, "world");
+    const mica::Body& b = world->world.body(body);
+    return copy_out(b.surface.empty() ? nullptr : b.surface[0].data(), int32_t(b.surface.size()), 3, out, capacity,
+                    out_count);
+  });
+}
+
+MICA_API mica_status mica_body_positions_view(const mica_world* world, mica_body_id body, const double** out,
+                                              int32_t* out_node_count) {
+  return guarded(world, "mica_body_positions_view", [&] {
+    require(world, "world");
+    require(out, "out");
+    const mica::Body& b = world->world.body(body);
+    *out = b.x[0].data();
+    if (out_node_count) *out_node_count = b.fem.node_count();
+    return MICA_OK;
+  });
+}
+
+MICA_API mica_status mica_body_set_node_forces(mica_world* world, mica_body_id body, const int32_t* nodes,
+                                               const double* forces, int32_t count) {
+  return guarded(world, "mica_body_set_node_forces", [&] {
+    require(world, "world");
+    check_count(count, 0, "count");
+    if (count > 0) {
+      require(nodes, "nodes");
+      require(forces, "forces");
+    }
+    mica::Vec3List f(static_cast<size_t>(count));
+    for (int32_t k = 0; k < count; ++k) f[k] = {forces[3 * k], forces[3 * k + 1], forces[3 * k + 2]};
+    world->world.set_node_forces(body, count ? node_list(nodes, count) : std::vector<int32_t>{}, f);
+    return MICA_OK;
+  });
+}
+
+MICA_API mica_status mica_body_select_nodes_in_box(const mica_world* world, mica_body_id body, const double lo[3],
+                                                   const double hi[3], int32_t use_rest, int32_t* out,
+                                                   int32_t capacity, int32_t* out_count) {
+  return guarded(world, "mica_body_select_nodes_in_box", [&] {
+    require(world, "world");
+    const mica::Vec3 l = vec3(lo, "lo"), h = vec3(hi, "hi");
+    if (!l.allFinite() || !h.allFinite()) refuse(MICA_ERR_INVALID_ARGUMENT, "the box corners must be finite");
+    return select_nodes(world->world.body(body), use_rest, out, capacity, out_count, [&](const mica::Vec3& p) {
+      return (p.array() >= l.array()).all() && (p.array() <= h.array()).all();
+    });
+  });
+}
+
+MICA_API mica_status mica_body_select_nodes_by_plane(const mica_world* world, mica_body_id body,
+                                                     const double point[3], const double normal[3],
+                                                     double tolerance, int32_t use_rest, int32_t* out,
+                                                     int32_t capacity, int32_t* out_count) {
+  return guarded(world, "mica_body_select_nodes_by_plane", [&] {
+    require(world, "world");
+    const mica::Vec3 o = vec3(point, "point"), n = vec3(normal, "normal");
+    if (!o.allFinite() || !(n.norm() > 0) || !std::isfinite(n.norm()) || !std::isfinite(tolerance))
+      refuse(MICA_ERR_INVALID_ARGUMENT, "the plane needs a finite point, a finite non-zero normal and a finite tolerance");
+    const mica::Vec3 u = n.normalized();
+    return select_nodes(world->world.body(body), use_rest, out, capacity, out_count,
+                        [&](const mica::Vec3& p) { return (p - o).dot(u) <= tolerance; });
+  });
+}
+
+MICA_API mica_status mica_body_get_energy(const mica_world* world, mica_body_id body, double* kinetic,
+                                          double* elastic, double* potential) {
+  return guarded(world, "mica_body_get_energy", [&] {
+    require(world, "world");
+    const mica::Body& b = world->world.body(body);
+    if (kinetic) *kinetic = mica::kinetic_energy(b.fem, b.v);
+    if (elastic) *elastic = mica::elastic_energy(b.fem, b.x, b.settings.corotational);
+    if (potential) {
+      double u = 0;
+      for (size_t i = 0; i < b.x.size(); ++i) u -= b.fem.node_mass[i] * world->world.settings().gravity.dot(b.x[i]);
+      *potential = u;
+    }
+    return MICA_OK;
+  });
+}
+
+}  // extern "C"

@@ -1,0 +1,55 @@
+// Linear projection constraints.
+#include "capi_internal.hpp"
+
+using namespace mica_capi;
+
+namespace {
+mica_lpc_def lpc_defaults() {
+  mica_lpc_def d{};
+  d.struct_size = sizeof d;
+  d.kind = MICA_LPC_FIXED;
+  d.direction[0][0] = 1;
+  d.direction[1][1] = 1;
+  return d;
+}
+}  // namespace
+
+extern "C" {
+
+MICA_API mica_status mica_lpc_def_init(mica_lpc_def* def, uint32_t struct_size) {
+  return init_def(def, struct_size, sizeof(mica_lpc_def), lpc_defaults());
+}
+
+MICA_API mica_status mica_add_lpc(mica_world* world, mica_body_id body, const int32_t* nodes, int32_t count,
+                                  const mica_lpc_def* def, mica_lpc_id* out_lpc) {
+  return guarded(world, "mica_add_lpc", [&] {
+    require(world, "world");
+    require(nodes, "nodes");
+    require(out_lpc, "out_lpc");
+    if (count < 1) refuse(MICA_ERR_INVALID_ARGUMENT, "count is " + std::to_string(count) + ", must be >= 1");
+    const mica_lpc_def d = read_def(def, lpc_defaults(), sizeof(mica_lpc_def), "def");
+    mica::LpcSpec spec;
+    switch (d.kind) {
+      case MICA_LPC_FIXED: spec.kind = mica::LpcKind::Fixed; break;
+      case MICA_LPC_PLANE: spec.kind = mica::LpcKind::Plane; break;
+      case MICA_LPC_LINE: spec.kind = mica::LpcKind::Line; break;
+      case MICA_LPC_TWO_DIRS: spec.kind = mica::LpcKind::TwoDirections; break;
+      default: refuse(MICA_ERR_INVALID_ARGUMENT, "def->kind is " + std::to_string(d.kind) + ", not a MICA_LPC_* value");
+    }
+    spec.directions[0] = vec3(d.direction[0], "def->direction[0]");
+    spec.directions[1] = vec3(d.direction[1], "def->direction[1]");
+    spec.velocity = vec3(d.velocity, "def->velocity");
+    *out_lpc = world->world.add_lpc(body, std::vector<int32_t>(nodes, nodes + count), spec);
+    return MICA_OK;
+  });
+}
+
+MICA_API mica_status mica_lpc_remove(mica_world* world, mica_lpc_id lpc) {
+  return guarded(world, "mica_lpc_remove", [&] {
+    require(world, "world");
+    world->world.remove_lpc(lpc);
+    return MICA_OK;
+  });
+}
+
+}  // extern "C"

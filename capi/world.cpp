@@ -1,0 +1,148 @@
+// World lifetime, settings, stepping, statistics and output.
+#include <fstream>
+
+#include "capi_internal.hpp"
+#include "mesh/mesh_io.hpp"
+
+using namespace mica_capi;
+
+static_assert(MICA_STAGE_COUNT == mica::kStageCount, "the C stage list must match the core's");
+static_assert(MICA_STAGE_SOLVE == int(mica::Stage::Solve) && MICA_STAGE_INTEGRATE == int(mica::Stage::Integrate),
+              "the C stage order must match the core's");
+
+namespace {
+
+mica_world_def world_defaults() {
+  mica_world_def d{};
+  d.struct_size = sizeof d;
+  d.header_version = MICA_VERSION_NUMBER;
+  d.gravity[1] = -9.81;
+  d.solver = MICA_SOLVER_DIRECT;
+  d.max_iterations = 200;
+  d.tolerance = 1e-8;
+  return d;
+}
+
+mica::WorldSettings translate(const mica_world_def& d) {
+  mica::WorldSettings s;
+  s.gravity = vec3(d.gravity, "def->gravity");
+  if (d.solver != MICA_SOLVER_DIRECT && d.solver != MICA_SOLVER_PCG)
+    refuse(MICA_ERR_INVALID_ARGUMENT, "def->solver is " + std::to_string(d.solver) + ", not a MICA_SOLVER_* value");
+  s.solver = d.solver == MICA_SOLVER_PCG ? mica::SolverKind::Pcg : mica::SolverKind::Direct;
+  s.max_iterations = d.max_iterations;
+  s.tolerance = d.tolerance;
+  s.plan_all_stages = d.plan_all_stages != 0;
+  return s;
+}
+
+std::vector<mica::VtkPiece> vtk_pieces(const mica::Body& b, std::vector<mica::Vec3List>& storage) {
+  mica::Vec3List displacement(b.x.size());
+  for (size_t i = 0; i < b.x.size(); ++i) displacement[i] = b.x[i] - b.fem.rest[i];
+  storage.push_back(std::move(displacement));
+  mica::VtkPiece piece;
+  piece.positions = &b.x;
+  piece.tets = &b.tets;
+  piece.point_vectors = {{"velocity", &b.v}, {"displacement", &storage.back()}};
+  return {piece};
+}
+
+}  // namespace
+
+extern "C" {
+
+MICA_API mica_status mica_world_def_init(mica_world_def* def, uint32_t struct_size, uint32_t header_version) {
+  const mica_status s = init_def(def, struct_size, sizeof(mica_world_def), world_defaults());
+  if (s == MICA_OK) def->header_version = header_version;
+  return s;
+}
+
+MICA_API mica_status mica_world_create(const mica_world_def* def, mica_world** out_world) {
+  if (out_world) *out_world = nullptr;
+  return guarded(nullptr, "mica_world_create", [&] {
+    require(out_world, "out_world");
+    const mica_world_def d = read_def(def, world_defaults(), sizeof(mica_world_def), "def");
+    if (d.header_version / 10000 != MICA_VERSION_MAJOR)
+      refuse(MICA_ERR_VERSION_MISMATCH, "the caller was compiled with libmica header " +
+                                            std::to_string(d.header_version) + ", this library is " +
+                                            std::to_string(MICA_VERSION_NUMBER));
+    auto* world = new mica_world(translate(d));
+    world->log = d.log;
+    world->log_user = d.log_user;
+    *out_world = world;
+    return MICA_OK;
+  });
+}
+
+MICA_API void mica_world_destroy(mica_world* world) { delete world; }
+
+MICA_API mica_status mica_world_set_gravity(mica_world* world, const double gravity[3]) {
+  return guarded(world, "mica_world_set_gravity", [&] {
+    require(world, "world");
+    world->world.set_gravity(vec3(gravity, "gravity"));
+    return MICA_OK;
+  });
+}
+
+MICA_API mica_status mica_step(mica_world* world, double dt) {
+  return guarded(world, "mica_step", [&] {
+    require(world, "world");
+    world->world.step(dt);
+    return world->world.stats().converged ? MICA_OK : MICA_WARN_NOT_CONVERGED;
+  });
+}
+
+MICA_API mica_status mica_world_get_stats(const mica_world* world, mica_world_stats* out) {
+  return guarded(world, "mica_world_get_stats", [&] {
+    require(world, "world");
+    require(out, "out");
+    if (out->struct_size < offsetof(mica_world_stats, stages) || out->struct_size > sizeof(mica_world_stats))
+      refuse(MICA_ERR_STRUCT_SIZE, "out->struct_size is " + std::to_string(out->struct_size) +
+                                       ": set it to sizeof(mica_world_stats)");
+    const mica::WorldStats& s = world->world.stats();
+    mica_world_stats r{};
+    r.struct_size = out->struct_size;
+    r.converged = s.converged ? 1 : 0;
+    r.step_count = s.step_count;
+    r.solver_iterations = s.solver_iterations;
+    r.solver_residual = s.solver_residual;
+    r.ms_last_step = s.ms_last_step;
+    for (int k = 0; k < MICA_STAGE_COUNT; ++k) {
+      r.stages[k].runs_last_step = s.stages[k].runs_last_step;
+      r.stages[k].runs_total = s.stages[k].runs_total;
+      r.stages[k].ms_last_step = s.stages[k].ms_last_step;
+      r.stages[k].ms_total = s.stages[k].ms_total;
+    }
+    std::memcpy(static_cast<void*>(out), &r, out->struct_size);
+    return MICA_OK;
+  });
+}
+
+MICA_API mica_status mica_body_write_vtk(const mica_world* world, mica_body_id body, const char* path) {
+  return guarded(world, "mica_body_write_vtk", [&] {
+    require(world, "world");
+    require(path, "path");
+    std::vector<mica::Vec3List> storage;
+    storage.reserve(1);
+    mica::write_vtk_file(path, vtk_pieces(world->world.body(body), storage), "libmica body");
+    return MICA_OK;
+  });
+}
+
+MICA_API mica_status mica_world_write_vtk(const mica_world* world, const char* path) {
+  return guarded(world, "mica_world_write_vtk", [&] {
+    require(world, "world");
+    require(path, "path");
+    std::vector<mica::Vec3List> storage;
+    std::vector<mica::VtkPiece> pieces;
+    size_t count = 0;
+    world->world.for_each_body([&](mica::Id, const mica::Body&) { ++count; });
+    storage.reserve(count);  // pieces point into storage: it must not reallocate
+    world->world.for_each_body([&](mica::Id, const mica::Body& b) {
+      for (auto& p : vtk_pieces(b, storage)) pieces.push_back(p);
+    });
+    mica::write_vtk_file(path, pieces, "libmica world");
+    return MICA_OK;
+  });
+}
+
+}  // extern "C"

@@ -1,0 +1,33 @@
+// The core reports failure by throwing mica::Error; the C layer turns it into a status.
+#pragma once
+#include <stdexcept>
+#include <string>
+
+namespace mica {
+
+enum class Errc {
+  InvalidArgument,  // a value is out of its domain (NaN, negative size, bad enum)
+  OutOfRange,       // an index is outside its array
+  StaleId,          // an id refers to an object that was destroyed
+  BadMesh,          // the mesh is unusable (degenerate or inverted rest element, ...)
+  Io,               // a file cannot be opened or read
+  Parse,            // a file is malformed
+  Numerical,        // the step produced non-finite values
+  WrongState,       // the call is not allowed now
+  Unsupported,      // the feature is not available in this build or on this scene
+  Device,           // a haptic device failed
+  Internal          // a bug in libmica
+};
+
+class Error : public std::runtime_error {
+ public:
+  Error(Errc code, const std::string& message) : std::runtime_error(message), code_(code) {}
+  Errc code() const { return code_; }
+
+ private:
+  Errc code_;
+};
+
+[[noreturn]] inline void fail(Errc code, const std::string& message) { throw Error(code, message); }
+
+}  // namespace mica

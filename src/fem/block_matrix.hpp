@@ -1,0 +1,32 @@
+// A symmetric-pattern sparse matrix of 3x3 blocks (block CSR): one block row per node.
+// The pattern is built once from the mesh; values are refilled every step without allocation.
+#pragma once
+#include <vector>
+
+#include "core/types.hpp"
+
+namespace mica {
+
+struct BlockPattern {
+  int32_t rows = 0;
+  std::vector<int32_t> row_start;  // rows + 1 offsets into col
+  std::vector<int32_t> col;        // block column of each stored block, sorted per row
+  std::vector<int32_t> diag;       // index of block (i, i) per row
+
+  size_t block_count() const { return col.size(); }
+  // Index of block (i, j) or -1 when it is not stored.
+  int32_t find(int32_t i, int32_t j) const;
+};
+
+using BlockValues = std::vector<Mat3>;
+
+// Nodes i, j are coupled when some tet holds both.
+BlockPattern build_block_pattern(int32_t node_count, const std::vector<Tet>& tets);
+
+// For each tet, the 16 block indices of (a, b), row-major: assembly is a plain scatter.
+std::vector<std::array<int32_t, 16>> element_block_slots(const BlockPattern& p, const std::vector<Tet>& tets);
+
+// y = A x
+void block_multiply(const BlockPattern& p, const BlockValues& A, const Vec3List& x, Vec3List& y);
+
+}  // namespace mica

@@ -1,0 +1,106 @@
+#include "fem/fem_model.hpp"
+
+#include <cmath>
+#include <numeric>
+
+#include "core/error.hpp"
+#include "fem/rotation.hpp"
+
+namespace mica {
+
+double FemModel::total_mass() const { return std::accumulate(node_mass.begin(), node_mass.end(), 0.0); }
+
+FemModel build_fem_model(const TetMesh& mesh, const Material& material, MassKind mass_kind,
+                         const std::string& source) {
+  const Material& mat = material;
+  if (!(mat.youngs_modulus > 0) || !std::isfinite(mat.youngs_modulus))
+    fail(Errc::InvalidArgument, source + ": Young's modulus must be finite and > 0 Pa");
+  if (!(mat.poisson_ratio >= 0 && mat.poisson_ratio < 0.5))
+    fail(Errc::InvalidArgument, source + ": Poisson ratio must be in [0, 0.5)");
+  if (!(mat.density > 0) || !std::isfinite(mat.density))
+    fail(Errc::InvalidArgument, source + ": density must be finite and > 0 kg/m^3");
+  validate_topology(mesh, source);
+  check_rest_quality(mesh, source);
+
+  FemModel m;
+  m.rest = mesh.nodes;
+  m.material = material;
+  m.lame = lame_parameters(material);
+  m.mass_kind = mass_kind;
+  m.elements.reserve(mesh.tets.size());
+  for (const Tet& t : mesh.tets) m.elements.push_back(make_tet_element(m.rest, t));
+  m.pattern = build_block_pattern(m.node_count(), mesh.tets);
+  m.slots = element_block_slots(m.pattern, mesh.tets);
+
+  // Consistent: M_ab = rho V / 20 (1 + delta_ab); lumped: rho V / 4 on the diagonal.
+  m.mass.assign(m.pattern.block_count(), 0.0);
+  for (size_t e = 0; e < m.elements.size(); ++e) {
+    const double rv = mat.density * m.elements[e].volume;
+    for (int a = 0; a < 4; ++a)
+      for (int b = 0; b < 4; ++b) {
+        const int32_t slot = m.slots[e][4 * a + b];
+        if (mass_kind == MassKind::Lumped)
+          m.mass[slot] += (a == b) ? rv / 4 : 0.0;
+        else
+          m.mass[slot] += (a == b) ? rv / 10 : rv / 20;
+      }
+  }
+  m.node_mass.assign(size_t(m.node_count()), 0.0);
+  for (int32_t i = 0; i < m.pattern.rows; ++i)
+    for (int32_t k = m.pattern.row_start[i]; k < m.pattern.row_start[i + 1]; ++k) m.node_mass[i] += m.mass[k];
+  return m;
+}
+
+void compute_rotations(const FemModel& m, const Vec3List& x, std::vector<Mat3>& R) {
+  for (size_t e = 0; e < m.elements.size(); ++e)
+    R[e] = proper_rotation(deformation_gradient(m.elements[e], x));
+}
+
+void assemble_elastic(const FemModel& m, const Vec3List& x, const std::vector<Mat3>* R, double k_scale,
+                      BlockValues* K, Vec3List& f_int) {
+  for (auto& f : f_int) f.setZero();
+  const Mat3 I = Mat3::Identity();
+  Mat3 Ke[16];
+  for (size_t e = 0; e < m.elements.size(); ++e) {
+    const TetElement& el = m.elements[e];
+    const Mat3& Re = R ? (*R)[e] : I;
+    add_elastic_forces(el, m.lame, Re, deformation_gradient(el, x), f_int);
+    if (!K) continue;
+    rotated_stiffness(el, m.lame, Re, k_scale, Ke);
+    for (int q = 0; q < 16; ++q) (*K)[m.slots[e][q]] += Ke[q];
+  }
+}
+
+void set_scaled_mass(const FemModel& m, double scale, BlockValues& A) {
+  for (size_t k = 0; k < A.size(); ++k) A[k] = (scale * m.mass[k]) * Mat3::Identity();
+}
+
+void add_scaled_mass(const FemModel& m, double scale, BlockValues& A) {
+  for (size_t k = 0; k < A.size(); ++k) A[k].diagonal().array() += scale * m.mass[k];
+}
+
+void mass_multiply(const FemModel& m, const Vec3List& v, Vec3List& out) {
+  const BlockPattern& p = m.pattern;
+  for (int32_t i = 0; i < p.rows; ++i) {
+    Vec3 sum = Vec3::Zero();
+    for (int32_t k = p.row_start[i]; k < p.row_start[i + 1]; ++k) sum += m.mass[k] * v[p.col[k]];
+    out[i] = sum;
+  }
+}
+
+double elastic_energy(const FemModel& m, const Vec3List& x, bool corotational) {
+  double energy = 0;
+  for (const TetElement& el : m.elements) {
+    const Mat3 F = deformation_gradient(el, x);
+    energy += elastic_energy(el, m.lame, corotational ? proper_rotation(F) : Mat3::Identity(), F);
+  }
+  return energy;
+}
+
+double kinetic_energy(const FemModel& m, const Vec3List& v) {
+  Vec3List Mv(v.size());
+  mass_multiply(m, v, Mv);
+  return 0.5 * flat(v).dot(flat(Mv));
+}
+
+}  // namespace mica

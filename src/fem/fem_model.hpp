@@ -1,0 +1,56 @@
+// The finite-element model of one body: what is constant (rest shape, elements, mass,
+// matrix pattern) and the routines that assemble A = M + h C + h^2 K and the forces from it.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "core/types.hpp"
+#include "fem/block_matrix.hpp"
+#include "fem/material.hpp"
+#include "fem/tet_element.hpp"
+#include "mesh/tet_mesh.hpp"
+
+namespace mica {
+
+enum class MassKind { Consistent, Lumped };
+
+struct FemModel {
+  Vec3List rest;
+  std::vector<TetElement> elements;
+  Material material;
+  Lame lame;
+  MassKind mass_kind;
+  BlockPattern pattern;
+  std::vector<std::array<int32_t, 16>> slots;  // per element, block index of (a, b)
+  std::vector<double> mass;                    // scalar mass per block (M_ij = mass * I)
+  std::vector<double> node_mass;               // row sums of M: the node's share, kg
+
+  int32_t node_count() const { return int32_t(rest.size()); }
+  double total_mass() const;
+};
+
+// Validates the mesh (topology, rest quality) and precomputes the model. Throws Error naming
+// the offending element; `source` prefixes messages.
+FemModel build_fem_model(const TetMesh& mesh, const Material& material, MassKind mass_kind,
+                         const std::string& source);
+
+// Per-element rotations of the current positions x.
+void compute_rotations(const FemModel& m, const Vec3List& x, std::vector<Mat3>& R);
+
+// f_int = sum of element elastic forces at x; when K is not null also K += k_scale * sum R Ke R^T.
+// R == nullptr means the linear model (R = I for every element).
+void assemble_elastic(const FemModel& m, const Vec3List& x, const std::vector<Mat3>* R, double k_scale,
+                      BlockValues* K, Vec3List& f_int);
+
+// A = scale * M (overwrites every block, so it also clears A).
+void set_scaled_mass(const FemModel& m, double scale, BlockValues& A);
+// A += scale * M
+void add_scaled_mass(const FemModel& m, double scale, BlockValues& A);
+// out = M v
+void mass_multiply(const FemModel& m, const Vec3List& v, Vec3List& out);
+
+// Strain energy at x; co-rotational uses each element's own rotation of x, linear R = I.
+double elastic_energy(const FemModel& m, const Vec3List& x, bool corotational);
+double kinetic_energy(const FemModel& m, const Vec3List& v);
+
+}  // namespace mica

@@ -1,0 +1,65 @@
+#include "fem/tet_element.hpp"
+
+#include <Eigen/LU>
+
+namespace mica {
+
+TetElement make_tet_element(const Vec3List& rest, const Tet& nodes) {
+  TetElement e;
+  e.nodes = nodes;
+  Mat3 dm;
+  for (int k = 0; k < 3; ++k) dm.col(k) = rest[nodes[k + 1]] - rest[nodes[0]];
+  e.volume = dm.determinant() / 6.0;
+  e.dm_inv = dm.inverse();
+  e.grad[0].setZero();
+  for (int k = 0; k < 3; ++k) {
+    e.grad[k + 1] = e.dm_inv.row(k).transpose();
+    e.grad[0] -= e.grad[k + 1];
+  }
+  return e;
+}
+
+Mat3 deformation_gradient(const TetElement& e, const Vec3List& x) {
+  Mat3 ds;
+  const Vec3& x0 = x[e.nodes[0]];
+  for (int k = 0; k < 3; ++k) ds.col(k) = x[e.nodes[k + 1]] - x0;
+  return ds * e.dm_inv;
+}
+
+namespace {
+// Small strain in the rotated frame and its stress: eps = sym(R^T F) - I.
+Mat3 rotated_strain(const Mat3& R, const Mat3& F) {
+  const Mat3 G = R.transpose() * F;
+  return 0.5 * (G + G.transpose()) - Mat3::Identity();
+}
+Mat3 stress(const Lame& m, const Mat3& eps) {
+  return 2 * m.mu * eps + m.lambda * eps.trace() * Mat3::Identity();
+}
+}  // namespace
+
+void add_elastic_forces(const TetElement& e, const Lame& m, const Mat3& R, const Mat3& F, Vec3List& f) {
+  const Mat3 P = -e.volume * (R * stress(m, rotated_strain(R, F)));
+  for (int a = 0; a < 4; ++a) f[e.nodes[a]] += P * e.grad[a];
+}
+
+void rotated_stiffness(const TetElement& e, const Lame& m, const Mat3& R, double scale, Mat3 K[16]) {
+  Vec3 h[4];
+  for (int a = 0; a < 4; ++a) h[a] = R * e.grad[a];
+  const double vl = scale * e.volume * m.lambda, vm = scale * e.volume * m.mu;
+  for (int a = 0; a < 4; ++a) {
+    for (int b = a; b < 4; ++b) {
+      Mat3 k = vl * h[a] * h[b].transpose() + vm * h[b] * h[a].transpose();
+      k.diagonal().array() += vm * e.grad[a].dot(e.grad[b]);
+      K[4 * a + b] = k;
+      if (b != a) K[4 * b + a] = k.transpose();
+    }
+  }
+}
+
+double elastic_energy(const TetElement& e, const Lame& m, const Mat3& R, const Mat3& F) {
+  const Mat3 eps = rotated_strain(R, F);
+  const double tr = eps.trace();
+  return e.volume * (m.mu * eps.squaredNorm() + 0.5 * m.lambda * tr * tr);
+}
+
+}  // namespace mica

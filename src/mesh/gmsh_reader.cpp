@@ -1,0 +1,384 @@
+// Gmsh ASCII mesh reader, format versions 2.2 and 4.1: keeps the 4-node tetrahedra.
+// Nodes are renumbered 0..n-1 in the order the $Nodes section lists them; nodes that no
+// tetrahedron uses are dropped. Memory reserved for a count read from the file is capped by
+// what the bytes left can hold, so a lying header fails at the end of the text, unallocated.
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <limits>
+#include <string>
+#include <string_view>
+#include <unordered_map>
+#include <vector>
+
+#include "core/error.hpp"
+#include "mesh/mesh_io.hpp"
+
+namespace mica {
+namespace detail {
+std::string read_text_file(const std::string& path);  // defined in mesh_io.cpp
+}
+
+namespace {
+
+constexpr int kTet4 = 4;                   // Gmsh element type of the 4-node tetrahedron
+constexpr std::int64_t kMinNodeBytes = 8;  // shortest node record: "1 0 0 0\n"
+
+bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
+
+std::string_view trim(std::string_view s) {
+  while (!s.empty() && is_space(s.front())) s.remove_prefix(1);
+  while (!s.empty() && is_space(s.back())) s.remove_suffix(1);
+  return s;
+}
+
+std::string_view first_token(std::string_view line) {
+  std::size_t end = 0;
+  while (end < line.size() && !is_space(line[end])) ++end;
+  return line.substr(0, end);
+}
+
+// A token as shown in a message: at most 40 characters, control characters replaced.
+std::string shown(std::string_view token) {
+  constexpr std::size_t kMax = 40;
+  std::string s;
+  for (char c : token.substr(0, kMax)) {
+    const auto u = static_cast<unsigned char>(c);
+    s += (u < 0x20 || u == 0x7f) ? '?' : c;
+  }
+  if (token.size() > kMax) s += "...";
+  return s;
+}
+
+// Walks the text one non-blank line at a time and formats errors with the line number.
+class LineReader {
+ public:
+  LineReader(std::string_view text, const std::string& name) : text_(text), name_(name) {}
+
+  // Moves to the next non-blank line; false at the end of the text, where the line number
+  // stays on the last line so that messages point at where the text stopped.
+  bool advance() {
+    while (pos_ < text_.size()) {
+      std::size_t end = text_.find('\n', pos_);
+      if (end == std::string_view::npos) end = text_.size();
+      line_ = trim(text_.substr(pos_, end - pos_));
+      pos_ = end < text_.size() ? end + 1 : end;
+      ++number_;
+      if (!line_.empty()) return true;
+    }
+    line_ = {};
+    return false;
+  }
+
+  // Like advance(), but the end of the text is an error: `what` was expected there.
+  std::string_view next(std::string_view what) {
+    if (!advance()) expected(what, "end of file");
+    return line_;
+  }
+
+  std::string_view line() const { return line_; }
+  std::int64_t bytes_left() const { return static_cast<std::int64_t>(text_.size() - pos_); }
+
+  [[noreturn]] void expected(std::string_view what, std::string_view got,
+                             Errc code = Errc::Parse) const {
+    fail(code, name_ + ": line " + std::to_string(number_ > 0 ? number_ : 1) + ": expected " +
+                   std::string(what) + ", got '" + shown(got) + "'");
+  }
+
+ private:
+  std::string_view text_;
+  const std::string& name_;
+  std::size_t pos_ = 0;
+  std::int64_t number_ = 0;
+  std::string_view line_;
+};
+
+// Reads the whitespace-separated fields of one line, reporting errors on that line.
+class Fields {
+ public:
+  Fields(const LineReader& at, std::string_view line) : at_(at), rest_(line) {}
+
+  std::string_view token(std::string_view what) {
+    rest_ = trim(rest_);
+    if (rest_.empty()) at_.expected(what, "end of line");
+    last_ = first_token(rest_);
+    rest_.remove_prefix(last_.size());
+    return last_;
+  }
+
+  // The token read last, for messages about it.
+  std::string_view last() const { return last_; }
+
+  // An integer in [lo, hi]; anything else is reported as not being `what`.
+  std::int64_t integer(std::string_view what,
+                       std::int64_t lo = std::numeric_limits<std::int64_t>::min(),
+                       std::int64_t hi = std::numeric_limits<std::int64_t>::max()) {
+    const std::string_view tok = token(what);
+    std::int64_t value = 0;
+    const auto [end, ec] = std::from_chars(tok.data(), tok.data() + tok.size(), value);
+    if (ec != std::errc() || end != tok.data() + tok.size() || value < lo || value > hi) {
+      at_.expected(what, tok);
+    }
+    return value;
+  }
+
+  // A record count: at most `max`, and small enough to index with int32.
+  std::int64_t count(std::string_view what,
+                     std::int64_t max = std::numeric_limits<std::int32_t>::max()) {
+    return integer(what, 0, max);
+  }
+
+  double coordinate(std::string_view what) {
+    const std::string tok(token(what));  // strtod needs a null-terminated string
+    char* end = nullptr;
+    const double value = std::strtod(tok.c_str(), &end);
+    if (end != tok.c_str() + tok.size() || !std::isfinite(value)) at_.expected(what, tok);
+    return value;
+  }
+
+  void finish() {
+    rest_ = trim(rest_);
+    if (!rest_.empty()) at_.expected("end of line", first_token(rest_));
+  }
+
+ private:
+  const LineReader& at_;
+  std::string_view rest_;
+  std::string_view last_;
+};
+
+enum class Version { Legacy2, Modern4 };
+
+class GmshParser {
+ public:
+  GmshParser(std::string_view text, const std::string& name) : lines_(text, name) {}
+
+  TetMesh parse() {
+    if (!lines_.advance() || lines_.line() != "$MeshFormat") {
+      lines_.expected("$MeshFormat", lines_.line().empty() ? "end of file" : first_token(lines_.line()));
+    }
+    read_format();
+    while (lines_.advance()) {
+      const std::string_view header = lines_.line();
+      if (header.front() != '$') lines_.expected("a section header such as $Nodes", first_token(header));
+      if (header == "$Nodes") {
+        version_ == Version::Legacy2 ? read_nodes_v2() : read_nodes_v4();
+      } else if (header == "$Elements") {
+        version_ == Version::Legacy2 ? read_elements_v2() : read_elements_v4();
+      } else {
+        skip_section(header);
+      }
+    }
+    if (tets_.empty()) lines_.expected("at least one 4-node tetrahedron (element type 4)", "end of file");
+    return compact();
+  }
+
+ private:
+  void read_format() {
+    Fields f(lines_, lines_.next("a version line 'version file-type data-size'"));
+    const std::string_view version = f.token("a format version");
+    if (version == "4.1") {
+      version_ = Version::Modern4;
+    } else if (version == "2.2" || version == "2.1" || version == "2.0" || version == "2") {
+      version_ = Version::Legacy2;
+    } else {
+      lines_.expected("format version 2.2 or 4.1", version, Errc::Unsupported);
+    }
+    const std::string_view file_type = f.token("a file type");
+    if (file_type != "0") {
+      lines_.expected("file type 0 (ASCII; binary .msh files are not supported)", file_type,
+                      file_type == "1" ? Errc::Unsupported : Errc::Parse);
+    }
+    f.integer("a data size");
+    f.finish();
+    expect_line("$EndMeshFormat");
+  }
+
+  void expect_line(std::string_view end_marker) {
+    const std::string_view line = lines_.next(end_marker);
+    if (line != end_marker) lines_.expected(end_marker, first_token(line));
+  }
+
+  void skip_section(std::string_view header) {
+    const std::string end_marker = "$End" + std::string(header.substr(1));
+    while (lines_.next(end_marker) != end_marker) {
+    }
+  }
+
+  // Records that `tag` names the node that will sit at `index` of nodes_.
+  void add_tag(std::int64_t tag, std::size_t index, const Fields& f) {
+    if (!index_of_tag_.emplace(tag, static_cast<std::int32_t>(index)).second) {
+      lines_.expected("a node tag not listed before", f.last());
+    }
+  }
+
+  std::int32_t node_index(Fields& f) {
+    const std::int64_t tag = f.integer("a node tag");
+    const auto it = index_of_tag_.find(tag);
+    if (it == index_of_tag_.end()) lines_.expected("a node tag listed in $Nodes", f.last());
+    return it->second;
+  }
+
+  static Vec3 read_point(Fields& f) {
+    const double x = f.coordinate("a finite x coordinate");
+    const double y = f.coordinate("a finite y coordinate");
+    const double z = f.coordinate("a finite z coordinate");
+    return {x, y, z};
+  }
+
+  // Room for `n` more nodes, but no more than the rest of the text can describe.
+  void reserve_nodes(std::int64_t n) {
+    const std::int64_t fit = std::min(n, lines_.bytes_left() / kMinNodeBytes);
+    nodes_.reserve(nodes_.size() + static_cast<std::size_t>(fit));
+  }
+
+  static constexpr std::int64_t kMaxTag = std::numeric_limits<std::int64_t>::max();
+
+  // 2.2: a count, then one "tag x y z" line per node.
+  void read_nodes_v2() {
+    Fields header(lines_, lines_.next("a node count"));
+    const std::int64_t n = header.count("a node count");
+    header.finish();
+    reserve_nodes(n);
+    for (std::int64_t i = 0; i < n; ++i) {
+      Fields f(lines_, lines_.next("a node line 'tag x y z'"));
+      add_tag(f.integer("a node tag", 1, kMaxTag), nodes_.size(), f);
+      nodes_.push_back(read_point(f));
+      f.finish();
+    }
+    expect_line("$EndNodes");
+  }
+
+  // 4.1: "numEntityBlocks numNodes minTag maxTag", then per block a header
+  // "entityDim entityTag parametric numNodesInBlock", the block's tags one per line, then its
+  // coordinates one node per line (parametric nodes add u [v [w]], which we ignore).
+  void read_nodes_v4() {
+    Fields header(lines_, lines_.next("a $Nodes header 'numEntityBlocks numNodes minTag maxTag'"));
+    const std::int64_t blocks = header.count("an entity block count");
+    const std::int64_t total = header.count("a node count");
+    header.integer("a minimum node tag");
+    header.integer("a maximum node tag");
+    header.finish();
+    reserve_nodes(total);
+    std::int64_t seen = 0;
+    for (std::int64_t b = 0; b < blocks; ++b) {
+      Fields block(lines_, lines_.next("a node block header 'entityDim entityTag parametric numNodes'"));
+      block.integer("an entity dimension 0 to 3", 0, 3);
+      block.integer("an entity tag");
+      const bool parametric = block.integer("a parametric flag 0 or 1", 0, 1) == 1;
+      const std::int64_t n = block.count("a block node count within the $Nodes total", total - seen);
+      block.finish();
+      seen += n;
+      const std::size_t first = nodes_.size();
+      for (std::int64_t i = 0; i < n; ++i) {
+        Fields f(lines_, lines_.next("a node tag line"));
+        add_tag(f.integer("a node tag", 1, kMaxTag), first + static_cast<std::size_t>(i), f);
+        f.finish();
+      }
+      for (std::int64_t i = 0; i < n; ++i) {
+        Fields f(lines_, lines_.next("a node coordinate line 'x y z'"));
+        nodes_.push_back(read_point(f));
+        if (!parametric) f.finish();
+      }
+    }
+    if (seen != total) more_expected("node", total, seen);
+    expect_line("$EndNodes");
+  }
+
+  // The blocks held fewer records than their section header promised.
+  [[noreturn]] void more_expected(const std::string& kind, std::int64_t total, std::int64_t seen) {
+    const std::string what = "another " + kind + " block (the header lists " + std::to_string(total) +
+                             " " + kind + "s, the blocks " + std::to_string(seen) + ")";
+    lines_.expected(what, first_token(lines_.next(what)));
+  }
+
+  // 2.2: a count, then "tag type numTags tags... nodes..." per element.
+  void read_elements_v2() {
+    Fields header(lines_, lines_.next("an element count"));
+    const std::int64_t n = header.count("an element count");
+    header.finish();
+    for (std::int64_t i = 0; i < n; ++i) {
+      Fields f(lines_, lines_.next("an element line 'tag type numTags tags... nodes...'"));
+      f.integer("an element tag");
+      const std::int64_t type = f.integer("an element type");
+      const std::int64_t num_tags = f.integer("a tag count", 0, kMaxTag);
+      for (std::int64_t t = 0; t < num_tags; ++t) f.integer("an element tag value");
+      if (type == kTet4) read_tet(f);
+    }
+    expect_line("$EndElements");
+  }
+
+  // 4.1: "numEntityBlocks numElements minTag maxTag", then per block a header
+  // "entityDim entityTag elementType numElementsInBlock" and one "tag nodes..." line per element.
+  void read_elements_v4() {
+    Fields header(lines_, lines_.next("an $Elements header 'numEntityBlocks numElements minTag maxTag'"));
+    const std::int64_t blocks = header.count("an entity block count");
+    const std::int64_t total = header.count("an element count");
+    header.integer("a minimum element tag");
+    header.integer("a maximum element tag");
+    header.finish();
+    std::int64_t seen = 0;
+    for (std::int64_t b = 0; b < blocks; ++b) {
+      Fields block(lines_, lines_.next("an element block header 'entityDim entityTag type numElements'"));
+      block.integer("an entity dimension 0 to 3", 0, 3);
+      block.integer("an entity tag");
+      const std::int64_t type = block.integer("an element type");
+      const std::int64_t n = block.count("a block element count within the $Elements total", total - seen);
+      block.finish();
+      seen += n;
+      for (std::int64_t i = 0; i < n; ++i) {
+        Fields f(lines_, lines_.next("an element line 'tag nodes...'"));
+        f.integer("an element tag");
+        if (type == kTet4) read_tet(f);
+      }
+    }
+    if (seen != total) more_expected("element", total, seen);
+    expect_line("$EndElements");
+  }
+
+  void read_tet(Fields& f) {
+    Tet t;
+    for (auto& v : t) v = node_index(f);
+    f.finish();
+    tets_.push_back(t);
+  }
+
+  // Keeps the nodes the tetrahedra use, numbered in the order $Nodes listed them.
+  TetMesh compact() const {
+    std::vector<std::int32_t> new_index(nodes_.size(), -1);
+    for (const Tet& t : tets_) {
+      for (std::int32_t v : t) new_index[static_cast<std::size_t>(v)] = 0;
+    }
+    TetMesh mesh;
+    for (std::size_t i = 0; i < nodes_.size(); ++i) {
+      if (new_index[i] < 0) continue;
+      new_index[i] = static_cast<std::int32_t>(mesh.nodes.size());
+      mesh.nodes.push_back(nodes_[i]);
+    }
+    mesh.tets.reserve(tets_.size());
+    for (const Tet& t : tets_) {
+      Tet renumbered;
+      for (std::size_t k = 0; k < 4; ++k) renumbered[k] = new_index[static_cast<std::size_t>(t[k])];
+      mesh.tets.push_back(renumbered);
+    }
+    return mesh;
+  }
+
+  LineReader lines_;
+  Version version_ = Version::Legacy2;
+  Vec3List nodes_;                                         // in file order
+  std::unordered_map<std::int64_t, std::int32_t> index_of_tag_;  // tag -> position in nodes_
+  std::vector<Tet> tets_;                                  // positions in nodes_
+};
+
+}  // namespace
+
+TetMesh parse_gmsh(std::string_view text, const std::string& name) {
+  return GmshParser(text, name).parse();
+}
+
+TetMesh read_gmsh(const std::string& path) { return parse_gmsh(detail::read_text_file(path), path); }
+
+}  // namespace mica

@@ -1,0 +1,68 @@
+#include "solver/direct_solver.hpp"
+
+#include <cmath>
+
+#include "core/error.hpp"
+
+namespace mica {
+
+void DirectSolver::analyze(const BlockPattern& pattern) {
+  const int32_t n = 3 * pattern.rows;
+  std::vector<Eigen::Triplet<double>> entries;
+  entries.reserve(9 * pattern.block_count() / 2 + 3 * size_t(pattern.rows));
+  for (int32_t i = 0; i < pattern.rows; ++i)
+    for (int32_t k = pattern.row_start[i]; k < pattern.row_start[i + 1]; ++k) {
+      const int32_t j = pattern.col[k];
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c)
+          if (3 * i + r >= 3 * j + c) entries.emplace_back(3 * i + r, 3 * j + c, 1.0);
+    }
+  lower_.resize(n, n);
+  lower_.setFromTriplets(entries.begin(), entries.end());
+  lower_.makeCompressed();
+  // Where each stored scalar comes from: entry (3i + r, 3j + c) is element (r, c) of block (i, j).
+  value_source_.resize(size_t(lower_.nonZeros()));
+  for (int32_t col = 0; col < n; ++col)
+    for (Eigen::SparseMatrix<double>::InnerIterator it(lower_, col); it; ++it) {
+      const int32_t row = int32_t(it.row());
+      const int32_t k = pattern.find(row / 3, col / 3);
+      value_source_[size_t(&it.valueRef() - lower_.valuePtr())] = 9 * k + 3 * (col % 3) + row % 3;
+    }
+  projected_.resize(pattern.block_count());
+  llt_.analyzePattern(lower_);
+  analyzed_ = true;
+}
+
+void DirectSolver::factorize(const ProjectedSystem& sys) {
+  const BlockPattern& p = sys.pattern;
+  for (int32_t i = 0; i < p.rows; ++i)
+    for (int32_t k = p.row_start[i]; k < p.row_start[i + 1]; ++k) projected_[k] = sys.block(i, k);
+  const double* source = projected_[0].data();
+  double* values = lower_.valuePtr();
+  for (size_t q = 0; q < value_source_.size(); ++q) values[q] = source[value_source_[q]];
+  llt_.factorize(lower_);
+  ++factorizations_;
+  if (llt_.info() != Eigen::Success)
+    fail(Errc::Numerical, "the system matrix is not positive definite (CHOLMOD factorization failed)");
+}
+
+SolveReport DirectSolver::solve(const ProjectedSystem& sys, const Vec3List& b, Vec3List& v) {
+  const size_t n = b.size();
+  rhs_.resize(n);
+  tmp_.resize(n);
+  check_.resize(n);
+  sys.right_hand_side(b, rhs_, tmp_);
+  const Eigen::VectorXd y = llt_.solve(flat(rhs_));
+  flat(v) = y;
+  // The residual of the projected system, reported like the iterative solvers'.
+  sys.apply(v, check_, tmp_);
+  const double rhs_norm = flat(rhs_).norm();
+  SolveReport report;
+  report.iterations = 1;
+  report.residual = rhs_norm > 0 ? (flat(check_) - flat(rhs_)).norm() / rhs_norm : 0;
+  report.converged = std::isfinite(report.residual);
+  for (int32_t i : sys.projection.nodes) v[i] += sys.projection.z[i];
+  return report;
+}
+
+}  // namespace mica

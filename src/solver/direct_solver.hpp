@@ -1,0 +1,34 @@
+// The exact velocity solve: sparse Cholesky (CHOLMOD, supernodal) of the projected system.
+// The symbolic analysis is done once per pattern; the numeric factorization whenever the
+// caller says the matrix or the constraints changed (a linear body factors once).
+#pragma once
+#include <Eigen/CholmodSupport>
+#include <Eigen/SparseCore>
+#include <memory>
+
+#include "solver/projected_system.hpp"
+
+namespace mica {
+
+class DirectSolver {
+ public:
+  // Builds the scalar lower-triangular pattern from the block pattern and analyses it.
+  void analyze(const BlockPattern& pattern);
+  bool analyzed() const { return analyzed_; }
+  // Numeric factorization of S A S + I - S. Throws Error(Numerical) if not positive definite.
+  void factorize(const ProjectedSystem& sys);
+  // v = y + z with y solving the factored system for the right-hand side of b.
+  SolveReport solve(const ProjectedSystem& sys, const Vec3List& b, Vec3List& v);
+  int64_t factorizations() const { return factorizations_; }
+
+ private:
+  Eigen::SparseMatrix<double> lower_;          // scalar matrix, lower triangle, fixed pattern
+  std::vector<int32_t> value_source_;          // per stored value: 9 * block + position in block
+  BlockValues projected_;                      // S A S + I - S per block
+  Eigen::CholmodSimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Lower> llt_;
+  Vec3List rhs_, tmp_, check_;
+  bool analyzed_ = false;
+  int64_t factorizations_ = 0;
+};
+
+}  // namespace mica

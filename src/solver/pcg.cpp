@@ -1,0 +1,67 @@
+#include "solver/pcg.hpp"
+
+#include <Eigen/LU>
+#include <cmath>
+
+namespace mica {
+
+void PcgWorkspace::resize(size_t n) {
+  for (Vec3List* v : {&r, &z, &p, &q, &tmp, &rhs}) v->resize(n);
+  inv_diag.resize(n);
+}
+
+namespace {
+double dot(const Vec3List& a, const Vec3List& b) { return flat(a).dot(flat(b)); }
+}  // namespace
+
+SolveReport solve_pcg(const ProjectedSystem& sys, const Vec3List& b, Vec3List& v, double tolerance,
+                      int32_t max_iterations, PcgWorkspace& ws) {
+  const int32_t n = sys.pattern.rows;
+  const Projection& proj = sys.projection;
+  ws.resize(size_t(n));
+  for (int32_t i = 0; i < n; ++i) ws.inv_diag[i] = sys.diagonal_block(i).inverse();
+
+  // Unknown y = S (v - z): start from the warm start's free part.
+  Vec3List& y = v;
+  for (int32_t i : proj.nodes) y[i] = proj.S[i] * y[i];
+  sys.right_hand_side(b, ws.rhs, ws.tmp);
+  sys.apply(y, ws.q, ws.tmp);
+  for (int32_t i = 0; i < n; ++i) ws.r[i] = ws.rhs[i] - ws.q[i];
+
+  SolveReport report;
+  const double rhs_norm = std::sqrt(dot(ws.rhs, ws.rhs));
+  const double stop = tolerance * rhs_norm;
+  double r_norm = std::sqrt(dot(ws.r, ws.r));
+  if (rhs_norm == 0) {
+    for (auto& yi : y) yi.setZero();
+    r_norm = 0;
+  }
+  double rz = 0;
+  while (r_norm > stop && report.iterations < max_iterations) {
+    for (int32_t i = 0; i < n; ++i) ws.z[i] = ws.inv_diag[i] * ws.r[i];
+    const double rz_new = dot(ws.r, ws.z);
+    if (report.iterations == 0) {
+      ws.p = ws.z;
+    } else {
+      const double beta = rz_new / rz;
+      for (int32_t i = 0; i < n; ++i) ws.p[i] = ws.z[i] + beta * ws.p[i];
+    }
+    rz = rz_new;
+    sys.apply(ws.p, ws.q, ws.tmp);
+    const double pq = dot(ws.p, ws.q);
+    if (!(pq > 0)) break;  // breakdown: the operator is not positive definite here
+    const double alpha = rz / pq;
+    for (int32_t i = 0; i < n; ++i) {
+      y[i] += alpha * ws.p[i];
+      ws.r[i] -= alpha * ws.q[i];
+    }
+    r_norm = std::sqrt(dot(ws.r, ws.r));
+    ++report.iterations;
+  }
+  for (int32_t i : proj.nodes) v[i] = y[i] + proj.z[i];
+  report.residual = rhs_norm > 0 ? r_norm / rhs_norm : 0;
+  report.converged = r_norm <= stop;
+  return report;
+}
+
+}  // namespace mica

@@ -1,0 +1,31 @@
+// The velocity system of one body under projection constraints.
+// With v = y + z, y = S y, the constrained problem S (A v - b) = 0, (I - S) v = z becomes
+// the symmetric positive definite system (S A S + I - S) y = S (b - A z).
+#pragma once
+#include "fem/block_matrix.hpp"
+#include "solver/projection.hpp"
+
+namespace mica {
+
+struct SolveReport {
+  int32_t iterations = 0;
+  double residual = 0;  // ||P y - r|| / ||r|| of the projected system (0 when r = 0)
+  bool converged = true;
+};
+
+struct ProjectedSystem {
+  const BlockPattern& pattern;
+  const BlockValues& A;
+  const Projection& projection;  // inactive: S = I, z = 0
+
+  // out = (S A S + I - S) y; tmp is scratch of the same size.
+  void apply(const Vec3List& y, Vec3List& out, Vec3List& tmp) const;
+  // rhs = S (b - A z); tmp is scratch.
+  void right_hand_side(const Vec3List& b, Vec3List& rhs, Vec3List& tmp) const;
+  // The projected diagonal block S_i A_ii S_i + I - S_i.
+  Mat3 diagonal_block(int32_t i) const;
+  // The projected block (i, j) stored at index k.
+  Mat3 block(int32_t i, int32_t k) const;
+};
+
+}  // namespace mica

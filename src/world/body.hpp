@@ -1,0 +1,60 @@
+// A deformable (or static) body: its finite-element model, its state, and the per-step
+// work arrays, sized once at creation so that stepping does not allocate.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "fem/fem_model.hpp"
+#include "solver/direct_solver.hpp"
+#include "solver/pcg.hpp"
+#include "solver/projection.hpp"
+
+namespace mica {
+
+struct BodySettings {
+  Material material;
+  double rayleigh_alpha = 0;  // 1/s
+  double rayleigh_beta = 0;   // s
+  MassKind mass = MassKind::Consistent;
+  bool corotational = true;
+  bool is_static = false;
+};
+
+struct Body {
+  Body(const TetMesh& mesh, const BodySettings& settings, const std::string& name);
+
+  BodySettings settings;
+  std::string name;            // "body 0x..." in messages
+  FemModel fem;
+  std::vector<Tet> tets;
+  std::vector<Tri> surface;
+
+  // State.
+  Vec3List x, v;
+  Vec3List node_forces;        // persistent user loads, N
+  bool has_node_forces = false;
+  uint64_t lpc_version = 0;    // bumped when a constraint on this body is added or removed
+
+  // Per-step work.
+  std::vector<Mat3> R;         // element rotations
+  BlockValues A;               // M + h C + h^2 K
+  Vec3List f_int, f_ext, b, v_next, x_next;
+  Projection projection;
+  DirectSolver direct;
+  PcgWorkspace pcg;
+
+  // What A and the factorization were built for; a linear body reuses both while unchanged.
+  struct MatrixKey {
+    double h = 0, alpha = -1, beta = -1;
+    bool operator==(const MatrixKey& o) const { return h == o.h && alpha == o.alpha && beta == o.beta; }
+  } matrix_key;
+  bool matrix_current = false;   // A holds M + hC + h^2 K for matrix_key
+  uint64_t factored_lpc_version = ~uint64_t(0);
+  bool factor_current = false;
+  bool matrix_rebuilt = false;   // this step assembled A anew
+
+  bool is_dynamic() const { return !settings.is_static; }
+  bool has_damping() const { return settings.rayleigh_alpha != 0 || settings.rayleigh_beta != 0; }
+};
+
+}  // namespace mica

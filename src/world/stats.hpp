@@ -1,0 +1,55 @@
+// Per-stage counters and timings of the step, and the solver's report.
+#pragma once
+#include <array>
+#include <chrono>
+#include <cstdint>
+
+namespace mica {
+
+// The stages of a step, in pipeline order (the C header lists the same order).
+enum class Stage { Loads, Rotations, Elements, Damping, Constraints, Solve, Integrate, Count };
+constexpr int kStageCount = int(Stage::Count);
+
+struct StageStats {
+  int32_t runs_last_step = 0;
+  int64_t runs_total = 0;
+  double ms_last_step = 0;
+  double ms_total = 0;
+};
+
+struct WorldStats {
+  int64_t step_count = 0;
+  std::array<StageStats, kStageCount> stages{};
+  int32_t solver_iterations = 0;
+  double solver_residual = 0;
+  bool converged = true;
+  double ms_last_step = 0;
+};
+
+// Runs a stage if the plan holds it, timing it into the stats.
+class StageRunner {
+ public:
+  explicit StageRunner(WorldStats& stats) : stats_(stats) {
+    for (auto& s : stats_.stages) {
+      s.runs_last_step = 0;
+      s.ms_last_step = 0;
+    }
+  }
+  template <class F>
+  void run(Stage stage, bool planned, F&& f) {
+    if (!planned) return;
+    const auto start = std::chrono::steady_clock::now();
+    f();
+    const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    StageStats& s = stats_.stages[size_t(stage)];
+    s.runs_last_step += 1;
+    s.runs_total += 1;
+    s.ms_last_step += ms;
+    s.ms_total += ms;
+  }
+
+ private:
+  WorldStats& stats_;
+};
+
+}  // namespace mica

@@ -1,0 +1,108 @@
+#include "world/world.hpp"
+
+#include <cmath>
+
+namespace mica {
+
+namespace {
+void check_finite(const Vec3& v, const std::string& what) {
+  if (!v.allFinite()) fail(Errc::InvalidArgument, what + " must be finite");
+}
+}  // namespace
+
+World::World(const WorldSettings& settings) : settings_(settings) {
+  check_finite(settings.gravity, "gravity");
+  if (!(settings.tolerance > 0) || !std::isfinite(settings.tolerance))
+    fail(Errc::InvalidArgument, "tolerance must be finite and > 0");
+  if (settings.max_iterations < 1) fail(Errc::InvalidArgument, "max_iterations must be >= 1");
+}
+
+void World::set_gravity(const Vec3& g) {
+  check_finite(g, "gravity");
+  settings_.gravity = g;
+}
+
+Id World::add_body(const TetMesh& mesh, const BodySettings& settings, const Vec3& translation, const Vec3& velocity) {
+  check_finite(translation, "translation");
+  check_finite(velocity, "initial velocity");
+  const double alpha = settings.rayleigh_alpha, beta = settings.rayleigh_beta;
+  if (!(alpha >= 0) || !std::isfinite(alpha)) fail(Errc::InvalidArgument, "rayleigh_alpha must be finite and >= 0");
+  if (!(beta >= 0) || !std::isfinite(beta)) fail(Errc::InvalidArgument, "rayleigh_beta must be finite and >= 0");
+  TetMesh placed = mesh;  // the rest shape sits where the body is placed
+  for (Vec3& p : placed.nodes) p += translation;
+  auto body = std::make_unique<Body>(placed, settings, "body " + std::to_string(bodies_created_));
+  if (!settings.is_static)
+    for (Vec3& u : body->v) u = velocity;
+  const Id id = bodies_.insert(std::move(body));
+  ++bodies_created_;
+  return id;
+}
+
+void World::remove_body(Id id) {
+  body(id);  // throws for a stale id
+  std::vector<Id> doomed;
+  lpcs_.for_each([&](Id lpc, const Lpc& c) {
+    if (c.body == id) doomed.push_back(lpc);
+  });
+  for (Id lpc : doomed) lpcs_.erase(lpc);
+  bodies_.erase(id);
+}
+
+void World::set_node_forces(Id id, const std::vector<int32_t>& nodes, const Vec3List& forces) {
+  Body& b = body(id);
+  for (size_t k = 0; k < nodes.size(); ++k) {
+    if (nodes[k] < 0 || nodes[k] >= b.fem.node_count())
+      fail(Errc::OutOfRange, b.name + ": node index " + std::to_string(nodes[k]) + " at position " +
+                                 std::to_string(k) + " is outside 0.." + std::to_string(b.fem.node_count() - 1));
+    check_finite(forces[k], "force " + std::to_string(k));
+  }
+  for (size_t k = 0; k < nodes.size(); ++k) b.node_forces[nodes[k]] = forces[k];
+  b.has_node_forces = false;
+  for (const Vec3& f : b.node_forces) b.has_node_forces = b.has_node_forces || !f.isZero(0);
+}
+
+Mat3 constrained_projector(const LpcSpec& spec) {
+  auto unit = [](const Vec3& d, const char* what) {
+    const double n = d.norm();
+    if (!(n > 1e-12) || !std::isfinite(n)) fail(Errc::InvalidArgument, std::string(what) + " must be a finite non-zero vector");
+    return Vec3(d / n);
+  };
+  switch (spec.kind) {
+    case LpcKind::Fixed: return Mat3::Identity();
+    case LpcKind::Plane: return line_projector(unit(spec.directions[0], "the plane normal"));
+    case LpcKind::Line: return Mat3::Identity() - line_projector(unit(spec.directions[0], "the line direction"));
+    case LpcKind::TwoDirections: {
+      const Vec3 p = unit(spec.directions[0], "direction 0");
+      const Vec3 q0 = spec.directions[1] - p * p.dot(spec.directions[1]);  // orthogonalise
+      if (!(q0.norm() > 1e-6 * spec.directions[1].norm()))
+        fail(Errc::InvalidArgument, "the two constrained directions are parallel");
+      return line_projector(p) + line_projector(unit(q0, "direction 1"));
+    }
+  }
+  fail(Errc::InvalidArgument, "unknown constraint kind");
+}
+
+Id World::add_lpc(Id body_id, const std::vector<int32_t>& nodes, const LpcSpec& spec) {
+  Body& b = body(body_id);
+  if (nodes.empty()) fail(Errc::InvalidArgument, "a constraint needs at least one node");
+  for (size_t k = 0; k < nodes.size(); ++k)
+    if (nodes[k] < 0 || nodes[k] >= b.fem.node_count())
+      fail(Errc::OutOfRange, b.name + ": node index " + std::to_string(nodes[k]) + " at position " +
+                                 std::to_string(k) + " is outside 0.." + std::to_string(b.fem.node_count() - 1));
+  check_finite(spec.velocity, "the prescribed velocity");
+  auto lpc = std::make_unique<Lpc>(Lpc{body_id, nodes, constrained_projector(spec), spec.velocity});
+  const Id id = lpcs_.insert(std::move(lpc));
+  ++b.lpc_version;
+  return id;
+}
+
+void World::remove_lpc(Id id) {
+  const Lpc& c = lpcs_.get(id, "constraint");
+  Body* b = bodies_.find(c.body);
+  lpcs_.erase(id);
+  if (!b) return;
+  ++b->lpc_version;
+  b->projection.reset(b->fem.node_count());  // the constraints stage rebuilds what remains
+}
+
+}  // namespace mica

@@ -1,0 +1,92 @@
+// The world: bodies, constraints, settings, and the step. Every mutating call validates
+// everything before it changes anything, so a call that throws leaves the world as it was.
+#pragma once
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "world/body.hpp"
+#include "world/slot_map.hpp"
+#include "world/stats.hpp"
+
+namespace mica {
+
+enum class SolverKind { Direct, Pcg };
+
+struct WorldSettings {
+  Vec3 gravity{0, -9.81, 0};
+  SolverKind solver = SolverKind::Direct;
+  int32_t max_iterations = 200;
+  double tolerance = 1e-8;
+  bool plan_all_stages = false;  // run every stage even when its effect is absent
+};
+
+enum class LpcKind { Fixed, Plane, Line, TwoDirections };
+
+struct LpcSpec {
+  LpcKind kind = LpcKind::Fixed;
+  Vec3 directions[2] = {Vec3::UnitX(), Vec3::UnitY()};
+  Vec3 velocity = Vec3::Zero();  // m/s, prescribed for the constrained components
+};
+
+// The constrained directions (I - S) of a constraint kind; throws on a zero or parallel direction.
+Mat3 constrained_projector(const LpcSpec& spec);
+
+struct Lpc {
+  Id body;
+  std::vector<int32_t> nodes;
+  Mat3 constrained;  // I - S
+  Vec3 velocity;
+};
+
+// Which stages the scene calls for (each body also checks its own need inside a stage).
+struct Plan {
+  bool loads = false, rotations = false, elements = false, damping = false;
+  bool constraints = false, solve = false, integrate = false;
+};
+
+class World {
+ public:
+  explicit World(const WorldSettings& settings);
+
+  const WorldSettings& settings() const { return settings_; }
+  void set_gravity(const Vec3& g);
+
+  Id add_body(const TetMesh& mesh, const BodySettings& settings, const Vec3& translation, const Vec3& velocity);
+  void remove_body(Id id);
+  Body& body(Id id) { return bodies_.get(id, "body"); }
+  const Body& body(Id id) const { return bodies_.get(id, "body"); }
+  void set_node_forces(Id body, const std::vector<int32_t>& nodes, const Vec3List& forces);
+
+  Id add_lpc(Id body, const std::vector<int32_t>& nodes, const LpcSpec& spec);
+  void remove_lpc(Id id);
+
+  // One implicit step of h seconds. Throws Error(Numerical) and keeps the old state when
+  // the result is not finite.
+  void step(double h);
+
+  Plan plan() const;
+  const WorldStats& stats() const { return stats_; }
+
+  template <class F>
+  void for_each_body(F&& f) const { bodies_.for_each(f); }
+
+ private:
+  void apply_loads(Body& b) const;
+  void assemble_elements(Body& b, double h, bool damping) const;
+  void add_damping(Body& b, double h) const;
+  void build_projection(Body& b) const;
+  void solve_velocities(Body& b, double h);
+  void commit();
+
+  bool needs_loads(const Body& b) const;
+  bool needs_damping(const Body& b) const;
+
+  WorldSettings settings_;
+  SlotMap<Body, IdKind::Body> bodies_;
+  SlotMap<Lpc, IdKind::Lpc> lpcs_;
+  WorldStats stats_;
+  int64_t bodies_created_ = 0;
+};
+
+}  // namespace mica

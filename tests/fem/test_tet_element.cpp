@@ -1,0 +1,151 @@
+// Element-level physics: patch test, rigid-motion invariance, stiffness against a finite
+// difference of the forces, and mass totals.
+#include "fem/fem_model.hpp"
+#include "fem/rotation.hpp"
+#include "test_util.hpp"
+
+using namespace mica;
+
+namespace {
+
+FemModel cube_model(MassKind mass = MassKind::Consistent, int32_t tets_per_cell = 6) {
+  const TetMesh mesh = make_box_grid(Vec3(0, 0, 0), Vec3(1, 0.8, 0.6), {4, 3, 3}, tets_per_cell);
+  return build_fem_model(mesh, Material{1e5, 0.3, 1000}, mass, "test");
+}
+
+Vec3List forces(const FemModel& m, const Vec3List& x, bool corotational) {
+  std::vector<Mat3> R(m.elements.size(), Mat3::Identity());
+  if (corotational) compute_rotations(m, x, R);
+  Vec3List f(x.size(), Vec3::Zero());
+  assemble_elastic(m, x, corotational ? &R : nullptr, 0, nullptr, f);
+  return f;
+}
+
+Mat3 rotation_about(const Vec3& axis, double angle) { return Eigen::AngleAxisd(angle, axis.normalized()).matrix(); }
+
+// Nodes strictly inside the box: their force has contributions from every side.
+std::vector<int32_t> interior_nodes(const FemModel& m) {
+  std::vector<int32_t> inside;
+  for (int32_t i = 0; i < m.node_count(); ++i) {
+    const Vec3& p = m.rest[i];
+    if (p.x() > 1e-9 && p.x() < 1 - 1e-9 && p.y() > 1e-9 && p.y() < 0.8 - 1e-9 && p.z() > 1e-9 && p.z() < 0.6 - 1e-9)
+      inside.push_back(i);
+  }
+  return inside;
+}
+
+void patch_test(bool corotational, int32_t tets_per_cell) {
+  const FemModel m = cube_model(MassKind::Consistent, tets_per_cell);
+  Mat3 G;  // an affine map with stretch, shear and (for co-rotation) a rotation
+  G << 1.02, 0.01, -0.015, 0.005, 0.99, 0.02, -0.01, 0.012, 1.01;
+  if (corotational) G = rotation_about(Vec3(1, 2, 3), 0.7) * G;
+  Vec3List x(m.rest.size());
+  for (size_t i = 0; i < x.size(); ++i) x[i] = G * m.rest[i] + Vec3(0.3, -0.2, 0.1);
+  const Vec3List f = forces(m, x, corotational);
+  double scale = 0;  // the typical boundary force, for a relative tolerance
+  for (const Vec3& fi : f) scale = std::max(scale, fi.norm());
+  assert_true(scale > 0);
+  const auto inside = interior_nodes(m);
+  assert_true(inside.size() >= 4);
+  for (int32_t i : inside) assert_le(f[i].norm(), 1e-10 * scale);
+}
+
+}  // namespace
+
+static void test_patch_linear(void**) { patch_test(false, 6); patch_test(false, 5); }
+static void test_patch_corotational(void**) { patch_test(true, 6); patch_test(true, 5); }
+
+static void test_rigid_rotation_gives_no_force(void**) {
+  const FemModel m = cube_model();
+  const Mat3 Q = rotation_about(Vec3(0.3, -1, 0.5), M_PI / 2);  // 90 degrees
+  Vec3List x(m.rest.size());
+  for (size_t i = 0; i < x.size(); ++i) x[i] = Q * m.rest[i] + Vec3(1, 2, 3);
+  const double E = m.material.youngs_modulus;
+  double corot = 0, linear = 0;
+  for (const Vec3& f : forces(m, x, true)) corot = std::max(corot, f.norm());
+  for (const Vec3& f : forces(m, x, false)) linear = std::max(linear, f.norm());
+  // Force scale of a unit strain on a 0.25 m cell: E * area ~ E * 0.06 m^2.
+  assert_le(corot, 1e-10 * E * 0.06);
+  assert_true(linear > 1e-2 * E * 0.06);  // the linear model sees the rotation as strain
+}
+
+static void test_rotation_is_proper_for_inverted_elements(void**) {
+  Mat3 F;
+  F << 0.5, 0.2, 0.0, -0.1, 0.8, 0.3, 0.05, 0.1, -0.7;  // det < 0: inverted
+  assert_true(F.determinant() < 0);
+  const Mat3 R = proper_rotation(F);
+  assert_near(R.determinant(), 1.0, 1e-12);
+  assert_near((R.transpose() * R - Mat3::Identity()).norm(), 0.0, 1e-12);
+  const Mat3 collapsed = Vec3(1, 0, 0) * Vec3(0, 1, 0).transpose();  // rank 1
+  assert_near(proper_rotation(collapsed).determinant(), 1.0, 1e-12);
+  const Mat3 Q = rotation_about(Vec3(1, 1, 0), 2.0);
+  assert_near((proper_rotation(Q * Vec3(1.1, 0.9, 1.0).asDiagonal()) - Q).norm(), 0.0, 1e-12);
+}
+
+// -d f / d x against the assembled K, by central differences along random directions.
+static void check_stiffness(const FemModel& m, const Vec3List& x, bool corotational, double rel_tol) {
+  std::vector<Mat3> R(m.elements.size(), Mat3::Identity());
+  if (corotational) compute_rotations(m, x, R);
+  BlockValues K(m.pattern.block_count(), Mat3::Zero());
+  Vec3List f(x.size());
+  assemble_elastic(m, x, corotational ? &R : nullptr, 1.0, &K, f);
+  std::mt19937 rng(7);
+  std::normal_distribution<double> normal;
+  for (int trial = 0; trial < 3; ++trial) {
+    Vec3List dx(x.size()), Kdx(x.size());
+    for (Vec3& d : dx) d = Vec3(normal(rng), normal(rng), normal(rng));
+    block_multiply(m.pattern, K, dx, Kdx);
+    const double eps = 1e-6;
+    Vec3List xp = x, xm = x;
+    for (size_t i = 0; i < x.size(); ++i) {
+      xp[i] += eps * dx[i];
+      xm[i] -= eps * dx[i];
+    }
+    const Vec3List fp = forces(m, xp, corotational), fm = forces(m, xm, corotational);
+    double err = 0, ref = 0;
+    for (size_t i = 0; i < x.size(); ++i) {
+      err += (-(fp[i] - fm[i]) / (2 * eps) - Kdx[i]).squaredNorm();
+      ref += Kdx[i].squaredNorm();
+    }
+    assert_le(std::sqrt(err / ref), rel_tol);
+  }
+}
+
+static void test_stiffness_matches_finite_difference(void**) {
+  const FemModel m = cube_model();
+  Vec3List x(m.rest.size());
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> jitter(-0.01, 0.01);
+  for (size_t i = 0; i < x.size(); ++i) x[i] = m.rest[i] + Vec3(jitter(rng), jitter(rng), jitter(rng));
+  check_stiffness(m, x, false, 1e-7);  // linear: K is the exact Jacobian
+  // Co-rotational K = R Ke R^T drops dR/dx, which vanishes at zero strain: exact on a
+  // rigidly rotated body, first order in the strain otherwise.
+  const Mat3 Q = rotation_about(Vec3(1, -2, 0.5), 1.1);
+  Vec3List rotated(m.rest.size());
+  for (size_t i = 0; i < x.size(); ++i) rotated[i] = Q * m.rest[i];
+  check_stiffness(m, rotated, true, 1e-7);
+}
+
+static void test_total_mass(void**) {
+  for (MassKind kind : {MassKind::Consistent, MassKind::Lumped})
+    for (int32_t tpc : {5, 6}) {
+      const FemModel m = cube_model(kind, tpc);
+      assert_near(m.total_mass(), 1000 * (1 * 0.8 * 0.6), 1e-9);
+      // M is symmetric and its blocks sum to the total (each tet's mass matrix sums to rho V).
+      double sum = 0;
+      for (double v : m.mass) sum += v;
+      assert_near(sum, m.total_mass(), 1e-9);
+    }
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_patch_linear),
+      cmocka_unit_test(test_patch_corotational),
+      cmocka_unit_test(test_rigid_rotation_gives_no_force),
+      cmocka_unit_test(test_rotation_is_proper_for_inverted_elements),
+      cmocka_unit_test(test_stiffness_matches_finite_difference),
+      cmocka_unit_test(test_total_mass),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}
