@@ -1,0 +1,6 @@
+#!/usr/bin/env bash
+# The whole test suite: install what is missing, build, run every test through ctest.
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+bash "$root/scripts/build.sh"
+ctest --test-dir "$root/build" --output-on-failure -j "$(nproc 2>/dev/null || echo 2)" "$@"
