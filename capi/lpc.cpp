@@ -44,6 +44,16 @@ MICA_API mica_status mica_add_lpc(mica_world* world, mica_body_id body, const in
   });
 }
 
+MICA_API mica_status mica_lpc_get_reaction(const mica_world* world, mica_lpc_id lpc, double out_force[3]) {
+  return guarded(world, "mica_lpc_get_reaction", [&] {
+    require(world, "world");
+    require(out_force, "out_force");
+    const mica::Vec3& f = world->world.lpc(lpc).reaction;
+    for (int k = 0; k < 3; ++k) out_force[k] = f[k];
+    return MICA_OK;
+  });
+}
+
 MICA_API mica_status mica_lpc_remove(mica_world* world, mica_lpc_id lpc) {
   return guarded(world, "mica_lpc_remove", [&] {
     require(world, "world");

@@ -69,8 +69,8 @@ MICA_API const char* mica_status_string(mica_status status) {
 }
 
 MICA_API const char* mica_stage_name(int32_t stage) {
-  static const char* const kNames[MICA_STAGE_COUNT] = {"loads",       "rotations", "elements", "damping",
-                                                        "constraints", "solve",     "integrate"};
+  static const char* const kNames[MICA_STAGE_COUNT] = {"loads", "rotations", "elements", "damping", "constraints",
+                                                        "solve", "integrate", "collide",  "forces"};
   return (stage >= 0 && stage < MICA_STAGE_COUNT) ? kNames[stage] : "unknown";
 }
 

@@ -7,7 +7,8 @@
 using namespace mica_capi;
 
 static_assert(MICA_STAGE_COUNT == mica::kStageCount, "the C stage list must match the core's");
-static_assert(MICA_STAGE_SOLVE == int(mica::Stage::Solve) && MICA_STAGE_INTEGRATE == int(mica::Stage::Integrate),
+static_assert(MICA_STAGE_SOLVE == int(mica::Stage::Solve) && MICA_STAGE_COLLIDE == int(mica::Stage::Collide) &&
+                  MICA_STAGE_FORCES == int(mica::Stage::Forces),
               "the C stage order must match the core's");
 
 namespace {
@@ -20,15 +21,27 @@ mica_world_def world_defaults() {
   d.solver = MICA_SOLVER_DIRECT;
   d.max_iterations = 200;
   d.tolerance = 1e-8;
+  d.pgs_sweeps = 1;
+  d.max_recovery_speed = 1.0;
   return d;
 }
 
 mica::WorldSettings translate(const mica_world_def& d) {
   mica::WorldSettings s;
   s.gravity = vec3(d.gravity, "def->gravity");
-  if (d.solver != MICA_SOLVER_DIRECT && d.solver != MICA_SOLVER_PCG)
-    refuse(MICA_ERR_INVALID_ARGUMENT, "def->solver is " + std::to_string(d.solver) + ", not a MICA_SOLVER_* value");
-  s.solver = d.solver == MICA_SOLVER_PCG ? mica::SolverKind::Pcg : mica::SolverKind::Direct;
+  switch (d.solver) {
+    case MICA_SOLVER_DIRECT: s.solver = mica::SolverKind::Direct; break;
+    case MICA_SOLVER_PCG: s.solver = mica::SolverKind::Pcg; break;
+    case MICA_SOLVER_MICA: s.solver = mica::SolverKind::Mica; break;
+    default: refuse(MICA_ERR_INVALID_ARGUMENT, "def->solver is " + std::to_string(d.solver) + ", not a MICA_SOLVER_* value");
+  }
+  if (d.pgs_sweeps < 1) refuse(MICA_ERR_INVALID_ARGUMENT, "def->pgs_sweeps must be >= 1");
+  if (d.paper_norm != 0 && d.paper_norm != 1) refuse(MICA_ERR_INVALID_ARGUMENT, "def->paper_norm must be 0 or 1");
+  if (!(d.max_recovery_speed > 0) || !std::isfinite(d.max_recovery_speed))
+    refuse(MICA_ERR_INVALID_ARGUMENT, "def->max_recovery_speed must be finite and > 0 m/s");
+  s.pgs_sweeps = d.pgs_sweeps;
+  s.paper_norm = d.paper_norm == 1;
+  s.max_recovery_speed = d.max_recovery_speed;
   s.max_iterations = d.max_iterations;
   s.tolerance = d.tolerance;
   s.plan_all_stages = d.plan_all_stages != 0;

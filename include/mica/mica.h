@@ -80,6 +80,7 @@ MICA_API const char* mica_status_string(mica_status status);
  *  @{ */
 typedef uint64_t mica_body_id;
 typedef uint64_t mica_lpc_id;
+typedef uint64_t mica_tool_id;
 #define MICA_NULL_ID 0u
 /** @} */
 
@@ -101,6 +102,7 @@ typedef void (*mica_log_fn)(int32_t level, const char* message, void* user);
 /** Velocity solvers. */
 #define MICA_SOLVER_DIRECT 0 /**< sparse Cholesky (CHOLMOD) of the projected system: exact */
 #define MICA_SOLVER_PCG 1    /**< projected conjugate gradient, block-Jacobi preconditioner */
+#define MICA_SOLVER_MICA 2   /**< MICA: constraint anticipation, PGS on contacts, modified block Gauss-Seidel */
 
 typedef struct mica_world_def {
   uint32_t struct_size;    /**< sizeof(mica_world_def) as the caller compiled it */
@@ -115,6 +117,10 @@ typedef struct mica_world_def {
   int32_t reserved0;       /**< zero */
   mica_log_fn log;         /**< optional log callback, NULL for none */
   void* log_user;          /**< passed to `log` */
+  int32_t pgs_sweeps;      /**< MICA: PGS sweeps over the contacts per iteration; default 1 */
+  int32_t paper_norm;      /**< MICA: 1 stops on the paper's 2-norm of the change of (v, lambda);
+                                default 0: relative changes of v and of lambda, each below tolerance */
+  double max_recovery_speed; /**< m/s: the penetration recovery gap/h is clamped at -this; default 1 */
 } mica_world_def;
 
 /** Fills `def` with defaults, writing only its first `struct_size` bytes, and records
@@ -288,6 +294,52 @@ MICA_API mica_status mica_add_lpc(mica_world* world, mica_body_id body, const in
 MICA_API mica_status mica_lpc_remove(mica_world* world, mica_lpc_id lpc);
 /** @} */
 
+/** Reaction force (N) of a constraint group of the last step: the force on whoever holds the
+ *  constraint (the user's hand in a grasp). Lifting a grasped region up against gravity gives
+ *  a downward force. The world's thread. */
+MICA_API mica_status mica_lpc_get_reaction(const mica_world* world, mica_lpc_id lpc, double out_force[3]);
+/** @} */
+
+/** @name Tools
+ *  Kinematic rigid tools: the host sets their pose; bodies cannot push them, they feel the
+ *  force of the contact.
+ *  @{ */
+#define MICA_TOOL_SPHERE 0 /**< a sphere of `radius` around the tool origin */
+#define MICA_TOOL_PLANE 1  /**< a half-space: bodies stay on the side `normal` points to */
+
+typedef struct mica_tool_def {
+  uint32_t struct_size;  /**< sizeof(mica_tool_def) as the caller compiled it */
+  int32_t shape;         /**< MICA_TOOL_*; default sphere */
+  double radius;         /**< m, sphere; default 0.01 */
+  double normal[3];      /**< plane normal in the tool frame; default (0, 0, 1) */
+  double position[3];    /**< m, initial tool origin; default 0 */
+  double orientation[4]; /**< initial unit quaternion (w, x, y, z); default identity */
+  double margin;         /**< m: contacts are made for gaps below this; default 0 */
+} mica_tool_def;
+
+/** Fills `def` with defaults, writing only its first `struct_size` bytes. Any thread. */
+MICA_API mica_status mica_tool_def_init(mica_tool_def* def, uint32_t struct_size);
+
+/** The default tool definition (a 1 cm sphere at the origin). */
+static inline mica_tool_def mica_tool_def_default(void) {
+  mica_tool_def def;
+  mica_tool_def_init(&def, (uint32_t)sizeof def);
+  return def;
+}
+
+/** Creates a tool. Contact with tools needs MICA_SOLVER_MICA. The world's thread. */
+MICA_API mica_status mica_tool_create(mica_world* world, const mica_tool_def* def, mica_tool_id* out_tool);
+/** Destroys a tool. The world's thread. */
+MICA_API mica_status mica_tool_destroy(mica_world* world, mica_tool_id tool);
+/** Moves a tool: position (m) and unit quaternion (w, x, y, z) for the next step. The world's thread. */
+MICA_API mica_status mica_tool_set_pose(mica_world* world, mica_tool_id tool, const double position[3],
+                                        const double orientation[4]);
+/** Force (N) and torque about the tool origin (N m) the bodies put on the tool in the last step,
+ *  and the number of active contacts; any output may be NULL. The world's thread. */
+MICA_API mica_status mica_tool_get_force(const mica_world* world, mica_tool_id tool, double out_force[3],
+                                         double out_torque[3], int32_t* out_contacts);
+/** @} */
+
 /** @name Stepping
  *  @{ */
 
@@ -309,7 +361,9 @@ MICA_API mica_status mica_step(mica_world* world, double dt);
 #define MICA_STAGE_CONSTRAINTS 4 /**< projection constraints (S, z per node) */
 #define MICA_STAGE_SOLVE 5       /**< the velocity solve */
 #define MICA_STAGE_INTEGRATE 6   /**< positions from velocities */
-#define MICA_STAGE_COUNT 7
+#define MICA_STAGE_COLLIDE 7     /**< contacts between tools and body surfaces (runs first) */
+#define MICA_STAGE_FORCES 8      /**< tool forces and constraint reactions (runs last) */
+#define MICA_STAGE_COUNT 9
 
 typedef struct mica_stage_stats {
   int32_t runs_last_step; /**< times the stage ran in the last step (0 or 1, or per body) */

@@ -157,12 +157,15 @@ class GmshParser {
 
   TetMesh parse() {
     if (!lines_.advance() || lines_.line() != "$MeshFormat") {
-      lines_.expected("$MeshFormat", lines_.line().empty() ? "end of file" : first_token(lines_.line()));
+      lines_.expected("$MeshFormat",
+                      lines_.line().empty() ? "end of file" : first_token(lines_.line()));
     }
     read_format();
     while (lines_.advance()) {
       const std::string_view header = lines_.line();
-      if (header.front() != '$') lines_.expected("a section header such as $Nodes", first_token(header));
+      if (header.front() != '$') {
+        lines_.expected("a section header such as $Nodes", first_token(header));
+      }
       if (header == "$Nodes") {
         version_ == Version::Legacy2 ? read_nodes_v2() : read_nodes_v4();
       } else if (header == "$Elements") {
@@ -171,7 +174,9 @@ class GmshParser {
         skip_section(header);
       }
     }
-    if (tets_.empty()) lines_.expected("at least one 4-node tetrahedron (element type 4)", "end of file");
+    if (tets_.empty()) {
+      lines_.expected("at least one 4-node tetrahedron (element type 4)", "end of file");
+    }
     return compact();
   }
 
@@ -264,11 +269,13 @@ class GmshParser {
     reserve_nodes(total);
     std::int64_t seen = 0;
     for (std::int64_t b = 0; b < blocks; ++b) {
-      Fields block(lines_, lines_.next("a node block header 'entityDim entityTag parametric numNodes'"));
+      Fields block(lines_,
+                   lines_.next("a node block header 'entityDim entityTag parametric numNodes'"));
       block.integer("an entity dimension 0 to 3", 0, 3);
       block.integer("an entity tag");
       const bool parametric = block.integer("a parametric flag 0 or 1", 0, 1) == 1;
-      const std::int64_t n = block.count("a block node count within the $Nodes total", total - seen);
+      const std::int64_t n =
+          block.count("a block node count within the $Nodes total", total - seen);
       block.finish();
       seen += n;
       const std::size_t first = nodes_.size();
@@ -289,8 +296,9 @@ class GmshParser {
 
   // The blocks held fewer records than their section header promised.
   [[noreturn]] void more_expected(const std::string& kind, std::int64_t total, std::int64_t seen) {
-    const std::string what = "another " + kind + " block (the header lists " + std::to_string(total) +
-                             " " + kind + "s, the blocks " + std::to_string(seen) + ")";
+    const std::string what = "another " + kind + " block (the header lists " +
+                             std::to_string(total) + " " + kind + "s, the blocks " +
+                             std::to_string(seen) + ")";
     lines_.expected(what, first_token(lines_.next(what)));
   }
 
@@ -313,7 +321,8 @@ class GmshParser {
   // 4.1: "numEntityBlocks numElements minTag maxTag", then per block a header
   // "entityDim entityTag elementType numElementsInBlock" and one "tag nodes..." line per element.
   void read_elements_v4() {
-    Fields header(lines_, lines_.next("an $Elements header 'numEntityBlocks numElements minTag maxTag'"));
+    Fields header(lines_,
+                  lines_.next("an $Elements header 'numEntityBlocks numElements minTag maxTag'"));
     const std::int64_t blocks = header.count("an entity block count");
     const std::int64_t total = header.count("an element count");
     header.integer("a minimum element tag");
@@ -321,11 +330,13 @@ class GmshParser {
     header.finish();
     std::int64_t seen = 0;
     for (std::int64_t b = 0; b < blocks; ++b) {
-      Fields block(lines_, lines_.next("an element block header 'entityDim entityTag type numElements'"));
+      Fields block(lines_,
+                   lines_.next("an element block header 'entityDim entityTag type numElements'"));
       block.integer("an entity dimension 0 to 3", 0, 3);
       block.integer("an entity tag");
       const std::int64_t type = block.integer("an element type");
-      const std::int64_t n = block.count("a block element count within the $Elements total", total - seen);
+      const std::int64_t n =
+          block.count("a block element count within the $Elements total", total - seen);
       block.finish();
       seen += n;
       for (std::int64_t i = 0; i < n; ++i) {
@@ -368,9 +379,9 @@ class GmshParser {
 
   LineReader lines_;
   Version version_ = Version::Legacy2;
-  Vec3List nodes_;                                         // in file order
+  Vec3List nodes_;                                               // in file order
   std::unordered_map<std::int64_t, std::int32_t> index_of_tag_;  // tag -> position in nodes_
-  std::vector<Tet> tets_;                                  // positions in nodes_
+  std::vector<Tet> tets_;                                        // positions in nodes_
 };
 
 }  // namespace
@@ -379,6 +390,8 @@ TetMesh parse_gmsh(std::string_view text, const std::string& name) {
   return GmshParser(text, name).parse();
 }
 
-TetMesh read_gmsh(const std::string& path) { return parse_gmsh(detail::read_text_file(path), path); }
+TetMesh read_gmsh(const std::string& path) {
+  return parse_gmsh(detail::read_text_file(path), path);
+}
 
 }  // namespace mica

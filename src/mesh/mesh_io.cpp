@@ -1,4 +1,6 @@
 // Loading a mesh file: choose the reader from the extension, read whole files into memory.
+#include "mesh/mesh_io.hpp"
+
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -6,7 +8,6 @@
 #include <string>
 
 #include "core/error.hpp"
-#include "mesh/mesh_io.hpp"
 
 namespace mica {
 namespace detail {
@@ -34,7 +35,8 @@ std::string read_text_file(const std::string& path) {
 namespace {
 
 bool ends_with(const std::string& s, const std::string& suffix) {
-  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+  return s.size() >= suffix.size() &&
+         s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 
 }  // namespace
@@ -43,7 +45,8 @@ TetMesh load_mesh(const std::string& path) {
   if (ends_with(path, ".msh")) return read_gmsh(path);
   if (ends_with(path, ".node") || ends_with(path, ".ele")) return read_tetgen(path);
   fail(Errc::Unsupported,
-       path + ": unsupported mesh file extension (accepted: .msh for Gmsh, .node or .ele for TetGen)");
+       path +
+           ": unsupported mesh file extension (accepted: .msh for Gmsh, .node or .ele for TetGen)");
 }
 
 }  // namespace mica

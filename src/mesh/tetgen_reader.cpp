@@ -170,7 +170,9 @@ PointList read_points(std::string_view text, const std::string& name) {
   LineReader lines(text, name);
   Fields header(lines, lines.next("a header 'npoints dim nattr nmarkers'"));
   const std::int64_t n = header.count("a positive point count");
-  if (header.integer("a dimension") != 3) lines.expected("dimension 3", header.last(), Errc::Unsupported);
+  if (header.integer("a dimension") != 3) {
+    lines.expected("dimension 3", header.last(), Errc::Unsupported);
+  }
   const std::int64_t num_attributes = header.integer("an attribute count", 0, kMaxCount);
   const std::int64_t num_markers = header.integer("a boundary marker count 0 or 1", 0, 1);
   header.finish();
@@ -198,18 +200,22 @@ PointList read_points(std::string_view text, const std::string& name) {
 }
 
 // .ele: "ntets nodes_per_tet nattr", then "index n1 n2 n3 n4 [6 more] [attributes]" per tet.
-std::vector<Tet> read_tets(std::string_view text, const std::string& name, const PointList& points) {
+std::vector<Tet> read_tets(std::string_view text, const std::string& name,
+                           const PointList& points) {
   LineReader lines(text, name);
   Fields header(lines, lines.next("a header 'ntets nodes_per_tet nattr'"));
   const std::int64_t n = header.count("a positive tetrahedron count");
   const std::int64_t nodes_per_tet = header.integer("4 or 10 nodes per tetrahedron", 4, 10);
-  if (nodes_per_tet != 4 && nodes_per_tet != 10) lines.expected("4 or 10 nodes per tetrahedron", header.last());
+  if (nodes_per_tet != 4 && nodes_per_tet != 10) {
+    lines.expected("4 or 10 nodes per tetrahedron", header.last());
+  }
   const std::int64_t num_attributes = header.integer("an attribute count", 0, kMaxCount);
   header.finish();
 
   const std::int64_t lo = points.first_index;
   const std::int64_t hi = lo + static_cast<std::int64_t>(points.points.size()) - 1;
-  const std::string node_what = "a point index from " + std::to_string(lo) + " to " + std::to_string(hi);
+  const std::string node_what =
+      "a point index from " + std::to_string(lo) + " to " + std::to_string(hi);
   std::vector<Tet> tets;
   tets.reserve(reservable(n, lines, kMinTetBytes));
   for (std::int64_t i = 0; i < n; ++i) {
@@ -220,7 +226,9 @@ std::vector<Tet> read_tets(std::string_view text, const std::string& name, const
     // (TetGen 1.5 tetgen.cxx: reconstructmesh swaps corners 0,1 when orient3d > 0; -R reverses).
     Tet t;
     for (auto& v : t) v = static_cast<std::int32_t>(f.integer(node_what, lo, hi) - lo);
-    for (std::int64_t k = 4; k < nodes_per_tet; ++k) f.integer(node_what, lo, hi);  // edge midpoints
+    for (std::int64_t k = 4; k < nodes_per_tet; ++k) {
+      f.integer(node_what, lo, hi);  // edge midpoints
+    }
     for (std::int64_t a = 0; a < num_attributes; ++a) f.real("a finite tetrahedron attribute");
     f.finish();
     tets.push_back(t);
@@ -230,7 +238,8 @@ std::vector<Tet> read_tets(std::string_view text, const std::string& name, const
 }
 
 bool ends_with(const std::string& s, const std::string& suffix) {
-  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+  return s.size() >= suffix.size() &&
+         s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 
 }  // namespace
@@ -246,8 +255,11 @@ TetMesh parse_tetgen(std::string_view node_text, std::string_view ele_text,
 
 TetMesh read_tetgen(const std::string& path) {
   std::string stem = path;
-  if (ends_with(path, ".node")) stem.resize(path.size() - 5);
-  else if (ends_with(path, ".ele")) stem.resize(path.size() - 4);
+  if (ends_with(path, ".node")) {
+    stem.resize(path.size() - 5);
+  } else if (ends_with(path, ".ele")) {
+    stem.resize(path.size() - 4);
+  }
   const std::string node_path = stem + ".node";
   const std::string ele_path = stem + ".ele";
   const std::string node_text = detail::read_text_file(node_path);

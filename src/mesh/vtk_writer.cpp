@@ -3,11 +3,13 @@
 // pieces apart, and the requested per-node vectors. Doubles are written with 17 significant
 // digits so that they read back exactly.
 #include <cerrno>
+#include <cstdint>
 #include <cstring>
 #include <fstream>
 #include <locale>
 #include <ostream>
 #include <string>
+#include <vector>
 
 #include "core/error.hpp"
 #include "mesh/mesh_io.hpp"
@@ -29,13 +31,16 @@ void check_pieces(const std::vector<VtkPiece>& pieces) {
   for (std::size_t p = 0; p < pieces.size(); ++p) {
     const VtkPiece& piece = pieces[p];
     const std::string where = "write_vtk: piece " + std::to_string(p);
-    if (!piece.positions || !piece.tets) fail(Errc::InvalidArgument, where + " has no positions or no tets");
+    if (!piece.positions || !piece.tets) {
+      fail(Errc::InvalidArgument, where + " has no positions or no tets");
+    }
     const auto n = static_cast<std::int64_t>(piece.positions->size());
     for (std::size_t e = 0; e < piece.tets->size(); ++e) {
       for (std::int32_t v : (*piece.tets)[e]) {
         if (v < 0 || v >= n) {
-          fail(Errc::OutOfRange, where + ", tet " + std::to_string(e) + ": node " + std::to_string(v) +
-                                     " is outside [0, " + std::to_string(n) + ")");
+          fail(Errc::OutOfRange, where + ", tet " + std::to_string(e) + ": node " +
+                                     std::to_string(v) + " is outside [0, " + std::to_string(n) +
+                                     ")");
         }
       }
     }
@@ -44,7 +49,8 @@ void check_pieces(const std::vector<VtkPiece>& pieces) {
     const auto& reference = pieces[0].point_vectors;
     if (fields.size() != reference.size()) {
       fail(Errc::InvalidArgument, where + " has " + std::to_string(fields.size()) +
-                                      " point vector fields, piece 0 has " + std::to_string(reference.size()));
+                                      " point vector fields, piece 0 has " +
+                                      std::to_string(reference.size()));
     }
     for (std::size_t f = 0; f < fields.size(); ++f) {
       const std::string& name = fields[f].first;
@@ -56,8 +62,8 @@ void check_pieces(const std::vector<VtkPiece>& pieces) {
                                         "', piece 0 has '" + reference[f].first + "'");
       }
       if (!fields[f].second || fields[f].second->size() != piece.positions->size()) {
-        fail(Errc::InvalidArgument, where + ": point vector '" + name + "' needs one value per node (" +
-                                        std::to_string(n) + ")");
+        fail(Errc::InvalidArgument, where + ": point vector '" + name +
+                                        "' needs one value per node (" + std::to_string(n) + ")");
       }
     }
   }
@@ -97,7 +103,9 @@ std::string title_line(const std::string& title) {
   return line;
 }
 
-void write_vec3(std::ostream& out, const Vec3& v) { out << v.x() << ' ' << v.y() << ' ' << v.z() << '\n'; }
+void write_vec3(std::ostream& out, const Vec3& v) {
+  out << v.x() << ' ' << v.y() << ' ' << v.z() << '\n';
+}
 
 void write_grid(std::ostream& out, const std::vector<VtkPiece>& pieces, const std::string& title) {
   const NumberFormat format(out);
@@ -108,7 +116,8 @@ void write_grid(std::ostream& out, const std::vector<VtkPiece>& pieces, const st
     num_cells += piece.tets->size();
   }
 
-  out << "# vtk DataFile Version 3.0\n" << title_line(title) << "\nASCII\nDATASET UNSTRUCTURED_GRID\n";
+  out << "# vtk DataFile Version 3.0\n"
+      << title_line(title) << "\nASCII\nDATASET UNSTRUCTURED_GRID\n";
   out << "POINTS " << num_points << " double\n";
   for (const VtkPiece& piece : pieces) {
     for (const Vec3& x : *piece.positions) write_vec3(out, x);
@@ -118,7 +127,9 @@ void write_grid(std::ostream& out, const std::vector<VtkPiece>& pieces, const st
   std::size_t offset = 0;  // index of the piece's first point in the grid
   for (const VtkPiece& piece : pieces) {
     for (const Tet& t : *piece.tets) {
-      out << 4 << ' ' << offset + t[0] << ' ' << offset + t[1] << ' ' << offset + t[2] << ' ' << offset + t[3] << '\n';
+      out << 4;
+      for (std::int32_t v : t) out << ' ' << offset + static_cast<std::size_t>(v);
+      out << '\n';
     }
     offset += piece.positions->size();
   }

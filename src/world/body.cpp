@@ -4,14 +4,15 @@ namespace mica {
 
 Body::Body(const TetMesh& mesh, const BodySettings& s, const std::string& body_name)
     : settings(s), name(body_name), fem(build_fem_model(mesh, s.material, s.mass, body_name)),
-      tets(mesh.tets), surface(extract_surface(mesh)) {
+      tets(mesh.tets), surface(extract_surface(mesh)),
+      surface_node_list(surface_nodes(surface)) {
   const size_t n = fem.rest.size();
   x = fem.rest;
   v.assign(n, Vec3::Zero());
   node_forces.assign(n, Vec3::Zero());
   R.assign(fem.elements.size(), Mat3::Identity());
   A.assign(fem.pattern.block_count(), Mat3::Zero());
-  for (Vec3List* w : {&f_int, &f_ext, &b, &v_next, &x_next}) w->assign(n, Vec3::Zero());
+  for (Vec3List* w : {&f_int, &f_ext, &b, &v_next, &x_next, &contact_impulse}) w->assign(n, Vec3::Zero());
   projection.reset(int32_t(n));
   pcg.resize(n);
 }

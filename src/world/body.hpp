@@ -28,6 +28,7 @@ struct Body {
   FemModel fem;
   std::vector<Tet> tets;
   std::vector<Tri> surface;
+  std::vector<int32_t> surface_node_list;  // candidates for contact
 
   // State.
   Vec3List x, v;
@@ -40,6 +41,7 @@ struct Body {
   BlockValues A;               // M + h C + h^2 K
   Vec3List f_int, f_ext, b, v_next, x_next;
   Projection projection;
+  Vec3List contact_impulse;    // G^T lambda of the last step, N s
   DirectSolver direct;
   PcgWorkspace pcg;
 

@@ -6,8 +6,9 @@
 
 namespace mica {
 
-// The stages of a step, in pipeline order (the C header lists the same order).
-enum class Stage { Loads, Rotations, Elements, Damping, Constraints, Solve, Integrate, Count };
+// The stages of a step (the C header numbers them the same way; the pipeline runs Collide first
+// and Forces last).
+enum class Stage { Loads, Rotations, Elements, Damping, Constraints, Solve, Integrate, Collide, Forces, Count };
 constexpr int kStageCount = int(Stage::Count);
 
 struct StageStats {

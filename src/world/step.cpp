@@ -1,6 +1,7 @@
 // The step: one linearised backward-Euler step at velocity level, per body
 //   A v+ = b,  A = M + h C + h^2 K,  b = M v + h (f_int(x) + f_ext),  x+ = x + h v+,
 // under the projection constraints (I - S) v+ = z. Each stage runs only when the plan holds it.
+#include <algorithm>
 #include <cmath>
 
 #include "world/world.hpp"
@@ -18,7 +19,12 @@ Plan World::plan() const {
     p.damping = p.damping || needs_damping(b);
   });
   lpcs_.for_each([&](Id, const Lpc& c) { p.constraints = p.constraints || bodies_.get(c.body, "body").is_dynamic(); });
-  if (all) p.constraints = p.constraints || p.solve;
+  tools_.for_each([&](Id, const Tool&) { p.collide = p.solve; });
+  if (all) {
+    p.constraints = p.constraints || p.solve;
+    p.collide = p.collide || p.solve;
+  }
+  p.forces = p.collide || p.constraints;
   return p;
 }
 
@@ -41,6 +47,8 @@ void World::step(double h) {
   stats_.converged = true;
 
   StageRunner stage(stats_);
+  stage.run(Stage::Collide, plan.collide, [&] { collide(dynamic); });
+  if (!plan.collide) contacts_.clear();
   stage.run(Stage::Loads, plan.loads, [&] {
     for (Body* b : dynamic)
       if (needs_loads(*b)) apply_loads(*b);
@@ -60,12 +68,19 @@ void World::step(double h) {
     for (Body* b : dynamic) build_projection(*b);
   });
   stage.run(Stage::Solve, plan.solve, [&] {
-    for (Body* b : dynamic) solve_velocities(*b, h);
+    if (settings_.solver == SolverKind::Mica) {
+      solve_mica(dynamic, h);
+    } else {
+      if (!contacts_.empty())
+        fail(Errc::Unsupported, "tool contact needs the MICA solver (MICA_SOLVER_MICA) in this version");
+      for (Body* b : dynamic) solve_velocities(*b, h);
+    }
   });
   stage.run(Stage::Integrate, plan.integrate, [&] {
     for (Body* b : dynamic)
       for (size_t i = 0; i < b->x.size(); ++i) b->x_next[i] = b->x[i] + h * b->v_next[i];
   });
+  stage.run(Stage::Forces, plan.forces, [&] { compute_forces(dynamic, h); });
   commit();
   stats_.step_count += 1;
   stats_.ms_last_step = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
@@ -106,11 +121,92 @@ void World::build_projection(Body& b) const {
   });
 }
 
-void World::solve_velocities(Body& b, double h) {
+void World::form_rhs(Body& b, double h) const {
   // b = M v + h (f_int + f_ext)
   mass_multiply(b.fem, b.v, b.b);
   const bool loads = needs_loads(b);
   for (size_t i = 0; i < b.b.size(); ++i) b.b[i] += h * (loads ? b.f_int[i] + b.f_ext[i] : b.f_int[i]);
+}
+
+void World::collide(const std::vector<Body*>& dynamic) {
+  contacts_.clear();
+  step_tools_.clear();
+  tools_.for_each([&](Id tool_id, Tool& t) {
+    const int32_t ti = int32_t(step_tools_.size());
+    step_tools_.push_back(&t);
+    bodies_.for_each([&](Id body_id, const Body& b) {
+      const auto it = std::find(dynamic.begin(), dynamic.end(), &b);
+      if (it == dynamic.end()) return;
+      collide_nodes(t, ti, tool_id, int32_t(it - dynamic.begin()), body_id, b.x, b.surface_node_list, contacts_);
+    });
+  });
+}
+
+void World::solve_mica(const std::vector<Body*>& dynamic, double h) {
+  mica_bodies_.resize(dynamic.size());
+  for (size_t k = 0; k < dynamic.size(); ++k) {
+    Body& b = *dynamic[k];
+    form_rhs(b, h);
+    b.v_next = b.v;  // warm start from the last velocity
+    mica_bodies_[k].pattern = &b.fem.pattern;
+    mica_bodies_[k].A = &b.A;
+    mica_bodies_[k].b = &b.b;
+    mica_bodies_[k].projection = &b.projection;
+    mica_bodies_[k].v = &b.v_next;
+  }
+  // Warm start the impulses of contacts that persist from the last step.
+  lambda_.assign(contacts_.size(), 0.0);
+  for (size_t r = 0; r < contacts_.size(); ++r) {
+    const auto it = warm_start_.find(contacts_[r].key);
+    if (it != warm_start_.end()) lambda_[r] = it->second;
+  }
+  MicaSettings ms;
+  ms.tolerance = settings_.tolerance;
+  ms.max_iterations = settings_.max_iterations;
+  ms.pgs_sweeps = settings_.pgs_sweeps;
+  ms.max_recovery_speed = settings_.max_recovery_speed;
+  ms.paper_norm = settings_.paper_norm;
+  const MicaReport report = mica_.solve(mica_bodies_, contacts_, h, ms, lambda_);
+  for (size_t k = 0; k < dynamic.size(); ++k) std::swap(dynamic[k]->contact_impulse, mica_bodies_[k].contact_impulse);
+  warm_start_.clear();
+  for (size_t r = 0; r < contacts_.size(); ++r) warm_start_[contacts_[r].key] = lambda_[r];
+  stats_.solver_iterations += report.iterations;
+  stats_.solver_residual = std::max(stats_.solver_residual, report.residual);
+  stats_.converged = stats_.converged && report.converged;
+}
+
+void World::compute_forces(const std::vector<Body*>& dynamic, double h) {
+  // Tools: the force the tissue puts on the tool is -sum n lambda / h.
+  for (Tool* t : step_tools_) {
+    t->force.setZero();
+    t->torque.setZero();
+    t->contact_count = 0;
+  }
+  for (size_t r = 0; r < contacts_.size(); ++r) {
+    const Contact& c = contacts_[r];
+    Tool& t = *step_tools_[c.tool];
+    const Vec3 f = -c.normal * lambda_[r] / h;
+    t.force += f;
+    t.torque += (c.point - t.position).cross(f);
+    t.contact_count += lambda_[r] > 0 ? 1 : 0;
+  }
+  // Constraints: the impulse r = (I - S)(A v - b - G^T lambda) holds the body; whoever holds
+  // the constraint (the user's hand) feels the opposite force, -r / h.
+  lpcs_.for_each([&](Id, Lpc& c) {
+    Body& b = bodies_.get(c.body, "body");
+    c.reaction.setZero();
+    if (std::find(dynamic.begin(), dynamic.end(), &b) == dynamic.end()) return;
+    for (int32_t i : c.nodes) {
+      Vec3 Av = Vec3::Zero();
+      for (int32_t k = b.fem.pattern.row_start[i]; k < b.fem.pattern.row_start[i + 1]; ++k)
+        Av += b.A[k] * b.v_next[b.fem.pattern.col[k]];
+      c.reaction -= c.constrained * (Av - b.b[i] - b.contact_impulse[i]) / h;
+    }
+  });
+}
+
+void World::solve_velocities(Body& b, double h) {
+  form_rhs(b, h);
 
   const ProjectedSystem sys{b.fem.pattern, b.A, b.projection};
   SolveReport report;

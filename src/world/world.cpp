@@ -96,6 +96,32 @@ Id World::add_lpc(Id body_id, const std::vector<int32_t>& nodes, const LpcSpec& 
   return id;
 }
 
+Id World::add_tool(const Tool& tool) {
+  if (!tool.position.allFinite() || !tool.orientation.coeffs().allFinite()) fail(Errc::InvalidArgument, "the tool pose must be finite");
+  if (tool.shape == ToolShape::Sphere && !(tool.radius > 0 && std::isfinite(tool.radius)))
+    fail(Errc::InvalidArgument, "the sphere radius must be finite and > 0 m");
+  if (tool.shape == ToolShape::Plane && !(tool.plane_normal.norm() > 1e-12 && tool.plane_normal.allFinite()))
+    fail(Errc::InvalidArgument, "the plane normal must be a finite non-zero vector");
+  if (!(tool.margin >= 0 && std::isfinite(tool.margin))) fail(Errc::InvalidArgument, "the contact margin must be finite and >= 0 m");
+  Tool t = tool;
+  t.plane_normal.normalize();
+  t.orientation.normalize();
+  return tools_.insert(std::make_unique<Tool>(t));
+}
+
+void World::remove_tool(Id id) {
+  tool(id);
+  tools_.erase(id);
+}
+
+void World::set_tool_pose(Id id, const Vec3& position, const Eigen::Quaterniond& orientation) {
+  Tool& t = tool(id);
+  if (!position.allFinite() || !orientation.coeffs().allFinite() || !(orientation.norm() > 1e-12))
+    fail(Errc::InvalidArgument, "the tool pose must be finite with a non-zero quaternion");
+  t.position = position;
+  t.orientation = orientation.normalized();
+}
+
 void World::remove_lpc(Id id) {
   const Lpc& c = lpcs_.get(id, "constraint");
   Body* b = bodies_.find(c.body);

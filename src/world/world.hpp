@@ -5,13 +5,17 @@
 #include <string>
 #include <vector>
 
+#include <unordered_map>
+
+#include "collision/contact.hpp"
+#include "solver/mica_solver.hpp"
 #include "world/body.hpp"
 #include "world/slot_map.hpp"
 #include "world/stats.hpp"
 
 namespace mica {
 
-enum class SolverKind { Direct, Pcg };
+enum class SolverKind { Direct, Pcg, Mica };
 
 struct WorldSettings {
   Vec3 gravity{0, -9.81, 0};
@@ -19,6 +23,9 @@ struct WorldSettings {
   int32_t max_iterations = 200;
   double tolerance = 1e-8;
   bool plan_all_stages = false;  // run every stage even when its effect is absent
+  int32_t pgs_sweeps = 1;          // MICA: PGS sweeps over the contacts per iteration
+  double max_recovery_speed = 1.0; // m/s, clamps gap / h for penetrating contacts
+  bool paper_norm = false;         // MICA: stop on the paper's 2-norm of the change
 };
 
 enum class LpcKind { Fixed, Plane, Line, TwoDirections };
@@ -37,12 +44,14 @@ struct Lpc {
   std::vector<int32_t> nodes;
   Mat3 constrained;  // I - S
   Vec3 velocity;
+  Vec3 reaction = Vec3::Zero();  // N: the force on whoever holds the constraint (the user), last step
 };
 
 // Which stages the scene calls for (each body also checks its own need inside a stage).
 struct Plan {
   bool loads = false, rotations = false, elements = false, damping = false;
   bool constraints = false, solve = false, integrate = false;
+  bool collide = false, forces = false;
 };
 
 class World {
@@ -60,6 +69,15 @@ class World {
 
   Id add_lpc(Id body, const std::vector<int32_t>& nodes, const LpcSpec& spec);
   void remove_lpc(Id id);
+  const Lpc& lpc(Id id) const { return lpcs_.get(id, "constraint"); }
+
+  Id add_tool(const Tool& tool);
+  void remove_tool(Id id);
+  Tool& tool(Id id) { return tools_.get(id, "tool"); }
+  const Tool& tool(Id id) const { return tools_.get(id, "tool"); }
+  void set_tool_pose(Id id, const Vec3& position, const Eigen::Quaterniond& orientation);
+  const std::vector<Contact>& contacts() const { return contacts_; }
+  const std::vector<double>& impulses() const { return lambda_; }
 
   // One implicit step of h seconds. Throws Error(Numerical) and keeps the old state when
   // the result is not finite.
@@ -72,10 +90,14 @@ class World {
   void for_each_body(F&& f) const { bodies_.for_each(f); }
 
  private:
+  void collide(const std::vector<Body*>& dynamic);
+  void solve_mica(const std::vector<Body*>& dynamic, double h);
+  void compute_forces(const std::vector<Body*>& dynamic, double h);
   void apply_loads(Body& b) const;
   void assemble_elements(Body& b, double h, bool damping) const;
   void add_damping(Body& b, double h) const;
   void build_projection(Body& b) const;
+  void form_rhs(Body& b, double h) const;
   void solve_velocities(Body& b, double h);
   void commit();
 
@@ -85,6 +107,13 @@ class World {
   WorldSettings settings_;
   SlotMap<Body, IdKind::Body> bodies_;
   SlotMap<Lpc, IdKind::Lpc> lpcs_;
+  SlotMap<Tool, IdKind::Tool> tools_;
+  std::vector<Tool*> step_tools_;
+  std::vector<Contact> contacts_;
+  std::vector<double> lambda_;                      // impulse per contact, N s
+  std::unordered_map<uint64_t, double> warm_start_; // last step's impulses by contact key
+  MicaSolver mica_;
+  std::vector<MicaBody> mica_bodies_;
   WorldStats stats_;
   int64_t bodies_created_ = 0;
 };

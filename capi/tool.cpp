@@ -1,0 +1,83 @@
+// Kinematic tools and the forces on them.
+#include "capi_internal.hpp"
+
+using namespace mica_capi;
+
+namespace {
+
+mica_tool_def tool_defaults() {
+  mica_tool_def d{};
+  d.struct_size = sizeof d;
+  d.shape = MICA_TOOL_SPHERE;
+  d.radius = 0.01;
+  d.normal[2] = 1;
+  d.orientation[0] = 1;
+  return d;
+}
+
+Eigen::Quaterniond quaternion(const double* q, const char* name) {
+  require(q, name);
+  return {q[0], q[1], q[2], q[3]};  // (w, x, y, z)
+}
+
+}  // namespace
+
+extern "C" {
+
+MICA_API mica_status mica_tool_def_init(mica_tool_def* def, uint32_t struct_size) {
+  return init_def(def, struct_size, sizeof(mica_tool_def), tool_defaults());
+}
+
+MICA_API mica_status mica_tool_create(mica_world* world, const mica_tool_def* def, mica_tool_id* out_tool) {
+  return guarded(world, "mica_tool_create", [&] {
+    require(world, "world");
+    require(out_tool, "out_tool");
+    const mica_tool_def d = read_def(def, tool_defaults(), sizeof(mica_tool_def), "def");
+    mica::Tool t;
+    switch (d.shape) {
+      case MICA_TOOL_SPHERE: t.shape = mica::ToolShape::Sphere; break;
+      case MICA_TOOL_PLANE: t.shape = mica::ToolShape::Plane; break;
+      default: refuse(MICA_ERR_INVALID_ARGUMENT, "def->shape is " + std::to_string(d.shape) + ", not a MICA_TOOL_* value");
+    }
+    t.radius = d.radius;
+    t.plane_normal = vec3(d.normal, "def->normal");
+    t.position = vec3(d.position, "def->position");
+    t.orientation = quaternion(d.orientation, "def->orientation");
+    t.margin = d.margin;
+    *out_tool = world->world.add_tool(t);
+    return MICA_OK;
+  });
+}
+
+MICA_API mica_status mica_tool_destroy(mica_world* world, mica_tool_id tool) {
+  return guarded(world, "mica_tool_destroy", [&] {
+    require(world, "world");
+    world->world.remove_tool(tool);
+    return MICA_OK;
+  });
+}
+
+MICA_API mica_status mica_tool_set_pose(mica_world* world, mica_tool_id tool, const double position[3],
+                                        const double orientation[4]) {
+  return guarded(world, "mica_tool_set_pose", [&] {
+    require(world, "world");
+    world->world.set_tool_pose(tool, vec3(position, "position"), quaternion(orientation, "orientation"));
+    return MICA_OK;
+  });
+}
+
+MICA_API mica_status mica_tool_get_force(const mica_world* world, mica_tool_id tool, double out_force[3],
+                                         double out_torque[3], int32_t* out_contacts) {
+  return guarded(world, "mica_tool_get_force", [&] {
+    require(world, "world");
+    const mica::Tool& t = world->world.tool(tool);
+    for (int k = 0; k < 3; ++k) {
+      if (out_force) out_force[k] = t.force[k];
+      if (out_torque) out_torque[k] = t.torque[k];
+    }
+    if (out_contacts) *out_contacts = t.contact_count;
+    return MICA_OK;
+  });
+}
+
+}  // extern "C"

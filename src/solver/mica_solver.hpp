@@ -1,0 +1,57 @@
+// MICA: Modified Iterative Constraint Anticipation (Arikatla, Ortiz, De, Enquobahrie 2016).
+// One loop resolves projection constraints and contact together:
+//
+//   A v = b + G^T lambda,   (I - S) v = z,   0 <= lambda  _|_  G v + gap / h >= 0
+//
+// Each iteration anticipates the contact velocities from the current v with the filtered
+// block-diagonal inverse Dt^-1 = S (S D S + I - S)^-1 S, updates lambda by projected
+// Gauss-Seidel on B = G Dt^-1 G^T, then sweeps v by modified block Gauss-Seidel with the
+// contact impulses on the right-hand side. At a fixed point v and lambda solve the
+// mixed complementarity problem above exactly.
+#pragma once
+#include <vector>
+
+#include "collision/contact.hpp"
+#include "solver/projected_system.hpp"
+
+namespace mica {
+
+struct MicaSettings {
+  double tolerance = 1e-8;          // relative change of v and of lambda between iterations
+  int32_t max_iterations = 200;
+  int32_t pgs_sweeps = 1;           // PGS sweeps over the contacts per iteration
+  double max_recovery_speed = 1.0;  // m/s: gap / h is clamped below at -this (no energy injection)
+  bool paper_norm = false;          // stop on the 2-norm of the change of (v, lambda) instead
+};
+
+// One body's system as the solver sees it. v holds the warm start and receives the result.
+struct MicaBody {
+  const BlockPattern* pattern;
+  const BlockValues* A;
+  const Vec3List* b;
+  const Projection* projection;
+  Vec3List* v;
+  Vec3List contact_impulse;  // out: G^T lambda per node, N s
+};
+
+struct MicaReport : SolveReport {
+  double velocity_change = 0;  // last relative change of v
+  double impulse_change = 0;   // last relative change of lambda
+  double paper_change = 0;     // last 2-norm of the change of (v, lambda), the paper's test
+};
+
+class MicaSolver {
+ public:
+  // lambda: in, the warm start (clamped to >= 0); out, the contact impulses (N s).
+  MicaReport solve(std::vector<MicaBody>& bodies, const std::vector<Contact>& contacts, double h,
+                   const MicaSettings& settings, std::vector<double>& lambda);
+
+ private:
+  std::vector<std::vector<Mat3>> inv_diag_;  // per body, per node: Dt_i^-1
+  std::vector<Vec3> g_;                      // per contact: Dt^-1 n
+  std::vector<double> diag_, bias_, c_;      // per contact: B_rr, clamped gap / h, anticipated velocity
+  std::vector<std::vector<Vec3>> u_;         // per body, per node: Dt^-1 G^T lambda
+  std::vector<double> lambda_old_;
+};
+
+}  // namespace mica
