@@ -38,8 +38,11 @@ extern "C" {
 
 /** @name Version
  *  @{ */
+/** Major version: incompatible ABI changes. */
 #define MICA_VERSION_MAJOR 0
+/** Minor version: compatible additions. */
 #define MICA_VERSION_MINOR 1
+/** Patch version: fixes. */
 #define MICA_VERSION_PATCH 0
 /** major * 10000 + minor * 100 + patch */
 #define MICA_VERSION_NUMBER (MICA_VERSION_MAJOR * 10000 + MICA_VERSION_MINOR * 100 + MICA_VERSION_PATCH)
@@ -50,7 +53,9 @@ MICA_API int32_t mica_version(void);
 
 /** @name Status codes
  *  @{ */
+/** A status: 0 success, > 0 warning (the call did its work), < 0 error (nothing changed). */
 typedef int32_t mica_status;
+/** Success. */
 #define MICA_OK 0
 /** Warning: the step finished but the solver stopped at its cap before its tolerance. */
 #define MICA_WARN_NOT_CONVERGED 1
@@ -78,9 +83,13 @@ MICA_API const char* mica_status_string(mica_status status);
 /** @name Ids
  *  A 64-bit id: bits 0-31 slot + 1, bits 32-55 generation, bits 56-63 kind. 0 is null.
  *  @{ */
+/** Id of a body. */
 typedef uint64_t mica_body_id;
+/** Id of a linear projection constraint group. */
 typedef uint64_t mica_lpc_id;
+/** Id of a tool. */
 typedef uint64_t mica_tool_id;
+/** The null id: never names an object. */
 #define MICA_NULL_ID 0u
 /** @} */
 
@@ -91,9 +100,9 @@ typedef uint64_t mica_tool_id;
 typedef struct mica_world mica_world;
 
 /** Log levels for ::mica_log_fn. */
-#define MICA_LOG_ERROR 0
-#define MICA_LOG_WARNING 1
-#define MICA_LOG_INFO 2
+#define MICA_LOG_ERROR 0   /**< a call failed */
+#define MICA_LOG_WARNING 1 /**< something worth knowing went wrong, the call succeeded */
+#define MICA_LOG_INFO 2    /**< information */
 
 /** Receives library messages on the thread that made the call. `message` is valid only during
  *  the call. Must not call back into the same world. */
@@ -104,6 +113,7 @@ typedef void (*mica_log_fn)(int32_t level, const char* message, void* user);
 #define MICA_SOLVER_PCG 1    /**< projected conjugate gradient, block-Jacobi preconditioner */
 #define MICA_SOLVER_MICA 2   /**< MICA: constraint anticipation, PGS on contacts, modified block Gauss-Seidel */
 
+/** How to create a world: fill with mica_world_def_default(), then change fields. */
 typedef struct mica_world_def {
   uint32_t struct_size;    /**< sizeof(mica_world_def) as the caller compiled it */
   uint32_t header_version; /**< MICA_VERSION_NUMBER the caller compiled with */
@@ -160,6 +170,7 @@ MICA_API mica_status mica_world_set_gravity(mica_world* world, const double grav
 #define MICA_MASS_CONSISTENT 0    /**< consistent mass (rho V / 20)(1 + delta_ab) */
 #define MICA_MASS_LUMPED 1        /**< lumped mass rho V / 4 per node */
 
+/** How to create a body: material, model, mass, damping, placement. Fill with mica_body_def_default(). */
 typedef struct mica_body_def {
   uint32_t struct_size;  /**< sizeof(mica_body_def) as the caller compiled it */
   int32_t model;         /**< MICA_MODEL_*; default co-rotational */
@@ -267,6 +278,7 @@ MICA_API mica_status mica_body_get_energy(const mica_world* world, mica_body_id 
 #define MICA_LPC_LINE 2     /**< move only along direction[0]: S = d d^T */
 #define MICA_LPC_TWO_DIRS 3 /**< directions direction[0] and direction[1] constrained: S = I - pp^T - qq^T */
 
+/** A projection constraint: its kind, directions and prescribed velocity. Fill with mica_lpc_def_default(). */
 typedef struct mica_lpc_def {
   uint32_t struct_size;  /**< sizeof(mica_lpc_def) as the caller compiled it */
   int32_t kind;          /**< MICA_LPC_*; default MICA_LPC_FIXED */
@@ -292,7 +304,6 @@ MICA_API mica_status mica_add_lpc(mica_world* world, mica_body_id body, const in
 
 /** Removes a constraint. The world's thread. */
 MICA_API mica_status mica_lpc_remove(mica_world* world, mica_lpc_id lpc);
-/** @} */
 
 /** Reaction force (N) of a constraint group of the last step: the force on whoever holds the
  *  constraint (the user's hand in a grasp). Lifting a grasped region up against gravity gives
@@ -307,6 +318,7 @@ MICA_API mica_status mica_lpc_get_reaction(const mica_world* world, mica_lpc_id 
 #define MICA_TOOL_SPHERE 0 /**< a sphere of `radius` around the tool origin */
 #define MICA_TOOL_PLANE 1  /**< a half-space: bodies stay on the side `normal` points to */
 
+/** A kinematic tool: shape, size, initial pose, contact margin. Fill with mica_tool_def_default(). */
 typedef struct mica_tool_def {
   uint32_t struct_size;  /**< sizeof(mica_tool_def) as the caller compiled it */
   int32_t shape;         /**< MICA_TOOL_*; default sphere */
@@ -363,22 +375,24 @@ MICA_API mica_status mica_step(mica_world* world, double dt);
 #define MICA_STAGE_INTEGRATE 6   /**< positions from velocities */
 #define MICA_STAGE_COLLIDE 7     /**< contacts between tools and body surfaces (runs first) */
 #define MICA_STAGE_FORCES 8      /**< tool forces and constraint reactions (runs last) */
-#define MICA_STAGE_COUNT 9
+#define MICA_STAGE_COUNT 9        /**< number of stages */
 
+/** Counters and timing of one stage of the step. */
 typedef struct mica_stage_stats {
-  int32_t runs_last_step; /**< times the stage ran in the last step (0 or 1, or per body) */
-  int32_t reserved0;
+  int32_t runs_last_step; /**< times the stage ran in the last step (0 or 1) */
+  int32_t reserved0;      /**< zero */
   int64_t runs_total;     /**< since creation */
   double ms_last_step;    /**< wall-clock milliseconds in the last step */
   double ms_total;        /**< since creation */
 } mica_stage_stats;
 
+/** Statistics of the last step and since creation: see mica_world_get_stats(). */
 typedef struct mica_world_stats {
   uint32_t struct_size;          /**< set by the caller: sizeof(mica_world_stats) */
   int32_t converged;             /**< 1 if every solve of the last step met its tolerance */
   int64_t step_count;            /**< steps taken */
   int32_t solver_iterations;     /**< iterations of the last step (summed over bodies; 1 for direct) */
-  int32_t reserved0;
+  int32_t reserved0;             /**< zero */
   double solver_residual;        /**< largest relative residual of the last step */
   double ms_last_step;           /**< wall-clock milliseconds of the last step */
   mica_stage_stats stages[MICA_STAGE_COUNT]; /**< indexed by MICA_STAGE_* */
