@@ -70,7 +70,7 @@ mica_status select_nodes(const mica::Body& b, int32_t use_rest, int32_t* out, in
 extern "C" {
 
 MICA_API mica_status mica_body_def_init(mica_body_def* def, uint32_t struct_size) {
-  return init_def(def, struct_size, sizeof(mica_body_def), body_defaults());
+  return init_def(def, struct_size, sizeof(mica_body_def), body_defaults(), "mica_body_def_init");
 }
 
 MICA_API mica_status mica_body_create(mica_world* world, const mica_body_def* def, const double* nodes,

@@ -73,12 +73,16 @@ T read_def(const T* def, T defaults, uint32_t min_size, const char* name) {
 
 // Writes defaults into the first struct_size bytes of *def (the *_init functions).
 template <class T>
-mica_status init_def(T* def, uint32_t struct_size, uint32_t min_size, const T& defaults) {
-  if (!def) return MICA_ERR_NULL_ARGUMENT;
-  if (struct_size < min_size || struct_size > sizeof(T)) return MICA_ERR_STRUCT_SIZE;
-  std::memcpy(static_cast<void*>(def), &defaults, struct_size);
-  def->struct_size = struct_size;
-  return MICA_OK;
+mica_status init_def(T* def, uint32_t struct_size, uint32_t min_size, const T& defaults, const char* function) {
+  return guarded(nullptr, function, [&] {
+    require(def, "def");
+    if (struct_size < min_size || struct_size > sizeof(T))
+      refuse(MICA_ERR_STRUCT_SIZE, "struct_size is " + std::to_string(struct_size) + ", this libmica knows sizes " +
+                                       std::to_string(min_size) + ".." + std::to_string(sizeof(T)));
+    std::memcpy(static_cast<void*>(def), &defaults, struct_size);
+    def->struct_size = struct_size;
+    return MICA_OK;
+  });
 }
 
 inline mica::Vec3 vec3(const double* v, const char* name) {
@@ -90,6 +94,7 @@ inline mica::Vec3 vec3(const double* v, const char* name) {
 template <class T>
 mica_status copy_out(const T* source, int32_t count, int32_t width, T* out, int32_t capacity, int32_t* out_count) {
   if (!out && !out_count) require(out_count, "out_count");
+  if (capacity < 0) refuse(MICA_ERR_INVALID_ARGUMENT, "capacity is " + std::to_string(capacity) + ", must be >= 0");
   if (out_count) *out_count = count;
   if (!out) return MICA_OK;
   if (capacity < count)

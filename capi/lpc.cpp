@@ -17,7 +17,7 @@ mica_lpc_def lpc_defaults() {
 extern "C" {
 
 MICA_API mica_status mica_lpc_def_init(mica_lpc_def* def, uint32_t struct_size) {
-  return init_def(def, struct_size, sizeof(mica_lpc_def), lpc_defaults());
+  return init_def(def, struct_size, sizeof(mica_lpc_def), lpc_defaults(), "mica_lpc_def_init");
 }
 
 MICA_API mica_status mica_add_lpc(mica_world* world, mica_body_id body, const int32_t* nodes, int32_t count,

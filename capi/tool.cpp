@@ -25,7 +25,7 @@ Eigen::Quaterniond quaternion(const double* q, const char* name) {
 extern "C" {
 
 MICA_API mica_status mica_tool_def_init(mica_tool_def* def, uint32_t struct_size) {
-  return init_def(def, struct_size, sizeof(mica_tool_def), tool_defaults());
+  return init_def(def, struct_size, sizeof(mica_tool_def), tool_defaults(), "mica_tool_def_init");
 }
 
 MICA_API mica_status mica_tool_create(mica_world* world, const mica_tool_def* def, mica_tool_id* out_tool) {

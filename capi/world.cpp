@@ -64,7 +64,7 @@ std::vector<mica::VtkPiece> vtk_pieces(const mica::Body& b, std::vector<mica::Ve
 extern "C" {
 
 MICA_API mica_status mica_world_def_init(mica_world_def* def, uint32_t struct_size, uint32_t header_version) {
-  const mica_status s = init_def(def, struct_size, sizeof(mica_world_def), world_defaults());
+  const mica_status s = init_def(def, struct_size, sizeof(mica_world_def), world_defaults(), "mica_world_def_init");
   if (s == MICA_OK) def->header_version = header_version;
   return s;
 }

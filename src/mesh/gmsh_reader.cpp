@@ -2,11 +2,7 @@
 // Nodes are renumbered 0..n-1 in the order the $Nodes section lists them; nodes that no
 // tetrahedron uses are dropped. Memory reserved for a count read from the file is capped by
 // what the bytes left can hold, so a lying header fails at the end of the text, unallocated.
-#include <algorithm>
-#include <charconv>
-#include <cmath>
 #include <cstdint>
-#include <cstdlib>
 #include <limits>
 #include <string>
 #include <string_view>
@@ -15,139 +11,17 @@
 
 #include "core/error.hpp"
 #include "mesh/mesh_io.hpp"
+#include "mesh/text_scanner.hpp"
 
 namespace mica {
-namespace detail {
-std::string read_text_file(const std::string& path);  // defined in mesh_io.cpp
-}
-
 namespace {
+
+using detail::Fields;
+using detail::first_token;
+using detail::LineReader;
 
 constexpr int kTet4 = 4;                   // Gmsh element type of the 4-node tetrahedron
 constexpr std::int64_t kMinNodeBytes = 8;  // shortest node record: "1 0 0 0\n"
-
-bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
-
-std::string_view trim(std::string_view s) {
-  while (!s.empty() && is_space(s.front())) s.remove_prefix(1);
-  while (!s.empty() && is_space(s.back())) s.remove_suffix(1);
-  return s;
-}
-
-std::string_view first_token(std::string_view line) {
-  std::size_t end = 0;
-  while (end < line.size() && !is_space(line[end])) ++end;
-  return line.substr(0, end);
-}
-
-// A token as shown in a message: at most 40 characters, control characters replaced.
-std::string shown(std::string_view token) {
-  constexpr std::size_t kMax = 40;
-  std::string s;
-  for (char c : token.substr(0, kMax)) {
-    const auto u = static_cast<unsigned char>(c);
-    s += (u < 0x20 || u == 0x7f) ? '?' : c;
-  }
-  if (token.size() > kMax) s += "...";
-  return s;
-}
-
-// Walks the text one non-blank line at a time and formats errors with the line number.
-class LineReader {
- public:
-  LineReader(std::string_view text, const std::string& name) : text_(text), name_(name) {}
-
-  // Moves to the next non-blank line; false at the end of the text, where the line number
-  // stays on the last line so that messages point at where the text stopped.
-  bool advance() {
-    while (pos_ < text_.size()) {
-      std::size_t end = text_.find('\n', pos_);
-      if (end == std::string_view::npos) end = text_.size();
-      line_ = trim(text_.substr(pos_, end - pos_));
-      pos_ = end < text_.size() ? end + 1 : end;
-      ++number_;
-      if (!line_.empty()) return true;
-    }
-    line_ = {};
-    return false;
-  }
-
-  // Like advance(), but the end of the text is an error: `what` was expected there.
-  std::string_view next(std::string_view what) {
-    if (!advance()) expected(what, "end of file");
-    return line_;
-  }
-
-  std::string_view line() const { return line_; }
-  std::int64_t bytes_left() const { return static_cast<std::int64_t>(text_.size() - pos_); }
-
-  [[noreturn]] void expected(std::string_view what, std::string_view got,
-                             Errc code = Errc::Parse) const {
-    fail(code, name_ + ": line " + std::to_string(number_ > 0 ? number_ : 1) + ": expected " +
-                   std::string(what) + ", got '" + shown(got) + "'");
-  }
-
- private:
-  std::string_view text_;
-  const std::string& name_;
-  std::size_t pos_ = 0;
-  std::int64_t number_ = 0;
-  std::string_view line_;
-};
-
-// Reads the whitespace-separated fields of one line, reporting errors on that line.
-class Fields {
- public:
-  Fields(const LineReader& at, std::string_view line) : at_(at), rest_(line) {}
-
-  std::string_view token(std::string_view what) {
-    rest_ = trim(rest_);
-    if (rest_.empty()) at_.expected(what, "end of line");
-    last_ = first_token(rest_);
-    rest_.remove_prefix(last_.size());
-    return last_;
-  }
-
-  // The token read last, for messages about it.
-  std::string_view last() const { return last_; }
-
-  // An integer in [lo, hi]; anything else is reported as not being `what`.
-  std::int64_t integer(std::string_view what,
-                       std::int64_t lo = std::numeric_limits<std::int64_t>::min(),
-                       std::int64_t hi = std::numeric_limits<std::int64_t>::max()) {
-    const std::string_view tok = token(what);
-    std::int64_t value = 0;
-    const auto [end, ec] = std::from_chars(tok.data(), tok.data() + tok.size(), value);
-    if (ec != std::errc() || end != tok.data() + tok.size() || value < lo || value > hi) {
-      at_.expected(what, tok);
-    }
-    return value;
-  }
-
-  // A record count: at most `max`, and small enough to index with int32.
-  std::int64_t count(std::string_view what,
-                     std::int64_t max = std::numeric_limits<std::int32_t>::max()) {
-    return integer(what, 0, max);
-  }
-
-  double coordinate(std::string_view what) {
-    const std::string tok(token(what));  // strtod needs a null-terminated string
-    char* end = nullptr;
-    const double value = std::strtod(tok.c_str(), &end);
-    if (end != tok.c_str() + tok.size() || !std::isfinite(value)) at_.expected(what, tok);
-    return value;
-  }
-
-  void finish() {
-    rest_ = trim(rest_);
-    if (!rest_.empty()) at_.expected("end of line", first_token(rest_));
-  }
-
- private:
-  const LineReader& at_;
-  std::string_view rest_;
-  std::string_view last_;
-};
 
 enum class Version { Legacy2, Modern4 };
 
@@ -177,7 +51,7 @@ class GmshParser {
     if (tets_.empty()) {
       lines_.expected("at least one 4-node tetrahedron (element type 4)", "end of file");
     }
-    return compact();
+    return detail::drop_unused_nodes(nodes_, tets_);
   }
 
  private:
@@ -227,16 +101,15 @@ class GmshParser {
   }
 
   static Vec3 read_point(Fields& f) {
-    const double x = f.coordinate("a finite x coordinate");
-    const double y = f.coordinate("a finite y coordinate");
-    const double z = f.coordinate("a finite z coordinate");
+    const double x = f.real("a finite x coordinate");
+    const double y = f.real("a finite y coordinate");
+    const double z = f.real("a finite z coordinate");
     return {x, y, z};
   }
 
   // Room for `n` more nodes, but no more than the rest of the text can describe.
   void reserve_nodes(std::int64_t n) {
-    const std::int64_t fit = std::min(n, lines_.bytes_left() / kMinNodeBytes);
-    nodes_.reserve(nodes_.size() + static_cast<std::size_t>(fit));
+    nodes_.reserve(nodes_.size() + lines_.reservable(n, kMinNodeBytes));
   }
 
   static constexpr std::int64_t kMaxTag = std::numeric_limits<std::int64_t>::max();
@@ -354,27 +227,6 @@ class GmshParser {
     for (auto& v : t) v = node_index(f);
     f.finish();
     tets_.push_back(t);
-  }
-
-  // Keeps the nodes the tetrahedra use, numbered in the order $Nodes listed them.
-  TetMesh compact() const {
-    std::vector<std::int32_t> new_index(nodes_.size(), -1);
-    for (const Tet& t : tets_) {
-      for (std::int32_t v : t) new_index[static_cast<std::size_t>(v)] = 0;
-    }
-    TetMesh mesh;
-    for (std::size_t i = 0; i < nodes_.size(); ++i) {
-      if (new_index[i] < 0) continue;
-      new_index[i] = static_cast<std::int32_t>(mesh.nodes.size());
-      mesh.nodes.push_back(nodes_[i]);
-    }
-    mesh.tets.reserve(tets_.size());
-    for (const Tet& t : tets_) {
-      Tet renumbered;
-      for (std::size_t k = 0; k < 4; ++k) renumbered[k] = new_index[static_cast<std::size_t>(t[k])];
-      mesh.tets.push_back(renumbered);
-    }
-    return mesh;
   }
 
   LineReader lines_;

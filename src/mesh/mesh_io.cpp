@@ -1,4 +1,5 @@
-// Loading a mesh file: choose the reader from the extension, read whole files into memory.
+// Loading a mesh file: choose the reader from the extension, read whole files into memory,
+// and the other helpers the readers share (declared in text_scanner.hpp).
 #include "mesh/mesh_io.hpp"
 
 #include <cerrno>
@@ -8,12 +9,11 @@
 #include <string>
 
 #include "core/error.hpp"
+#include "mesh/text_scanner.hpp"
 
 namespace mica {
 namespace detail {
 
-// The whole file as text; Errc::Io naming the path and the system's reason on failure.
-// (Shared by the readers, which declare it themselves: there is no private header for it.)
 std::string read_text_file(const std::string& path) {
   struct Closer {
     void operator()(std::FILE* f) const { std::fclose(f); }
@@ -30,20 +30,43 @@ std::string read_text_file(const std::string& path) {
   return text;
 }
 
-}  // namespace detail
-
-namespace {
-
-bool ends_with(const std::string& s, const std::string& suffix) {
-  return s.size() >= suffix.size() &&
-         s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+bool has_extension(std::string_view path, std::string_view extension) {
+  if (path.size() < extension.size()) return false;
+  const std::string_view tail = path.substr(path.size() - extension.size());
+  const auto lower = [](char c) { return c >= 'A' && c <= 'Z' ? char(c - 'A' + 'a') : c; };
+  for (std::size_t i = 0; i < tail.size(); ++i) {
+    if (lower(tail[i]) != lower(extension[i])) return false;
+  }
+  return true;
 }
 
-}  // namespace
+TetMesh drop_unused_nodes(const Vec3List& nodes, const std::vector<Tet>& tets) {
+  std::vector<std::int32_t> new_index(nodes.size(), -1);
+  for (const Tet& t : tets) {
+    for (std::int32_t v : t) new_index[static_cast<std::size_t>(v)] = 0;
+  }
+  TetMesh mesh;
+  for (std::size_t i = 0; i < nodes.size(); ++i) {
+    if (new_index[i] < 0) continue;
+    new_index[i] = static_cast<std::int32_t>(mesh.nodes.size());
+    mesh.nodes.push_back(nodes[i]);
+  }
+  mesh.tets.reserve(tets.size());
+  for (const Tet& t : tets) {
+    Tet renumbered;
+    for (std::size_t k = 0; k < 4; ++k) renumbered[k] = new_index[static_cast<std::size_t>(t[k])];
+    mesh.tets.push_back(renumbered);
+  }
+  return mesh;
+}
+
+}  // namespace detail
 
 TetMesh load_mesh(const std::string& path) {
-  if (ends_with(path, ".msh")) return read_gmsh(path);
-  if (ends_with(path, ".node") || ends_with(path, ".ele")) return read_tetgen(path);
+  if (detail::has_extension(path, ".msh")) return read_gmsh(path);
+  if (detail::has_extension(path, ".node") || detail::has_extension(path, ".ele")) {
+    return read_tetgen(path);
+  }
   fail(Errc::Unsupported,
        path +
            ": unsupported mesh file extension (accepted: .msh for Gmsh, .node or .ele for TetGen)");

@@ -109,10 +109,13 @@ TetMesh make_box_grid(const Vec3& lo, const Vec3& hi, const std::array<int32_t, 
     if (!(hi[k] > lo[k])) fail(Errc::InvalidArgument, "box: hi[" + std::to_string(k) + "] must exceed lo[" + std::to_string(k) + "]");
   }
   const int64_t nx = cells[0], ny = cells[1], nz = cells[2];
+  // Checked in floating point first: the integer products can overflow 64 bits.
+  const double tets_wanted = double(nx) * double(ny) * double(nz) * tets_per_cell;
+  if (tets_wanted > double(INT32_MAX / 4))
+    fail(Errc::InvalidArgument, "box: " + std::to_string(nx) + " x " + std::to_string(ny) + " x " + std::to_string(nz) +
+                                    " cells is more than one body can hold");
   const int64_t node_count = (nx + 1) * (ny + 1) * (nz + 1);
   const int64_t tet_count = nx * ny * nz * tets_per_cell;
-  if (node_count > INT32_MAX / 4 || tet_count > INT32_MAX / 4)
-    fail(Errc::InvalidArgument, "box: " + std::to_string(tet_count) + " tets is more than one body can hold");
 
   TetMesh mesh;
   mesh.nodes.reserve(size_t(node_count));

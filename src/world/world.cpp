@@ -97,7 +97,8 @@ Id World::add_lpc(Id body_id, const std::vector<int32_t>& nodes, const LpcSpec& 
 }
 
 Id World::add_tool(const Tool& tool) {
-  if (!tool.position.allFinite() || !tool.orientation.coeffs().allFinite()) fail(Errc::InvalidArgument, "the tool pose must be finite");
+  if (!tool.position.allFinite() || !tool.orientation.coeffs().allFinite() || !(tool.orientation.norm() > 1e-12))
+    fail(Errc::InvalidArgument, "the tool pose must be finite with a non-zero quaternion");
   if (tool.shape == ToolShape::Sphere && !(tool.radius > 0 && std::isfinite(tool.radius)))
     fail(Errc::InvalidArgument, "the sphere radius must be finite and > 0 m");
   if (tool.shape == ToolShape::Plane && !(tool.plane_normal.norm() > 1e-12 && tool.plane_normal.allFinite()))
