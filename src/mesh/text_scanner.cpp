@@ -38,8 +38,10 @@ bool underflows(std::string_view s) {
   if (e != std::string_view::npos) {
     std::string_view digits = s.substr(e + 1);
     if (!digits.empty() && digits.front() == '+') digits.remove_prefix(1);
-    const auto [end, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), exponent);
-    if (ec == std::errc::result_out_of_range) exponent = digits.front() == '-' ? -(1LL << 40) : 1LL << 40;
+    const auto ec = std::from_chars(digits.data(), digits.data() + digits.size(), exponent).ec;
+    if (ec == std::errc::result_out_of_range) {
+      exponent = digits.front() == '-' ? -(std::int64_t{1} << 40) : std::int64_t{1} << 40;
+    }
   }
   // Power of ten of the leading nonzero digit (the mantissa has one, or it would be in range).
   const auto point = static_cast<std::int64_t>(std::min(mantissa.find('.'), mantissa.size()));

@@ -1,5 +1,7 @@
 // Mesh files in and out: Gmsh 2.2 / 4.1 and TetGen readers, their error messages, load_mesh,
 // and the VTK legacy writer read back by a small parser.
+#include <unistd.h>
+
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -7,8 +9,6 @@
 #include <sstream>
 #include <string>
 #include <vector>
-
-#include <unistd.h>
 
 #include "core/error.hpp"
 #include "mesh/mesh_io.hpp"
@@ -25,73 +25,73 @@ namespace {
 // Five used nodes listed out of tag order, one unused node (50), and elements the reader
 // ignores (a point and a triangle). Line numbers are on the right.
 const std::string kGmsh22 =
-    "$MeshFormat\n"              // 1
-    "2.2 0 8\n"                  // 2
-    "$EndMeshFormat\n"           // 3
-    "$PhysicalNames\n"           // 4
-    "1\n"                        // 5
-    "3 1 \"body\"\n"             // 6
-    "$EndPhysicalNames\n"        // 7
-    "$Nodes\n"                   // 8
-    "6\n"                        // 9
-    "30 0 1 0\n"                 // 10
-    "10 0 0 0\n"                 // 11
-    "50 5 5 5\n"                 // 12
-    "20 1 0 0\n"                 // 13
-    "60 1 1 1\n"                 // 14
-    "40 0 0 1\n"                 // 15
-    "$EndNodes\n"                // 16
-    "$Elements\n"                // 17
-    "4\n"                        // 18
-    "1 15 2 0 1 50\n"            // 19
-    "2 2 2 0 1 10 20 30\n"       // 20
-    "3 4 2 1 1 10 20 30 40\n"    // 21
-    "4 4 2 1 1 20 60 30 40\n"    // 22
-    "$EndElements\n";            // 23
+    "$MeshFormat\n"            // 1
+    "2.2 0 8\n"                // 2
+    "$EndMeshFormat\n"         // 3
+    "$PhysicalNames\n"         // 4
+    "1\n"                      // 5
+    "3 1 \"body\"\n"           // 6
+    "$EndPhysicalNames\n"      // 7
+    "$Nodes\n"                 // 8
+    "6\n"                      // 9
+    "30 0 1 0\n"               // 10
+    "10 0 0 0\n"               // 11
+    "50 5 5 5\n"               // 12
+    "20 1 0 0\n"               // 13
+    "60 1 1 1\n"               // 14
+    "40 0 0 1\n"               // 15
+    "$EndNodes\n"              // 16
+    "$Elements\n"              // 17
+    "4\n"                      // 18
+    "1 15 2 0 1 50\n"          // 19
+    "2 2 2 0 1 10 20 30\n"     // 20
+    "3 4 2 1 1 10 20 30 40\n"  // 21
+    "4 4 2 1 1 20 60 30 40\n"  // 22
+    "$EndElements\n";          // 23
 
 // The same mesh in 4.1: nodes in three entity blocks (the last one parametric, whose u v
 // values are ignored), the same node order, elements in three blocks.
 const std::string kGmsh41 =
-    "$MeshFormat\n"              // 1
-    "4.1 0 8\n"                  // 2
-    "$EndMeshFormat\n"           // 3
-    "$PhysicalNames\n"           // 4
-    "1\n"                        // 5
-    "3 1 \"body\"\n"             // 6
-    "$EndPhysicalNames\n"        // 7
-    "$Entities\n"                // 8
-    "1 0 0 1\n"                  // 9
-    "1 5 5 5 0\n"                // 10
-    "1 0 0 0 1 1 1 1 1 0\n"      // 11
-    "$EndEntities\n"             // 12
-    "$Nodes\n"                   // 13
-    "3 6 10 60\n"                // 14
-    "3 1 0 2\n"                  // 15
-    "30\n"                       // 16
-    "10\n"                       // 17
-    "0 1 0\n"                    // 18
-    "0 0 0\n"                    // 19
-    "0 1 0 1\n"                  // 20
-    "50\n"                       // 21
-    "5 5 5\n"                    // 22
-    "2 1 1 3\n"                  // 23
-    "20\n"                       // 24
-    "60\n"                       // 25
-    "40\n"                       // 26
-    "1 0 0 0.25 0.5\n"           // 27
-    "1 1 1 0.5 0.5\n"            // 28
-    "0 0 1 0.75 0.5\n"           // 29
-    "$EndNodes\n"                // 30
-    "$Elements\n"                // 31
-    "3 4 1 4\n"                  // 32
-    "0 1 15 1\n"                 // 33
-    "1 50\n"                     // 34
-    "2 1 2 1\n"                  // 35
-    "2 10 20 30\n"               // 36
-    "3 1 4 2\n"                  // 37
-    "3 10 20 30 40\n"            // 38
-    "4 20 60 30 40\n"            // 39
-    "$EndElements\n";            // 40
+    "$MeshFormat\n"          // 1
+    "4.1 0 8\n"              // 2
+    "$EndMeshFormat\n"       // 3
+    "$PhysicalNames\n"       // 4
+    "1\n"                    // 5
+    "3 1 \"body\"\n"         // 6
+    "$EndPhysicalNames\n"    // 7
+    "$Entities\n"            // 8
+    "1 0 0 1\n"              // 9
+    "1 5 5 5 0\n"            // 10
+    "1 0 0 0 1 1 1 1 1 0\n"  // 11
+    "$EndEntities\n"         // 12
+    "$Nodes\n"               // 13
+    "3 6 10 60\n"            // 14
+    "3 1 0 2\n"              // 15
+    "30\n"                   // 16
+    "10\n"                   // 17
+    "0 1 0\n"                // 18
+    "0 0 0\n"                // 19
+    "0 1 0 1\n"              // 20
+    "50\n"                   // 21
+    "5 5 5\n"                // 22
+    "2 1 1 3\n"              // 23
+    "20\n"                   // 24
+    "60\n"                   // 25
+    "40\n"                   // 26
+    "1 0 0 0.25 0.5\n"       // 27
+    "1 1 1 0.5 0.5\n"        // 28
+    "0 0 1 0.75 0.5\n"       // 29
+    "$EndNodes\n"            // 30
+    "$Elements\n"            // 31
+    "3 4 1 4\n"              // 32
+    "0 1 15 1\n"             // 33
+    "1 50\n"                 // 34
+    "2 1 2 1\n"              // 35
+    "2 10 20 30\n"           // 36
+    "3 1 4 2\n"              // 37
+    "3 10 20 30 40\n"        // 38
+    "4 20 60 30 40\n"        // 39
+    "$EndElements\n";        // 40
 
 // The mesh both Gmsh texts describe: used nodes in file order 30, 10, 20, 60, 40.
 TetMesh expected_gmsh_mesh() {
@@ -183,8 +183,8 @@ void expect_error(F f, Errc code, const char* text) {
   }
   if (!thrown) fail_msg("no mica::Error thrown; wanted one saying \"%s\"", text);
   if (got != code) {
-    fail_msg("error code %d, wanted %d; message \"%s\"", static_cast<int>(got), static_cast<int>(code),
-             message.c_str());
+    fail_msg("error code %d, wanted %d; message \"%s\"", static_cast<int>(got),
+             static_cast<int>(code), message.c_str());
   }
   if (message.find(text) == std::string::npos) {
     fail_msg("message \"%s\" does not contain \"%s\"", message.c_str(), text);
@@ -195,7 +195,8 @@ void expect_gmsh_error(const std::string& text, Errc code, const char* message) 
   expect_error([&] { mica::parse_gmsh(text, "t.msh"); }, code, message);
 }
 
-void expect_tetgen_error(const std::string& node, const std::string& ele, Errc code, const char* message) {
+void expect_tetgen_error(const std::string& node, const std::string& ele, Errc code,
+                         const char* message) {
   expect_error([&] { mica::parse_tetgen(node, ele, "t.node", "t.ele"); }, code, message);
 }
 
@@ -203,15 +204,18 @@ void assert_same_mesh(const TetMesh& a, const TetMesh& b) {
   assert_int_equal(a.nodes.size(), b.nodes.size());
   for (std::size_t i = 0; i < a.nodes.size(); ++i) {
     if (a.nodes[i] != b.nodes[i]) {
-      fail_msg("node %zu: (%.17g %.17g %.17g) vs (%.17g %.17g %.17g)", i, a.nodes[i].x(), a.nodes[i].y(),
-               a.nodes[i].z(), b.nodes[i].x(), b.nodes[i].y(), b.nodes[i].z());
+      fail_msg("node %zu: (%.17g %.17g %.17g) vs (%.17g %.17g %.17g)", i, a.nodes[i].x(),
+               a.nodes[i].y(), a.nodes[i].z(), b.nodes[i].x(), b.nodes[i].y(), b.nodes[i].z());
     }
   }
   assert_int_equal(a.tets.size(), b.tets.size());
   for (std::size_t e = 0; e < a.tets.size(); ++e) {
     const mica::Tet& s = a.tets[e];
     const mica::Tet& t = b.tets[e];
-    if (s != t) fail_msg("tet %zu: {%d %d %d %d} vs {%d %d %d %d}", e, s[0], s[1], s[2], s[3], t[0], t[1], t[2], t[3]);
+    if (s != t) {
+      fail_msg("tet %zu: {%d %d %d %d} vs {%d %d %d %d}", e, s[0], s[1], s[2], s[3], t[0], t[1],
+               t[2], t[3]);
+    }
   }
 }
 
@@ -261,23 +265,28 @@ void gmsh_missing_end_markers(void**) {
                     "t.msh: line 22: expected $EndElements, got 'end of file'");
   expect_gmsh_error(without_line(kGmsh22, 3), Errc::Parse,
                     "t.msh: line 3: expected $EndMeshFormat, got '$PhysicalNames'");
-  expect_gmsh_error(without_line(kGmsh22, 1), Errc::Parse, "t.msh: line 1: expected $MeshFormat, got '2.2'");
+  expect_gmsh_error(without_line(kGmsh22, 1), Errc::Parse,
+                    "t.msh: line 1: expected $MeshFormat, got '2.2'");
 }
 
 void gmsh_wrong_counts(void**) {
   expect_gmsh_error(with_line(kGmsh22, 9, "7"), Errc::Parse,
                     "t.msh: line 16: expected a node tag, got '$EndNodes'");
-  expect_gmsh_error(with_line(kGmsh22, 9, "5"), Errc::Parse, "t.msh: line 15: expected $EndNodes, got '40'");
-  expect_gmsh_error(with_line(kGmsh22, 18, "3"), Errc::Parse, "t.msh: line 22: expected $EndElements, got '4'");
+  expect_gmsh_error(with_line(kGmsh22, 9, "5"), Errc::Parse,
+                    "t.msh: line 15: expected $EndNodes, got '40'");
+  expect_gmsh_error(with_line(kGmsh22, 18, "3"), Errc::Parse,
+                    "t.msh: line 22: expected $EndElements, got '4'");
   // 4.1: the header promises more nodes than the blocks hold, or a block more than the header.
-  expect_gmsh_error(with_line(kGmsh41, 14, "3 7 10 60"), Errc::Parse,
-                    "t.msh: line 30: expected another node block (the header lists 7 nodes, the blocks 6), "
-                    "got '$EndNodes'");
+  expect_gmsh_error(
+      with_line(kGmsh41, 14, "3 7 10 60"), Errc::Parse,
+      "t.msh: line 30: expected another node block (the header lists 7 nodes, the blocks 6), "
+      "got '$EndNodes'");
   expect_gmsh_error(with_line(kGmsh41, 14, "3 5 10 60"), Errc::Parse,
                     "t.msh: line 23: expected a block node count within the $Nodes total, got '3'");
-  expect_gmsh_error(with_line(kGmsh41, 32, "3 5 1 4"), Errc::Parse,
-                    "t.msh: line 40: expected another element block (the header lists 5 elements, the "
-                    "blocks 4), got '$EndElements'");
+  expect_gmsh_error(
+      with_line(kGmsh41, 32, "3 5 1 4"), Errc::Parse,
+      "t.msh: line 40: expected another element block (the header lists 5 elements, the "
+      "blocks 4), got '$EndElements'");
   expect_gmsh_error(with_line(kGmsh41, 14, "4 6 10 60"), Errc::Parse,
                     "t.msh: line 30: expected an entity dimension 0 to 3, got '$EndNodes'");
 }
@@ -289,8 +298,10 @@ void gmsh_bad_tokens(void**) {
                     "t.msh: line 13: expected a finite z coordinate, got 'nan'");
   expect_gmsh_error(with_line(kGmsh22, 13, "20 1e999 0 0"), Errc::Parse,
                     "t.msh: line 13: expected a finite x coordinate, got '1e999'");
-  expect_gmsh_error(with_line(kGmsh22, 13, "2x0 1 0 0"), Errc::Parse, "t.msh: line 13: expected a node tag, got '2x0'");
-  expect_gmsh_error(with_line(kGmsh22, 13, "20 1 0 0 7"), Errc::Parse, "t.msh: line 13: expected end of line, got '7'");
+  expect_gmsh_error(with_line(kGmsh22, 13, "2x0 1 0 0"), Errc::Parse,
+                    "t.msh: line 13: expected a node tag, got '2x0'");
+  expect_gmsh_error(with_line(kGmsh22, 13, "20 1 0 0 7"), Errc::Parse,
+                    "t.msh: line 13: expected end of line, got '7'");
   expect_gmsh_error(with_line(kGmsh22, 21, "3 4 2 1 1 10 20 30"), Errc::Parse,
                     "t.msh: line 21: expected a node tag, got 'end of line'");
   expect_gmsh_error(with_line(kGmsh41, 27, "1 0 zero"), Errc::Parse,
@@ -313,8 +324,9 @@ void gmsh_unknown_or_repeated_node_tags(void**) {
 }
 
 void gmsh_binary_and_other_versions_are_unsupported(void**) {
-  expect_gmsh_error(with_line(kGmsh22, 2, "2.2 1 8"), Errc::Unsupported,
-                    "t.msh: line 2: expected file type 0 (ASCII; binary .msh files are not supported), got '1'");
+  expect_gmsh_error(
+      with_line(kGmsh22, 2, "2.2 1 8"), Errc::Unsupported,
+      "t.msh: line 2: expected file type 0 (ASCII; binary .msh files are not supported), got '1'");
   expect_gmsh_error(with_line(kGmsh41, 2, "4.1 1 8"), Errc::Unsupported, "got '1'");
   expect_gmsh_error(with_line(kGmsh22, 2, "4.0 0 8"), Errc::Unsupported,
                     "t.msh: line 2: expected format version 2.2 or 4.1, got '4.0'");
@@ -324,23 +336,27 @@ void gmsh_binary_and_other_versions_are_unsupported(void**) {
 void gmsh_without_tets_is_rejected(void**) {
   const std::string no_tets = with_line(without_line(without_line(kGmsh22, 22), 21), 18, "2");
   expect_gmsh_error(no_tets, Errc::Parse,
-                    "t.msh: line 21: expected at least one 4-node tetrahedron (element type 4), got 'end of file'");
+                    "t.msh: line 21: expected at least one 4-node tetrahedron (element type 4), "
+                    "got 'end of file'");
 }
 
 void gmsh_huge_counts_fail_before_allocating(void**) {
   // A header may claim up to 2^31 - 1 records; only what the text can hold is reserved, so a
   // lying header ends at the end of the text (ASan would abort on a 48 GB reservation).
   const std::string tiny = "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n2147483647\n1 0 0 0\n";
-  expect_gmsh_error(tiny, Errc::Parse, "t.msh: line 6: expected a node line 'tag x y z', got 'end of file'");
+  expect_gmsh_error(tiny, Errc::Parse,
+                    "t.msh: line 6: expected a node line 'tag x y z', got 'end of file'");
   expect_gmsh_error(with_line(kGmsh22, 9, "3000000"), Errc::Parse,
                     "t.msh: line 16: expected a node tag, got '$EndNodes'");
-  expect_gmsh_error(with_line(kGmsh41, 14, "1 2147483647 1 2147483647"), Errc::Parse,
-                    "t.msh: line 20: expected another node block (the header lists 2147483647 nodes, the "
-                    "blocks 2), got '0'");
+  expect_gmsh_error(
+      with_line(kGmsh41, 14, "1 2147483647 1 2147483647"), Errc::Parse,
+      "t.msh: line 20: expected another node block (the header lists 2147483647 nodes, the "
+      "blocks 2), got '0'");
   // Counts beyond int32 indices, negative or unreadable, are rejected where they stand.
   expect_gmsh_error(with_line(kGmsh22, 9, "2147483648"), Errc::Parse,
                     "t.msh: line 9: expected a node count, got '2147483648'");
-  expect_gmsh_error(with_line(kGmsh22, 9, "-1"), Errc::Parse, "t.msh: line 9: expected a node count, got '-1'");
+  expect_gmsh_error(with_line(kGmsh22, 9, "-1"), Errc::Parse,
+                    "t.msh: line 9: expected a node count, got '-1'");
   expect_gmsh_error(with_line(kGmsh22, 18, "99999999999999999999"), Errc::Parse,
                     "t.msh: line 18: expected an element count, got '99999999999999999999'");
   expect_gmsh_error(with_line(kGmsh22, 21, "3 4 2000000000 1 1 10 20 30 40"), Errc::Parse,
@@ -373,6 +389,40 @@ void tetgen_keeps_file_orientation(void**) {
   assert_true(six_volume(m, m.tets[1]) < 0);
 }
 
+void tetgen_drops_unused_points_and_renumbers(void**) {
+  // Points 0 and 4 are used by no tet: the rest keep their file order, renumbered from 0.
+  const std::string node =
+      "6 3 0 0\n0 9 9 9\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 5 5 5\n5 0 0 1\n";
+  TetMesh expected;
+  expected.nodes = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1)};
+  expected.tets = {{0, 1, 2, 3}};
+  assert_same_mesh(mica::parse_tetgen(node, "1 4 0\n0 1 2 3 5\n", "t.node", "t.ele"), expected);
+  // Edge nodes of 10-node tets are not kept: point 5 is only an edge node here.
+  const TetMesh m =
+      mica::parse_tetgen(kNode1, "1 10 0\n1 1 2 3 4  5 5 5 5 5 5\n", "t.node", "t.ele");
+  expected.tets = {{0, 1, 2, 3}};
+  assert_same_mesh(m, expected);
+}
+
+void tetgen_reals_read_like_strtod_in_the_c_locale(void**) {
+  const std::string ele = "1 4 0\n0 0 1 2 3\n";
+  const TetMesh m = mica::parse_tetgen(
+      "4 3 0 0\n0 +1 -0.5 1e-400\n1 0x1p1 .25 2.\n2 1E2 -1e-400 4.9e-324\n3 0 0 1\n", ele,
+      "t.node", "t.ele");
+  assert_true(m.nodes[0] == Vec3(1, -0.5, 0));
+  assert_true(m.nodes[1] == Vec3(2, 0.25, 2));
+  assert_true(m.nodes[2].x() == 100 && m.nodes[2].y() == 0 && std::signbit(m.nodes[2].y()));
+  assert_true(m.nodes[2].z() > 0);
+  const std::string node = "4 3 0 0\n0 0 0 0\n1 1 0 0\n2 0 1 0\n3 0 0 1\n";
+  for (const char* bad : {"1e400", "-1e999999999999999999999", "nan", "inf", "+-1", "--1", "1,5",
+                          "0x", "1e", "+", "0.5x"}) {
+    const std::string message =
+        std::string("t.node: line 2: expected a finite x coordinate, got '") + bad + "'";
+    expect_tetgen_error(with_line(node, 2, std::string("1 ") + bad + " 0 0"), ele, Errc::Parse,
+                        message.c_str());
+  }
+}
+
 void tetgen_dimension_must_be_3(void**) {
   expect_tetgen_error(with_line(kNode1, 2, "5 2 1 1"), kEle1, Errc::Unsupported,
                       "t.node: line 2: expected dimension 3, got '2'");
@@ -392,7 +442,8 @@ void tetgen_numbering(void**) {
                       "t.node: line 4: expected a first point index 0 or 1, got '2'");
   expect_tetgen_error(with_line(kNode1, 6, "4 0 1 0 0.5 0"), kEle1, Errc::Parse,
                       "t.node: line 6: expected point index 3, got '4'");
-  expect_tetgen_error(kNode0, kEle1, Errc::Parse, "t.ele: line 3: expected tetrahedron index 0, got '1'");
+  expect_tetgen_error(kNode0, kEle1, Errc::Parse,
+                      "t.ele: line 3: expected tetrahedron index 0, got '1'");
 }
 
 void tetgen_wrong_counts_and_truncation(void**) {
@@ -400,15 +451,18 @@ void tetgen_wrong_counts_and_truncation(void**) {
                       "t.node: line 8: expected a point line 'index x y z', got 'end of file'");
   expect_tetgen_error(with_line(kNode1, 2, "4 3 1 1"), kEle1, Errc::Parse,
                       "t.node: line 8: expected end of file after 4 points, got '5'");
-  expect_tetgen_error(kNode1, with_line(kEle1, 1, "3 4 1"), Errc::Parse,
-                      "t.ele: line 4: expected a tetrahedron line 'index n1 n2 n3 n4', got 'end of file'");
+  expect_tetgen_error(
+      kNode1, with_line(kEle1, 1, "3 4 1"), Errc::Parse,
+      "t.ele: line 4: expected a tetrahedron line 'index n1 n2 n3 n4', got 'end of file'");
   expect_tetgen_error(with_line(kNode1, 5, "2 1 0 0 0.5"), kEle1, Errc::Parse,
                       "t.node: line 5: expected a boundary marker, got 'end of line'");
   expect_tetgen_error(kNode1, with_line(kEle1, 4, "2 2 5 3 4 7 8"), Errc::Parse,
                       "t.ele: line 4: expected end of line, got '8'");
   expect_tetgen_error(kNode1, with_line(kEle1, 1, "2 8 1"), Errc::Parse,
                       "t.ele: line 1: expected 4 or 10 nodes per tetrahedron, got '8'");
-  expect_tetgen_error(kNode1, "", Errc::Parse, "t.ele: line 1: expected a header 'ntets nodes_per_tet nattr', got 'end of file'");
+  expect_tetgen_error(
+      kNode1, "", Errc::Parse,
+      "t.ele: line 1: expected a header 'ntets nodes_per_tet nattr', got 'end of file'");
   expect_tetgen_error(kNode1, "# nothing\n\n", Errc::Parse, "t.ele: line 2: expected a header");
 }
 
@@ -426,8 +480,9 @@ void tetgen_bad_tokens(void**) {
 void tetgen_huge_counts_fail_before_allocating(void**) {
   expect_tetgen_error("2147483647 3 0 0\n1 0 0 0\n", kEle1, Errc::Parse,
                       "t.node: line 2: expected a point line 'index x y z', got 'end of file'");
-  expect_tetgen_error(kNode1, with_line(kEle1, 1, "2000000000 4 1"), Errc::Parse,
-                      "t.ele: line 4: expected a tetrahedron line 'index n1 n2 n3 n4', got 'end of file'");
+  expect_tetgen_error(
+      kNode1, with_line(kEle1, 1, "2000000000 4 1"), Errc::Parse,
+      "t.ele: line 4: expected a tetrahedron line 'index n1 n2 n3 n4', got 'end of file'");
   expect_tetgen_error(with_line(kNode1, 2, "2147483648 3 0 0"), kEle1, Errc::Parse,
                       "t.node: line 2: expected a positive point count, got '2147483648'");
   expect_tetgen_error(with_line(kNode1, 2, "0 3 0 0"), kEle1, Errc::Parse,
@@ -462,8 +517,10 @@ void survives_damage(const std::string& text, Parse parse) {
 void parsers_survive_damaged_input(void**) {
   survives_damage(kGmsh22, [](const std::string& s) { mica::parse_gmsh(s, "t.msh"); });
   survives_damage(kGmsh41, [](const std::string& s) { mica::parse_gmsh(s, "t.msh"); });
-  survives_damage(kNode1, [](const std::string& s) { mica::parse_tetgen(s, kEle1, "t.node", "t.ele"); });
-  survives_damage(kEle1, [](const std::string& s) { mica::parse_tetgen(kNode1, s, "t.node", "t.ele"); });
+  survives_damage(kNode1,
+                  [](const std::string& s) { mica::parse_tetgen(s, kEle1, "t.node", "t.ele"); });
+  survives_damage(kEle1,
+                  [](const std::string& s) { mica::parse_tetgen(kNode1, s, "t.node", "t.ele"); });
 }
 
 // ---------------------------------------------------------------- load_mesh and sample files
@@ -495,7 +552,8 @@ void load_mesh_reads_the_sample_cubes(void**) {
 
 void load_mesh_missing_file_is_io(void**) {
   const std::string path = data_path("no_such_mesh.msh");
-  expect_error([&] { mica::load_mesh(path); }, Errc::Io, (path + ": cannot open: No such file or directory").c_str());
+  expect_error([&] { mica::load_mesh(path); }, Errc::Io,
+               (path + ": cannot open: No such file or directory").c_str());
   const std::string node = data_path("no_such_mesh.node");
   expect_error([&] { mica::load_mesh(data_path("no_such_mesh.ele")); }, Errc::Io, node.c_str());
   // A directory opens but cannot be read.
@@ -505,9 +563,39 @@ void load_mesh_missing_file_is_io(void**) {
 
 void load_mesh_unknown_extension_is_unsupported(void**) {
   const std::string path = data_path("cube.stl");
-  expect_error([&] { mica::load_mesh(path); }, Errc::Unsupported, (path + ": unsupported mesh file extension").c_str());
+  expect_error([&] { mica::load_mesh(path); }, Errc::Unsupported,
+               (path + ": unsupported mesh file extension").c_str());
   expect_error([&] { mica::load_mesh(path); }, Errc::Unsupported, ".msh");
   expect_error([&] { mica::load_mesh("cube"); }, Errc::Unsupported, ".node or .ele");
+}
+
+// Copies the sample `file` to a temporary path ending in `name`, which the caller removes.
+std::string temp_copy(const char* file, const std::string& name) {
+  const std::string path = "/tmp/mica_test_mesh_io_" + std::to_string(getpid()) + "_" + name;
+  std::ifstream in(data_path(file), std::ios::binary);
+  std::ofstream out(path, std::ios::binary);
+  out << in.rdbuf();
+  assert_true(in.good() && out.good());
+  return path;
+}
+
+void load_mesh_extensions_ignore_case(void**) {
+  const TetMesh cube = mica::load_mesh(data_path("cube_v22.msh"));
+  const std::string msh = temp_copy("cube_v22.msh", "cube.MSH");
+  const std::string mixed = temp_copy("cube_v41.msh", "cube.Msh");
+  const std::string node = temp_copy("cube.node", "cube.NODE");
+  const std::string ele = temp_copy("cube.ele", "cube.ELE");
+  const TetMesh from_msh = mica::load_mesh(msh);
+  const TetMesh from_mixed = mica::load_mesh(mixed);
+  const TetMesh from_node = mica::load_mesh(node);
+  const TetMesh from_ele = mica::load_mesh(ele);
+  for (const std::string& path : {msh, mixed, node, ele}) std::remove(path.c_str());
+  assert_same_mesh(from_msh, cube);
+  assert_same_mesh(from_mixed, cube);
+  assert_same_mesh(from_node, cube);
+  assert_same_mesh(from_ele, cube);
+  expect_error([&] { mica::load_mesh("cube.MSH2"); }, Errc::Unsupported,
+               "cube.MSH2: unsupported mesh file extension");
 }
 
 // ---------------------------------------------------------------- VTK
@@ -607,15 +695,17 @@ struct CommaDecimal : std::numpunct<char> {
 
 void vtk_round_trips_exactly(void**) {
   const mica::Vec3List a_pos = {Vec3(0.1, 1.0 / 3.0, -2.5e-300), Vec3(6.02214076e23, -0.0, 1e-5),
-                                Vec3(0.7, 0.2, 0.3), Vec3(std::nextafter(1.0, 2.0), 2, 3), Vec3(-1, -2, -3)};
+                                Vec3(0.7, 0.2, 0.3), Vec3(std::nextafter(1.0, 2.0), 2, 3),
+                                Vec3(-1, -2, -3)};
   const std::vector<mica::Tet> a_tets = {{0, 1, 2, 3}, {1, 4, 2, 3}};
-  const mica::Vec3List a_vel = {Vec3(1, 2, 3), Vec3(0.1, 0.2, 0.3), Vec3(1e300, -1e-300, 0), Vec3(4, 5, 6),
-                                Vec3(7, 8, 9)};
-  const mica::Vec3List a_force = {Vec3(-1, 0, 0), Vec3(0, -1, 0), Vec3(0, 0, -1), Vec3(1.0 / 7.0, 0, 0),
-                                  Vec3(0, 2.0 / 3.0, 0)};
+  const mica::Vec3List a_vel = {Vec3(1, 2, 3), Vec3(0.1, 0.2, 0.3), Vec3(1e300, -1e-300, 0),
+                                Vec3(4, 5, 6), Vec3(7, 8, 9)};
+  const mica::Vec3List a_force = {Vec3(-1, 0, 0), Vec3(0, -1, 0), Vec3(0, 0, -1),
+                                  Vec3(1.0 / 7.0, 0, 0), Vec3(0, 2.0 / 3.0, 0)};
   const mica::Vec3List b_pos = {Vec3(10, 0, 0), Vec3(11, 0, 0), Vec3(10, 1, 0), Vec3(10, 0, 1)};
   const std::vector<mica::Tet> b_tets = {{0, 1, 2, 3}};
-  const mica::Vec3List b_vel = {Vec3(0.5, 0.25, 0.125), Vec3(0, 0, 0), Vec3(3.14159, 0, 0), Vec3(0, 0, 2.718281828)};
+  const mica::Vec3List b_vel = {Vec3(0.5, 0.25, 0.125), Vec3(0, 0, 0), Vec3(3.14159, 0, 0),
+                                Vec3(0, 0, 2.718281828)};
   const mica::Vec3List b_force = {Vec3(9, 9, 9), Vec3(8, 8, 8), Vec3(7, 7, 7), Vec3(6, 6, 6)};
 
   mica::VtkPiece a{&a_pos, &a_tets, {{"velocity", &a_vel}, {"force", &a_force}}};
@@ -675,30 +765,53 @@ void vtk_file_matches_stream_and_reports_io(void**) {
   assert_true(g.vectors.empty());
 
   const std::string bad = "/nonexistent_dir_for_mica/out.vtk";
-  expect_error([&] { mica::write_vtk_file(bad, pieces, "x"); }, Errc::Io, (bad + ": cannot open for writing").c_str());
+  expect_error([&] { mica::write_vtk_file(bad, pieces, "x"); }, Errc::Io,
+               (bad + ": cannot open for writing").c_str());
 }
 
 void vtk_rejects_inconsistent_pieces(void**) {
   const TetMesh m = expected_gmsh_mesh();
   const std::vector<mica::Tet> bad_tets = {{0, 1, 2, 5}};
-  expect_error([&] { std::ostringstream o; mica::write_vtk(o, {{&m.nodes, &bad_tets, {}}}, "x"); }, Errc::OutOfRange,
-               "write_vtk: piece 0, tet 0: node 5 is outside [0, 5)");
-  const mica::Vec3List short_field(3);
-  expect_error([&] { std::ostringstream o; mica::write_vtk(o, {{&m.nodes, &m.tets, {{"v", &short_field}}}}, "x"); },
-               Errc::InvalidArgument, "point vector 'v' needs one value per node");
-  expect_error([&] { std::ostringstream o; mica::write_vtk(o, {{&m.nodes, &m.tets, {{"my v", &m.nodes}}}}, "x"); },
-               Errc::InvalidArgument, "must be one word");
   expect_error(
       [&] {
         std::ostringstream o;
-        mica::write_vtk(o, {{&m.nodes, &m.tets, {{"v", &m.nodes}}}, {&m.nodes, &m.tets, {{"w", &m.nodes}}}}, "x");
+        mica::write_vtk(o, {{&m.nodes, &bad_tets, {}}}, "x");
+      },
+      Errc::OutOfRange, "write_vtk: piece 0, tet 0: node 5 is outside [0, 5)");
+  const mica::Vec3List short_field(3);
+  expect_error(
+      [&] {
+        std::ostringstream o;
+        mica::write_vtk(o, {{&m.nodes, &m.tets, {{"v", &short_field}}}}, "x");
+      },
+      Errc::InvalidArgument, "point vector 'v' needs one value per node");
+  expect_error(
+      [&] {
+        std::ostringstream o;
+        mica::write_vtk(o, {{&m.nodes, &m.tets, {{"my v", &m.nodes}}}}, "x");
+      },
+      Errc::InvalidArgument, "must be one word");
+  expect_error(
+      [&] {
+        std::ostringstream o;
+        mica::write_vtk(
+            o, {{&m.nodes, &m.tets, {{"v", &m.nodes}}}, {&m.nodes, &m.tets, {{"w", &m.nodes}}}},
+            "x");
       },
       Errc::InvalidArgument, "write_vtk: piece 1: point vector 0 is 'w', piece 0 has 'v'");
-  expect_error([&] { std::ostringstream o; mica::write_vtk(o, {{nullptr, &m.tets, {}}}, "x"); }, Errc::InvalidArgument,
-               "piece 0 has no positions");
+  expect_error(
+      [&] {
+        std::ostringstream o;
+        mica::write_vtk(o, {{nullptr, &m.tets, {}}}, "x");
+      },
+      Errc::InvalidArgument, "piece 0 has no positions");
   std::ostringstream failed;
   failed.setstate(std::ios::badbit);
-  expect_error([&] { mica::write_vtk(failed, {{&m.nodes, &m.tets, {}}}, "x"); }, Errc::Io, "write_vtk");
+  expect_error(
+      [&] {
+        mica::write_vtk(failed, {{&m.nodes, &m.tets, {}}}, "x");
+      },
+      Errc::Io, "write_vtk");
 }
 
 }  // namespace
@@ -720,6 +833,8 @@ int main() {
       cmocka_unit_test(tetgen_zero_based),
       cmocka_unit_test(tetgen_ten_node_tets_keep_their_corners),
       cmocka_unit_test(tetgen_keeps_file_orientation),
+      cmocka_unit_test(tetgen_drops_unused_points_and_renumbers),
+      cmocka_unit_test(tetgen_reals_read_like_strtod_in_the_c_locale),
       cmocka_unit_test(tetgen_dimension_must_be_3),
       cmocka_unit_test(tetgen_node_index_out_of_range),
       cmocka_unit_test(tetgen_numbering),
@@ -730,6 +845,7 @@ int main() {
       cmocka_unit_test(load_mesh_reads_the_sample_cubes),
       cmocka_unit_test(load_mesh_missing_file_is_io),
       cmocka_unit_test(load_mesh_unknown_extension_is_unsupported),
+      cmocka_unit_test(load_mesh_extensions_ignore_case),
       cmocka_unit_test(vtk_round_trips_exactly),
       cmocka_unit_test(vtk_file_matches_stream_and_reports_io),
       cmocka_unit_test(vtk_rejects_inconsistent_pieces),
