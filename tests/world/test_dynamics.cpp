@@ -106,8 +106,34 @@ static void test_damping_decays_energy(void**) {
   for (size_t k = 1; k < damped.size(); ++k) assert_le(damped[k], damped[k - 1] * (1 + 1e-6));
 }
 
+// An unconstrained body falls rigidly: backward Euler gives v_n = g n h and a drop of
+// g h^2 n (n + 1) / 2, which tends to g t^2 / 2 as h -> 0 (relative gap 1/n).
+static void test_free_fall(void**) {
+  for (bool corot : {true, false}) {
+    WorldSettings ws;
+    ws.gravity = Vec3(0, 0, -9.81);
+    World world(ws);
+    BodySettings bs;
+    bs.corotational = corot;
+    const Id id = world.add_body(make_box_grid(Vec3(0, 0, 0), Vec3(0.2, 0.1, 0.1), {4, 2, 2}, 5), bs, Vec3::Zero(),
+                                 Vec3::Zero());
+    const int n = 100;
+    const double h = 0.001, g = 9.81, t = n * h;
+    for (int k = 0; k < n; ++k) world.step(h);
+    const Body& b = world.body(id);
+    const double drop_be = g * h * h * n * (n + 1) / 2;
+    for (size_t i = 0; i < b.x.size(); ++i) {
+      assert_near(b.fem.rest[i].z() - b.x[i].z(), drop_be, 1e-9 * drop_be);
+      assert_near(b.v[i].z(), -g * t, 1e-9 * g * t);
+      assert_near(b.x[i].x(), b.fem.rest[i].x(), 1e-12);
+    }
+    assert_near(drop_be / (0.5 * g * t * t), 1.0, 1.01 / n);
+  }
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_free_fall),
       cmocka_unit_test(test_cantilever_matches_euler_bernoulli),
       cmocka_unit_test(test_energy_never_grows_without_damping),
       cmocka_unit_test(test_damping_decays_energy),
