@@ -63,6 +63,19 @@ MicaReport MicaSolver::solve(std::vector<MicaBody>& bodies, const std::vector<Co
     u_[ct.body][ct.node] += g_[r] * lambda[r];
   }
 
+  // Scales for the stopping test, so it stays meaningful when v or lambda tend to zero (a body
+  // at rest): the velocity the momentum and loads alone give, Dt^-1 b, and the impulse the
+  // first anticipation calls for, c / B_rr.
+  double v_scale2 = 0, l_scale2 = 0;
+  for (size_t bi = 0; bi < nb; ++bi)
+    for (int32_t i = 0; i < bodies[bi].pattern->rows; ++i) v_scale2 += (inv_diag_[bi][i] * (*bodies[bi].b)[i]).squaredNorm();
+  for (size_t r = 0; r < nc; ++r) {
+    if (diag_[r] == 0) continue;
+    const Contact& ct = contacts[r];
+    const MicaBody& body = bodies[ct.body];
+    const double c = ct.normal.dot(node_update(body, inv_diag_[ct.body][ct.node], ct.node, (*body.b)[ct.node])) + bias_[r];
+    l_scale2 += (c / diag_[r]) * (c / diag_[r]);
+  }
   MicaReport report;
   report.converged = false;
   while (report.iterations < settings.max_iterations) {
@@ -107,8 +120,8 @@ MicaReport MicaSolver::solve(std::vector<MicaBody>& bodies, const std::vector<Co
       dl2 += (lambda[r] - lambda_old_[r]) * (lambda[r] - lambda_old_[r]);
       l2 += lambda[r] * lambda[r];
     }
-    report.velocity_change = std::sqrt(dv2) / std::max(std::sqrt(v2), 1e-12);
-    report.impulse_change = nc ? std::sqrt(dl2) / std::max(std::sqrt(l2), 1e-12) : 0.0;
+    report.velocity_change = dv2 > 0 ? std::sqrt(dv2 / std::max(v2, v_scale2)) : 0.0;
+    report.impulse_change = dl2 > 0 ? std::sqrt(dl2 / std::max(l2, l_scale2)) : 0.0;
     report.paper_change = std::sqrt(dv2 + dl2);
     report.residual = std::max(report.velocity_change, report.impulse_change);
     const bool done = settings.paper_norm ? report.paper_change <= settings.tolerance

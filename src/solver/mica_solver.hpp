@@ -17,7 +17,9 @@
 namespace mica {
 
 struct MicaSettings {
-  double tolerance = 1e-8;          // relative change of v and of lambda between iterations
+  // Stop when the change of v between iterations is below tolerance * max(|v|, |Dt^-1 b|) and
+  // the change of lambda below tolerance * max(|lambda|, the first anticipated impulse).
+  double tolerance = 1e-8;
   int32_t max_iterations = 200;
   int32_t pgs_sweeps = 1;           // PGS sweeps over the contacts per iteration
   double max_recovery_speed = 1.0;  // m/s: gap / h is clamped below at -this (no energy injection)
@@ -35,8 +37,8 @@ struct MicaBody {
 };
 
 struct MicaReport : SolveReport {
-  double velocity_change = 0;  // last relative change of v
-  double impulse_change = 0;   // last relative change of lambda
+  double velocity_change = 0;  // last change of v, relative to its scale (see MicaSettings)
+  double impulse_change = 0;   // last change of lambda, relative to its scale
   double paper_change = 0;     // last 2-norm of the change of (v, lambda), the paper's test
 };
 

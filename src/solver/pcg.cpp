@@ -3,6 +3,8 @@
 #include <Eigen/LU>
 #include <cmath>
 
+#include "core/error.hpp"
+
 namespace mica {
 
 void PcgWorkspace::resize(size_t n) {
@@ -30,6 +32,7 @@ SolveReport solve_pcg(const ProjectedSystem& sys, const Vec3List& b, Vec3List& v
 
   SolveReport report;
   const double rhs_norm = std::sqrt(dot(ws.rhs, ws.rhs));
+  if (!std::isfinite(rhs_norm)) fail(Errc::Numerical, "the right-hand side is not finite (loads or state overflow)");
   const double stop = tolerance * rhs_norm;
   double r_norm = std::sqrt(dot(ws.r, ws.r));
   if (rhs_norm == 0) {
@@ -60,7 +63,7 @@ SolveReport solve_pcg(const ProjectedSystem& sys, const Vec3List& b, Vec3List& v
   }
   for (int32_t i : proj.nodes) v[i] = y[i] + proj.z[i];
   report.residual = rhs_norm > 0 ? r_norm / rhs_norm : 0;
-  report.converged = r_norm <= stop;
+  report.converged = r_norm <= stop;  // false for a NaN residual
   return report;
 }
 

@@ -36,9 +36,20 @@ bool World::needs_damping(const Body& b) const { return settings_.plan_all_stage
 
 void World::step(double h) {
   if (!(h > 0 && h <= 1)) fail(Errc::InvalidArgument, "the time step must be in (0, 1] s, got " + std::to_string(h));
+  const WorldStats saved = stats_;  // a failed step leaves even the statistics as they were
+  try {
+    advance(h);
+  } catch (...) {
+    stats_ = saved;
+    throw;
+  }
+}
+
+void World::advance(double h) {
   const auto start = std::chrono::steady_clock::now();
   const Plan plan = this->plan();
-  std::vector<Body*> dynamic;
+  std::vector<Body*>& dynamic = dynamic_;
+  dynamic.clear();
   bodies_.for_each([&](Id, Body& b) {
     if (b.is_dynamic()) dynamic.push_back(&b);
   });
@@ -80,8 +91,9 @@ void World::step(double h) {
     for (Body* b : dynamic)
       for (size_t i = 0; i < b->x.size(); ++i) b->x_next[i] = b->x[i] + h * b->v_next[i];
   });
+  check_finite(dynamic);  // throws before anything observable has changed
   stage.run(Stage::Forces, plan.forces, [&] { compute_forces(dynamic, h); });
-  commit();
+  commit(dynamic);
   stats_.step_count += 1;
   stats_.ms_last_step = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
@@ -168,11 +180,7 @@ void World::solve_mica(const std::vector<Body*>& dynamic, double h) {
   ms.paper_norm = settings_.paper_norm;
   const MicaReport report = mica_.solve(mica_bodies_, contacts_, h, ms, lambda_);
   for (size_t k = 0; k < dynamic.size(); ++k) std::swap(dynamic[k]->contact_impulse, mica_bodies_[k].contact_impulse);
-  warm_start_.clear();
-  for (size_t r = 0; r < contacts_.size(); ++r) warm_start_[contacts_[r].key] = lambda_[r];
-  stats_.solver_iterations += report.iterations;
-  stats_.solver_residual = std::max(stats_.solver_residual, report.residual);
-  stats_.converged = stats_.converged && report.converged;
+  record(report);
 }
 
 void World::compute_forces(const std::vector<Body*>& dynamic, double h) {
@@ -222,22 +230,31 @@ void World::solve_velocities(Body& b, double h) {
     b.v_next = b.v;  // warm start from the last velocity
     report = solve_pcg(sys, b.b, b.v_next, settings_.tolerance, settings_.max_iterations, b.pcg);
   }
+  record(report);
+}
+
+void World::record(const SolveReport& report) {
   stats_.solver_iterations += report.iterations;
-  stats_.solver_residual = std::max(stats_.solver_residual, report.residual);
+  // A NaN residual must show, not vanish in a max.
+  if (!(report.residual <= stats_.solver_residual)) stats_.solver_residual = report.residual;
   stats_.converged = stats_.converged && report.converged;
 }
 
-void World::commit() {
-  // All or nothing: a non-finite result anywhere keeps every body's old state.
-  bodies_.for_each([&](Id, Body& b) {
-    if (b.is_dynamic() && !(flat(b.v_next).allFinite() && flat(b.x_next).allFinite()))
-      fail(Errc::Numerical, b.name + ": the step produced non-finite velocities or positions; the step was undone");
-  });
-  bodies_.for_each([&](Id, Body& b) {
-    if (!b.is_dynamic()) return;
-    std::swap(b.x, b.x_next);
-    std::swap(b.v, b.v_next);
-  });
+void World::check_finite(const std::vector<Body*>& dynamic) const {
+  for (const Body* b : dynamic)
+    if (!(flat(b->v_next).allFinite() && flat(b->x_next).allFinite()))
+      fail(Errc::Numerical, b->name + ": the step produced non-finite velocities or positions; the step was undone");
+  for (double l : lambda_)
+    if (!std::isfinite(l)) fail(Errc::Numerical, "a contact impulse is not finite; the step was undone");
+}
+
+void World::commit(const std::vector<Body*>& dynamic) {
+  for (Body* b : dynamic) {
+    std::swap(b->x, b->x_next);
+    std::swap(b->v, b->v_next);
+  }
+  warm_start_.clear();
+  for (size_t r = 0; r < contacts_.size(); ++r) warm_start_[contacts_[r].key] = lambda_[r];
 }
 
 }  // namespace mica

@@ -5,26 +5,26 @@
 namespace mica {
 
 namespace {
-void check_finite(const Vec3& v, const std::string& what) {
+void require_finite(const Vec3& v, const std::string& what) {
   if (!v.allFinite()) fail(Errc::InvalidArgument, what + " must be finite");
 }
 }  // namespace
 
 World::World(const WorldSettings& settings) : settings_(settings) {
-  check_finite(settings.gravity, "gravity");
+  require_finite(settings.gravity, "gravity");
   if (!(settings.tolerance > 0) || !std::isfinite(settings.tolerance))
     fail(Errc::InvalidArgument, "tolerance must be finite and > 0");
   if (settings.max_iterations < 1) fail(Errc::InvalidArgument, "max_iterations must be >= 1");
 }
 
 void World::set_gravity(const Vec3& g) {
-  check_finite(g, "gravity");
+  require_finite(g, "gravity");
   settings_.gravity = g;
 }
 
 Id World::add_body(const TetMesh& mesh, const BodySettings& settings, const Vec3& translation, const Vec3& velocity) {
-  check_finite(translation, "translation");
-  check_finite(velocity, "initial velocity");
+  require_finite(translation, "translation");
+  require_finite(velocity, "initial velocity");
   const double alpha = settings.rayleigh_alpha, beta = settings.rayleigh_beta;
   if (!(alpha >= 0) || !std::isfinite(alpha)) fail(Errc::InvalidArgument, "rayleigh_alpha must be finite and >= 0");
   if (!(beta >= 0) || !std::isfinite(beta)) fail(Errc::InvalidArgument, "rayleigh_beta must be finite and >= 0");
@@ -54,7 +54,7 @@ void World::set_node_forces(Id id, const std::vector<int32_t>& nodes, const Vec3
     if (nodes[k] < 0 || nodes[k] >= b.fem.node_count())
       fail(Errc::OutOfRange, b.name + ": node index " + std::to_string(nodes[k]) + " at position " +
                                  std::to_string(k) + " is outside 0.." + std::to_string(b.fem.node_count() - 1));
-    check_finite(forces[k], "force " + std::to_string(k));
+    require_finite(forces[k], "force " + std::to_string(k));
   }
   for (size_t k = 0; k < nodes.size(); ++k) b.node_forces[nodes[k]] = forces[k];
   b.has_node_forces = false;
@@ -89,7 +89,7 @@ Id World::add_lpc(Id body_id, const std::vector<int32_t>& nodes, const LpcSpec& 
     if (nodes[k] < 0 || nodes[k] >= b.fem.node_count())
       fail(Errc::OutOfRange, b.name + ": node index " + std::to_string(nodes[k]) + " at position " +
                                  std::to_string(k) + " is outside 0.." + std::to_string(b.fem.node_count() - 1));
-  check_finite(spec.velocity, "the prescribed velocity");
+  require_finite(spec.velocity, "the prescribed velocity");
   auto lpc = std::make_unique<Lpc>(Lpc{body_id, nodes, constrained_projector(spec), spec.velocity});
   const Id id = lpcs_.insert(std::move(lpc));
   ++b.lpc_version;

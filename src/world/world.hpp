@@ -99,7 +99,10 @@ class World {
   void build_projection(Body& b) const;
   void form_rhs(Body& b, double h) const;
   void solve_velocities(Body& b, double h);
-  void commit();
+  void advance(double h);
+  void record(const SolveReport& report);
+  void check_finite(const std::vector<Body*>& dynamic) const;
+  void commit(const std::vector<Body*>& dynamic);
 
   bool needs_loads(const Body& b) const;
   bool needs_damping(const Body& b) const;
@@ -108,6 +111,7 @@ class World {
   SlotMap<Body, IdKind::Body> bodies_;
   SlotMap<Lpc, IdKind::Lpc> lpcs_;
   SlotMap<Tool, IdKind::Tool> tools_;
+  std::vector<Body*> dynamic_;                      // this step's dynamic bodies
   std::vector<Tool*> step_tools_;
   std::vector<Contact> contacts_;
   std::vector<double> lambda_;                      // impulse per contact, N s

@@ -120,39 +120,46 @@ static const int32_t kCells[3] = {3, 1, 1};
     }                                                                                                \
   } while (0)
 
-static int setup(void** state) {
+/* The fixture world with the given solver; NULL on failure. */
+static fixture* new_fixture(int32_t solver) {
   fixture* fx = calloc(1, sizeof *fx);
-  if (!fx) return -1;
+  if (!fx) return NULL;
   mica_world_def wd = mica_world_def_default();
+  wd.solver = solver;
   wd.log = record_log;
   wd.log_user = fx;
-  if (mica_world_create(&wd, &fx->world) != MICA_OK) return -1;
+  if (mica_world_create(&wd, &fx->world) != MICA_OK) return NULL;
   const mica_body_def bd = mica_body_def_default();
-  if (mica_body_create_box(fx->world, &bd, kLo, kHi, kCells, 6, &fx->body) != MICA_OK) return -1;
+  if (mica_body_create_box(fx->world, &bd, kLo, kHi, kCells, 6, &fx->body) != MICA_OK) return NULL;
   mica_body_def moved = bd;
   moved.translation[0] = 1.0;
-  if (mica_body_create_box(fx->world, &moved, kLo, kHi, kCells, 5, &fx->dead_body) != MICA_OK) return -1;
-  if (mica_body_destroy(fx->world, fx->dead_body) != MICA_OK) return -1;
-  if (mica_body_get_counts(fx->world, fx->body, &fx->node_count, NULL, NULL) != MICA_OK) return -1;
+  if (mica_body_create_box(fx->world, &moved, kLo, kHi, kCells, 5, &fx->dead_body) != MICA_OK) return NULL;
+  if (mica_body_destroy(fx->world, fx->dead_body) != MICA_OK) return NULL;
+  if (mica_body_get_counts(fx->world, fx->body, &fx->node_count, NULL, NULL) != MICA_OK) return NULL;
 
   const double normal[3] = {1, 0, 0};
   int32_t face[64];
   int32_t count = 0;
   if (mica_body_select_nodes_by_plane(fx->world, fx->body, kLo, normal, 1e-9, 1, face, 64, &count) != MICA_OK)
-    return -1;
+    return NULL;
   mica_lpc_def fixed = mica_lpc_def_default();
-  if (mica_add_lpc(fx->world, fx->body, face, count, &fixed, &fx->lpc) != MICA_OK) return -1;
+  if (mica_add_lpc(fx->world, fx->body, face, count, &fixed, &fx->lpc) != MICA_OK) return NULL;
   mica_lpc_def plane = mica_lpc_def_default();
   plane.kind = MICA_LPC_PLANE;
   plane.direction[0][0] = 0;
   plane.direction[0][2] = 1;
   const int32_t tip[1] = {fx->node_count - 1};
-  if (mica_add_lpc(fx->world, fx->body, tip, 1, &plane, &fx->dead_lpc) != MICA_OK) return -1;
-  if (mica_lpc_remove(fx->world, fx->dead_lpc) != MICA_OK) return -1;
-  if (mica_step(fx->world, 0.01) != MICA_OK) return -1;
+  if (mica_add_lpc(fx->world, fx->body, tip, 1, &plane, &fx->dead_lpc) != MICA_OK) return NULL;
+  if (mica_lpc_remove(fx->world, fx->dead_lpc) != MICA_OK) return NULL;
+  if (mica_step(fx->world, 0.01) != MICA_OK) return NULL;
   fx->log_calls = 0;
+  return fx;
+}
+
+static int setup(void** state) {
+  fixture* fx = new_fixture(MICA_SOLVER_DIRECT);
   *state = fx;
-  return 0;
+  return fx ? 0 : -1;
 }
 
 static int teardown(void** state) {
@@ -199,6 +206,7 @@ typedef struct snapshot {
   double* rest;
   int32_t* surface;
   int64_t step_count;
+  mica_world_stats stats; /* all of it: counters, residual, timings */
   double kinetic, elastic, potential;
   long world_points;
 } snapshot;
@@ -226,11 +234,10 @@ static void take_snapshot(const fixture* fx, snapshot* s) {
   mica_body_get_velocities(fx->world, fx->body, s->v, s->nodes, NULL);
   mica_body_get_rest_positions(fx->world, fx->body, s->rest, s->nodes, NULL);
   mica_body_get_surface(fx->world, fx->body, s->surface, s->tris, NULL);
-  mica_world_stats st;
-  memset(&st, 0, sizeof st);
-  st.struct_size = sizeof st;
-  mica_world_get_stats(fx->world, &st);
-  s->step_count = st.step_count;
+  memset(&s->stats, 0, sizeof s->stats);
+  s->stats.struct_size = sizeof s->stats;
+  mica_world_get_stats(fx->world, &s->stats);
+  s->step_count = s->stats.step_count;
   mica_body_get_energy(fx->world, fx->body, &s->kinetic, &s->elastic, &s->potential);
   const char* path = tmp_path("snapshot.vtk");
   s->world_points = mica_world_write_vtk(fx->world, path) == MICA_OK ? vtk_points(path) : -3;
@@ -262,6 +269,17 @@ static int snapshot_differs(const snapshot* a, const snapshot* b, char* why, siz
     return snprintf(why, why_size, "step_count changed: %lld -> %lld", (long long)a->step_count,
                     (long long)b->step_count),
            1;
+  if (memcmp(&a->stats, &b->stats, sizeof a->stats) != 0) {
+    int stage = -1;
+    for (int k = 0; k < MICA_STAGE_COUNT && stage < 0; ++k)
+      if (memcmp(&a->stats.stages[k], &b->stats.stages[k], sizeof a->stats.stages[k]) != 0) stage = k;
+    return snprintf(why, why_size,
+                    "the stats changed: converged %d -> %d, solver_iterations %d -> %d, residual %g -> %g, "
+                    "first changed stage: %s",
+                    a->stats.converged, b->stats.converged, a->stats.solver_iterations, b->stats.solver_iterations,
+                    a->stats.solver_residual, b->stats.solver_residual, stage < 0 ? "none" : mica_stage_name(stage)),
+           1;
+  }
   if (memcmp(&a->kinetic, &b->kinetic, sizeof(double)) != 0 ||
       memcmp(&a->elastic, &b->elastic, sizeof(double)) != 0 ||
       memcmp(&a->potential, &b->potential, sizeof(double)) != 0)
@@ -1849,6 +1867,95 @@ static void test_tools_bad_input(void** state) {
   EXPECT_STATUS(MICA_ERR_INVALID_ARGUMENT, zero_status);
 }
 
+/* ------------------------------------------------------------------------------------------ */
+/* Failed steps                                                                                */
+
+/* A load whose exact answer overflows: 1e308 N on every node of the free 3 kg body. The
+ * momentum balance of a backward-Euler step, sum(M v+) = sum(M v) + h sum(f), makes the mean
+ * velocity after a 1 s step about 16e308 / 3 m/s, beyond DBL_MAX. Every solver must report
+ * MICA_ERR_NUMERICAL and undo the step completely, the statistics included (the header: "on
+ * an error the world is left exactly as it was"); none may return MICA_OK. */
+static void check_numerical_failure(int32_t solver) {
+  fixture* fx = new_fixture(solver);
+  assert_non_null(fx);
+  REQUIRE_OK_W(fx->world, mica_lpc_remove(fx->world, fx->lpc));
+  int32_t nodes[64];
+  double force[3 * 64], zero[3 * 64];
+  assert_true(fx->node_count <= 64);
+  for (int32_t k = 0; k < fx->node_count; ++k) {
+    nodes[k] = k;
+    force[3 * k] = force[3 * k + 1] = force[3 * k + 2] = 1e308;
+    zero[3 * k] = zero[3 * k + 1] = zero[3 * k + 2] = 0;
+  }
+  REQUIRE_OK_W(fx->world, mica_body_set_node_forces(fx->world, fx->body, nodes, force, fx->node_count));
+  /* Make the cleanup below run even when the check fails. */
+  snapshot before;
+  take_snapshot(fx, &before);
+  fx->log_calls = 0;
+  const mica_status got = mica_step(fx->world, 1.0);
+  char failure[4096] = "";
+  {
+    snapshot after;
+    take_snapshot(fx, &after);
+    char why[512] = "";
+    if (got != MICA_ERR_NUMERICAL)
+      snprintf(failure, sizeof failure, "mica_step(1.0) with 1e308 N on every node returned %d (%s), want %s\n", got,
+               mica_status_string(got), mica_status_string(MICA_ERR_NUMERICAL));
+    if (snapshot_differs(&before, &after, why, sizeof why))
+      snprintf(failure + strlen(failure), sizeof failure - strlen(failure),
+               "mica_step(1.0) with 1e308 N on every node changed the world: %s\n", why);
+    free_snapshot(&before);
+    free_snapshot(&after);
+  }
+  /* Without the load the world steps again. */
+  const mica_status unloaded = mica_body_set_node_forces(fx->world, fx->body, nodes, zero, fx->node_count);
+  const mica_status again = mica_step(fx->world, 0.01);
+  mica_world_destroy(fx->world);
+  free(fx);
+  if (failure[0]) {
+    print_error("%s", failure);
+    fail();
+  }
+  assert_int_equal(unloaded, MICA_OK);
+  assert_int_equal(again, MICA_OK);
+}
+
+static void test_numerical_failure_direct(void** state) {
+  (void)state;
+  check_numerical_failure(MICA_SOLVER_DIRECT);
+}
+static void test_numerical_failure_pcg(void** state) {
+  (void)state;
+  check_numerical_failure(MICA_SOLVER_PCG);
+}
+static void test_numerical_failure_mica(void** state) {
+  (void)state;
+  check_numerical_failure(MICA_SOLVER_MICA);
+}
+
+/* A step that is refused part-way (a tool touching a body in a world whose solver cannot
+ * handle contact) must also leave everything as it was, the statistics included. */
+static void test_unsupported_step_leaves_world_unchanged(void** state) {
+  (void)state;
+  fixture* fx = new_fixture(MICA_SOLVER_DIRECT);
+  assert_non_null(fx);
+  mica_tool_def td = mica_tool_def_default();
+  td.position[0] = 0.3; /* a 1 cm sphere around the corner node at (0.3, 0, 0) */
+  mica_tool_id tool = 0;
+  const mica_status created = mica_tool_create(fx->world, &td, &tool);
+  if (created == MICA_OK) {
+    EXPECT_FAIL(fx, MICA_ERR_UNSUPPORTED, mica_step(fx->world, 0.01), NULL);
+    EXPECT_FAIL(fx, MICA_ERR_UNSUPPORTED, mica_step(fx->world, 0.01), NULL);
+    REQUIRE_OK_W(fx->world, mica_tool_destroy(fx->world, tool));
+  } else {
+    /* Refusing the tool itself is the other acceptable design. */
+    assert_int_equal(created, MICA_ERR_UNSUPPORTED);
+  }
+  REQUIRE_OK_W(fx->world, mica_step(fx->world, 0.01));
+  mica_world_destroy(fx->world);
+  free(fx);
+}
+
 /* The world's message and the thread's message are separate. */
 static void test_error_message_scopes(void** state) {
   fixture* fx = *state;
@@ -1899,6 +2006,10 @@ int main(void) {
       cmocka_unit_test(test_log_callback),
       cmocka_unit_test_setup_teardown(test_lpc_reaction_bad_input, setup, teardown),
       cmocka_unit_test_setup_teardown(test_tools_bad_input, setup, teardown),
+      cmocka_unit_test(test_numerical_failure_direct),
+      cmocka_unit_test(test_numerical_failure_pcg),
+      cmocka_unit_test(test_numerical_failure_mica),
+      cmocka_unit_test(test_unsupported_step_leaves_world_unchanged),
       cmocka_unit_test_setup_teardown(test_error_message_scopes, setup, teardown),
   };
   return cmocka_run_group_tests(tests, group_setup, group_teardown);
