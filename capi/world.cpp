@@ -78,7 +78,16 @@ MICA_API mica_status mica_world_create(const mica_world_def* def, mica_world** o
       refuse(MICA_ERR_VERSION_MISMATCH, "the caller was compiled with libmica header " +
                                             std::to_string(d.header_version) + ", this library is " +
                                             std::to_string(MICA_VERSION_NUMBER));
-    auto* world = new mica_world(translate(d));
+    mica::WorldSettings settings = translate(d);
+    if (d.log) {
+      const mica_log_fn log = d.log;
+      void* const user = d.log_user;
+      settings.log = [log, user](mica::LogLevel level, const std::string& message) {
+        log(level == mica::LogLevel::Error ? MICA_LOG_ERROR : level == mica::LogLevel::Warning ? MICA_LOG_WARNING : MICA_LOG_INFO,
+            message.c_str(), user);
+      };
+    }
+    auto* world = new mica_world(settings);
     world->log = d.log;
     world->log_user = d.log_user;
     *out_world = world;

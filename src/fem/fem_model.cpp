@@ -20,9 +20,8 @@ FemModel build_fem_model(const TetMesh& mesh, const Material& material, MassKind
   if (!(mat.density > 0) || !std::isfinite(mat.density))
     fail(Errc::InvalidArgument, source + ": density must be finite and > 0 kg/m^3");
   validate_topology(mesh, source);
-  check_rest_quality(mesh, source);
-
   FemModel m;
+  m.quality = check_rest_quality(mesh, source);
   m.rest = mesh.nodes;
   m.material = material;
   m.lame = lame_parameters(material);

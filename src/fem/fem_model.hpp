@@ -24,6 +24,7 @@ struct FemModel {
   std::vector<std::array<int32_t, 16>> slots;  // per element, block index of (a, b)
   std::vector<double> mass;                    // scalar mass per block (M_ij = mass * I)
   std::vector<double> node_mass;               // row sums of M: the node's share, kg
+  QualityReport quality;                       // rest-shape quality: slivers are kept but reported
 
   int32_t node_count() const { return int32_t(rest.size()); }
   double total_mass() const;

@@ -31,6 +31,12 @@ Id World::add_body(const TetMesh& mesh, const BodySettings& settings, const Vec3
   TetMesh placed = mesh;  // the rest shape sits where the body is placed
   for (Vec3& p : placed.nodes) p += translation;
   auto body = std::make_unique<Body>(placed, settings, "body " + std::to_string(bodies_created_));
+  const QualityReport& q = body->fem.quality;
+  if (!q.slivers.empty() && settings_.log)
+    settings_.log(LogLevel::Warning, body->name + ": " + std::to_string(q.slivers.size()) +
+                                         " sliver elements (aspect ratio above 100), the first is tet " +
+                                         std::to_string(q.slivers.front()) + "; worst aspect " +
+                                         std::to_string(q.worst_aspect) + ". They slow iterative solvers.");
   if (!settings.is_static)
     for (Vec3& u : body->v) u = velocity;
   const Id id = bodies_.insert(std::move(body));

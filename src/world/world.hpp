@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include <functional>
 #include <unordered_map>
 
 #include "collision/contact.hpp"
@@ -16,6 +17,7 @@
 namespace mica {
 
 enum class SolverKind { Direct, Pcg, Mica };
+enum class LogLevel { Error, Warning, Info };
 
 struct WorldSettings {
   Vec3 gravity{0, -9.81, 0};
@@ -26,6 +28,7 @@ struct WorldSettings {
   int32_t pgs_sweeps = 1;          // MICA: PGS sweeps over the contacts per iteration
   double max_recovery_speed = 1.0; // m/s, clamps gap / h for penetrating contacts
   bool paper_norm = false;         // MICA: stop on the paper's 2-norm of the change
+  std::function<void(LogLevel, const std::string&)> log;  // optional
 };
 
 enum class LpcKind { Fixed, Plane, Line, TwoDirections };

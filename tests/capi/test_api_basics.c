@@ -1070,6 +1070,40 @@ static void test_pcg_not_converged(void** state) {
   mica_world_destroy(w);
 }
 
+/* A sliver (aspect ratio ~1e3) is accepted, and the host is warned through the log callback. */
+typedef struct {
+  int warnings;
+  char last[512];
+} log_capture;
+
+static void capture_log(int32_t level, const char* message, void* user) {
+  log_capture* c = user;
+  if (level == MICA_LOG_WARNING) {
+    c->warnings++;
+    snprintf(c->last, sizeof c->last, "%s", message);
+  }
+}
+
+static void test_sliver_is_reported(void** state) {
+  (void)state;
+  log_capture capture = {0, ""};
+  mica_world_def wd = mica_world_def_default();
+  wd.log = capture_log;
+  wd.log_user = &capture;
+  mica_world* w = NULL;
+  assert_int_equal(mica_world_create(&wd, &w), MICA_OK);
+  /* A regular-ish tet and a flat one: its apex sits 1e-3 above the base plane. */
+  const double nodes[] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0.3, 0.3, -1e-3};
+  const int32_t tets[] = {0, 1, 2, 3, 0, 2, 1, 4};
+  const mica_body_def bd = mica_body_def_default();
+  mica_body_id body = 0;
+  assert_int_equal(mica_body_create(w, &bd, nodes, 5, tets, 2, &body), MICA_OK);
+  assert_int_equal(capture.warnings, 1);
+  assert_non_null(strstr(capture.last, "sliver"));
+  assert_non_null(strstr(capture.last, "tet 1"));
+  mica_world_destroy(w);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_version),
@@ -1090,6 +1124,7 @@ int main(void) {
       cmocka_unit_test(test_stats),
       cmocka_unit_test(test_pcg_matches_direct),
       cmocka_unit_test(test_pcg_not_converged),
+      cmocka_unit_test(test_sliver_is_reported),
   };
   return cmocka_run_group_tests(tests, group_setup, group_teardown);
 }
