@@ -4,12 +4,16 @@
 
 namespace mica {
 
-enum class ToolShape { Sphere, Plane };
+enum class ToolShape { Sphere, Capsule, Box, Plane, ConvexHull };
 
+// Shapes are given in the tool frame (origin `position`, rotation `orientation`).
 struct Tool {
   ToolShape shape = ToolShape::Sphere;
-  double radius = 0.01;          // m, sphere
+  double radius = 0.01;          // m, sphere and capsule
+  double half_length = 0.01;     // m, capsule: segment from -half_length to +half_length along local z
+  Vec3 half_extents{0.01, 0.01, 0.01};  // m, box
   Vec3 plane_normal{0, 0, 1};    // unit, in the tool frame: the side the body stays on
+  Vec3List hull_points;          // m, convex hull: the hull of these points (tool frame)
   Vec3 position = Vec3::Zero();  // m, the tool origin (sphere centre, a point of the plane)
   Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();
   double margin = 0.0;           // m, contacts are made for gaps below this
