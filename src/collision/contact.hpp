@@ -1,20 +1,45 @@
-// Contacts between a body's surface nodes and tools: one row of G each.
+// Contacts: where a body touches a tool or another body, with the normal, the gap and a
+// persistent key. Each contact gives one normal row of G (and two tangent rows with friction).
 #pragma once
+#include <array>
 #include <vector>
 
 #include "collision/tool.hpp"
 
 namespace mica {
 
-struct Contact {
-  uint64_t key;      // persistent across steps while the same (tool, body, node) touch: warm starts
-  int32_t tool;      // index in the step's tool list
-  int32_t body;      // index in the step's dynamic-body list
-  int32_t node;      // body node
-  Vec3 normal;       // unit, from the tool into the body: the direction lambda pushes the body
-  Vec3 point;        // m, the node's position when detected
-  double gap;        // m, signed distance at the start of the step (negative: penetrating)
+// A point of a body: a node (one weight of 1) or a point of a surface triangle (barycentric).
+struct BodyPoint {
+  int32_t body = -1;  // index in the step's dynamic-body list
+  int32_t count = 0;
+  std::array<int32_t, 3> nodes{};
+  std::array<double, 3> weights{};
 };
+
+struct Contact {
+  uint64_t key;      // persistent while the same features touch: warm starts
+  int32_t tool;      // index in the step's tool list, or -1 between two bodies
+  BodyPoint a;       // pushed along +normal
+  BodyPoint b;       // between two bodies: pushed along -normal (count 0 for tools)
+  Vec3 normal;       // unit, the direction that separates a from the other side
+  Vec3 point;        // m, the contact point when detected
+  double gap;        // m, signed distance at the start of the step (negative: penetrating)
+  double friction;   // Coulomb coefficient, 0 for none
+};
+
+inline BodyPoint node_point(int32_t body, int32_t node) {
+  BodyPoint p;
+  p.body = body;
+  p.count = 1;
+  p.nodes[0] = node;
+  p.weights[0] = 1.0;
+  return p;
+}
+
+// Mixes ids into a contact key that survives reordering of tools, bodies and nodes.
+inline uint64_t contact_key(uint64_t a, uint64_t b, uint64_t feature) {
+  return (a * 0x9E3779B97F4A7C15ull) ^ (b * 0xC2B2AE3D27D4EB4Full) ^ (feature * 0x165667B19E3779F9ull);
+}
 
 // Appends a contact for each listed node closer to the tool than its margin.
 void collide_nodes(const Tool& tool, int32_t tool_index, uint64_t tool_key, int32_t body_index, uint64_t body_key,

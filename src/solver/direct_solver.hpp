@@ -19,6 +19,8 @@ class DirectSolver {
   void factorize(const ProjectedSystem& sys);
   // v = y + z with y solving the factored system for the right-hand side of b.
   SolveReport solve(const ProjectedSystem& sys, const Vec3List& b, Vec3List& v);
+  // y = (S A S + I - S)^-1 S f: the response to a force f with no prescribed velocity.
+  void solve_homogeneous(const ProjectedSystem& sys, const Vec3List& f, Vec3List& y);
   int64_t factorizations() const { return factorizations_; }
 
  private:

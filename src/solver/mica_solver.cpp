@@ -7,8 +7,8 @@ namespace mica {
 
 namespace {
 
-// v_i = z_i + Dt_i^-1 (q_i - sum_{j != i} A_ij v_j - D_ii z_i): the constrained-filtered block
-// Gauss-Seidel (or, with v read but not written, Jacobi) update of node i.
+// v_i = z_i + Dt_i^-1 (q_i - sum_{j != i} A_ij v_j - D_ii z_i): the constraint-filtered block
+// Gauss-Seidel update of node i (with v read but not written, the Jacobi anticipation).
 Vec3 node_update(const MicaBody& body, const Mat3& inv_diag, int32_t i, const Vec3& q_i) {
   const BlockPattern& p = *body.pattern;
   const BlockValues& A = *body.A;
@@ -25,9 +25,30 @@ Vec3 node_update(const MicaBody& body, const Mat3& inv_diag, int32_t i, const Ve
 
 }  // namespace
 
-MicaReport MicaSolver::solve(std::vector<MicaBody>& bodies, const std::vector<Contact>& contacts, double h,
-                             const MicaSettings& settings, std::vector<double>& lambda) {
-  const size_t nb = bodies.size(), nc = contacts.size();
+double MicaSolver::anticipated_velocity(const std::vector<MicaBody>& bodies, const ContactRows& rows, size_t r) const {
+  double c = rows.bias[r];
+  for (int32_t t = rows.start[r]; t < rows.start[r + 1]; ++t) {
+    const RowTerm& term = rows.terms[t];
+    const MicaBody& body = bodies[term.body];
+    const Vec3 vt = node_update(body, inv_diag_[term.body][term.node], term.node, (*body.b)[term.node]);
+    c += term.coef * rows.direction[r].dot(vt);
+  }
+  return c;
+}
+
+// Normal rows: lambda >= 0; friction rows: |lambda| <= mu lambda_normal.
+void MicaSolver::project(const ContactRows& rows, size_t r, std::vector<double>& lambda) const {
+  if (rows.normal_of[r] < 0) {
+    lambda[r] = std::max(0.0, lambda[r]);
+  } else {
+    const double bound = rows.mu[r] * lambda[rows.normal_of[r]];
+    lambda[r] = std::clamp(lambda[r], -bound, bound);
+  }
+}
+
+MicaReport MicaSolver::solve(std::vector<MicaBody>& bodies, const ContactRows& rows, const MicaSettings& settings,
+                             std::vector<double>& lambda) {
+  const size_t nb = bodies.size(), nr = rows.size();
   inv_diag_.resize(nb);
   u_.resize(nb);
   // Filtered diagonal inverses; the warm start made to satisfy (I - S) v = z.
@@ -45,65 +66,68 @@ MicaReport MicaSolver::solve(std::vector<MicaBody>& bodies, const std::vector<Co
       (*body.v)[i] = S * (*body.v)[i] + body.projection->z[i];
     }
   }
-  // Per contact: Dt^-1 n, the diagonal of B, the clamped recovery term.
-  g_.resize(nc);
-  diag_.resize(nc);
-  bias_.resize(nc);
-  c_.resize(nc);
-  lambda.resize(nc, 0.0);
-  for (size_t r = 0; r < nc; ++r) {
-    const Contact& ct = contacts[r];
-    g_[r] = inv_diag_[ct.body][ct.node] * ct.normal;
-    diag_[r] = ct.normal.dot(g_[r]);
-    bias_[r] = std::max(ct.gap / h, -settings.max_recovery_speed);
-    // A row on a node that cannot move along n (B_rr ~ 0) carries no impulse.
-    const double scale = inv_diag_[ct.body][ct.node].norm();
+  // Per row: the terms of Dt^-1 G_r^T and B_rr; the warm start projected onto the bounds.
+  g_.resize(rows.terms.size());
+  diag_.assign(nr, 0.0);
+  c_.resize(nr);
+  lambda.resize(nr, 0.0);
+  for (size_t r = 0; r < nr; ++r) {
+    double scale = 0;
+    for (int32_t t = rows.start[r]; t < rows.start[r + 1]; ++t) {
+      const RowTerm& term = rows.terms[t];
+      const Mat3& inv = inv_diag_[term.body][term.node];
+      g_[t] = term.coef * (inv * rows.direction[r]);
+      diag_[r] += term.coef * rows.direction[r].dot(g_[t]);
+      scale += term.coef * term.coef * inv.norm();
+    }
+    // A row whose nodes cannot move along it (B_rr ~ 0: fixed nodes) carries no impulse.
     if (!(diag_[r] > 1e-12 * scale)) diag_[r] = 0;
-    lambda[r] = diag_[r] > 0 ? std::max(0.0, lambda[r]) : 0.0;
-    u_[ct.body][ct.node] += g_[r] * lambda[r];
   }
+  for (size_t r = 0; r < nr; ++r) {
+    if (diag_[r] == 0) lambda[r] = 0;
+    project(rows, r, lambda);
+  }
+  for (size_t r = 0; r < nr; ++r)
+    for (int32_t t = rows.start[r]; t < rows.start[r + 1]; ++t)
+      u_[rows.terms[t].body][rows.terms[t].node] += g_[t] * lambda[r];
 
   // Scales for the stopping test, so it stays meaningful when v or lambda tend to zero (a body
   // at rest): the velocity the momentum and loads alone give, Dt^-1 b, and the impulse the
   // first anticipation calls for, c / B_rr.
   double v_scale2 = 0, l_scale2 = 0;
   for (size_t bi = 0; bi < nb; ++bi)
-    for (int32_t i = 0; i < bodies[bi].pattern->rows; ++i) v_scale2 += (inv_diag_[bi][i] * (*bodies[bi].b)[i]).squaredNorm();
-  for (size_t r = 0; r < nc; ++r) {
-    if (diag_[r] == 0) continue;
-    const Contact& ct = contacts[r];
-    const MicaBody& body = bodies[ct.body];
-    const double c = ct.normal.dot(node_update(body, inv_diag_[ct.body][ct.node], ct.node, (*body.b)[ct.node])) + bias_[r];
-    l_scale2 += (c / diag_[r]) * (c / diag_[r]);
-  }
+    for (int32_t i = 0; i < bodies[bi].pattern->rows; ++i)
+      v_scale2 += (inv_diag_[bi][i] * (*bodies[bi].b)[i]).squaredNorm();
+  for (size_t r = 0; r < nr; ++r)
+    if (diag_[r] > 0) l_scale2 += std::pow(anticipated_velocity(bodies, rows, r) / diag_[r], 2);
+
   MicaReport report;
   report.converged = false;
   while (report.iterations < settings.max_iterations) {
     ++report.iterations;
     lambda_old_ = lambda;
-    // Anticipate: the velocity each contact node would get from the current v, without contact.
-    for (size_t r = 0; r < nc; ++r) {
-      const Contact& ct = contacts[r];
-      const MicaBody& body = bodies[ct.body];
-      const Vec3 vt = node_update(body, inv_diag_[ct.body][ct.node], ct.node, (*body.b)[ct.node]);
-      c_[r] = ct.normal.dot(vt) + bias_[r];
-    }
-    // Projected Gauss-Seidel on lambda with B = G Dt^-1 G^T (B couples contacts sharing a node).
+    // Anticipate: each row's velocity from the current v, without contact.
+    for (size_t r = 0; r < nr; ++r) c_[r] = anticipated_velocity(bodies, rows, r);
+    // Projected Gauss-Seidel on lambda with B = G Dt^-1 G^T (B couples rows sharing a node).
     for (int32_t sweep = 0; sweep < settings.pgs_sweeps; ++sweep)
-      for (size_t r = 0; r < nc; ++r) {
+      for (size_t r = 0; r < nr; ++r) {
         if (diag_[r] == 0) continue;
-        const Contact& ct = contacts[r];
-        Vec3& u = u_[ct.body][ct.node];
-        const double w = c_[r] + ct.normal.dot(u);
-        const double next = std::max(0.0, lambda[r] - w / diag_[r]);
-        u += g_[r] * (next - lambda[r]);
-        lambda[r] = next;
+        double w = c_[r];
+        for (int32_t t = rows.start[r]; t < rows.start[r + 1]; ++t)
+          w += rows.terms[t].coef * rows.direction[r].dot(u_[rows.terms[t].body][rows.terms[t].node]);
+        const double before = lambda[r];
+        lambda[r] -= w / diag_[r];
+        project(rows, r, lambda);
+        for (int32_t t = rows.start[r]; t < rows.start[r + 1]; ++t)
+          u_[rows.terms[t].body][rows.terms[t].node] += g_[t] * (lambda[r] - before);
       }
-    // MBGS sweep with the contact impulses on the right-hand side.
-    for (size_t bi = 0; bi < nb; ++bi)
-      for (Vec3& f : bodies[bi].contact_impulse) f.setZero();
-    for (size_t r = 0; r < nc; ++r)
-      bodies[contacts[r].body].contact_impulse[contacts[r].node] += contacts[r].normal * lambda[r];
+    // MBGS sweep with the contact impulses G^T lambda on the right-hand side.
+    for (auto& body : bodies)
+      for (Vec3& f : body.contact_impulse) f.setZero();
+    for (size_t r = 0; r < nr; ++r)
+      for (int32_t t = rows.start[r]; t < rows.start[r + 1]; ++t)
+        bodies[rows.terms[t].body].contact_impulse[rows.terms[t].node] +=
+            rows.terms[t].coef * lambda[r] * rows.direction[r];
     double dv2 = 0, v2 = 0;
     for (size_t bi = 0; bi < nb; ++bi) {
       MicaBody& body = bodies[bi];
@@ -116,7 +140,7 @@ MicaReport MicaSolver::solve(std::vector<MicaBody>& bodies, const std::vector<Co
       }
     }
     double dl2 = 0, l2 = 0;
-    for (size_t r = 0; r < nc; ++r) {
+    for (size_t r = 0; r < nr; ++r) {
       dl2 += (lambda[r] - lambda_old_[r]) * (lambda[r] - lambda_old_[r]);
       l2 += lambda[r] * lambda[r];
     }

@@ -1,17 +1,18 @@
 // MICA: Modified Iterative Constraint Anticipation (Arikatla, Ortiz, De, Enquobahrie 2016).
 // One loop resolves projection constraints and contact together:
 //
-//   A v = b + G^T lambda,   (I - S) v = z,   0 <= lambda  _|_  G v + gap / h >= 0
+//   A v = b + G^T lambda,   (I - S) v = z,   0 <= lambda_n  _|_  G_n v + gap / h >= 0,
+//   |lambda_t| <= mu lambda_n (Coulomb friction, box bounds per tangent row)
 //
 // Each iteration anticipates the contact velocities from the current v with the filtered
 // block-diagonal inverse Dt^-1 = S (S D S + I - S)^-1 S, updates lambda by projected
 // Gauss-Seidel on B = G Dt^-1 G^T, then sweeps v by modified block Gauss-Seidel with the
 // contact impulses on the right-hand side. At a fixed point v and lambda solve the
-// mixed complementarity problem above exactly.
+// complementarity problem above exactly.
 #pragma once
 #include <vector>
 
-#include "collision/contact.hpp"
+#include "solver/contact_rows.hpp"
 #include "solver/projected_system.hpp"
 
 namespace mica {
@@ -21,8 +22,7 @@ struct MicaSettings {
   // the change of lambda below tolerance * max(|lambda|, the first anticipated impulse).
   double tolerance = 1e-8;
   int32_t max_iterations = 200;
-  int32_t pgs_sweeps = 1;           // PGS sweeps over the contacts per iteration
-  double max_recovery_speed = 1.0;  // m/s: gap / h is clamped below at -this (no energy injection)
+  int32_t pgs_sweeps = 1;           // PGS sweeps over the contact rows per iteration
   bool paper_norm = false;          // stop on the 2-norm of the change of (v, lambda) instead
 };
 
@@ -44,14 +44,17 @@ struct MicaReport : SolveReport {
 
 class MicaSolver {
  public:
-  // lambda: in, the warm start (clamped to >= 0); out, the contact impulses (N s).
-  MicaReport solve(std::vector<MicaBody>& bodies, const std::vector<Contact>& contacts, double h,
-                   const MicaSettings& settings, std::vector<double>& lambda);
+  // lambda: in, the warm start (projected onto its bounds); out, the impulses (N s) per row.
+  MicaReport solve(std::vector<MicaBody>& bodies, const ContactRows& rows, const MicaSettings& settings,
+                   std::vector<double>& lambda);
 
  private:
+  double anticipated_velocity(const std::vector<MicaBody>& bodies, const ContactRows& rows, size_t r) const;
+  void project(const ContactRows& rows, size_t r, std::vector<double>& lambda) const;
+
   std::vector<std::vector<Mat3>> inv_diag_;  // per body, per node: Dt_i^-1
-  std::vector<Vec3> g_;                      // per contact: Dt^-1 n
-  std::vector<double> diag_, bias_, c_;      // per contact: B_rr, clamped gap / h, anticipated velocity
+  std::vector<Vec3> g_;                      // per row term: coef Dt^-1 d
+  std::vector<double> diag_, c_;             // per row: B_rr, anticipated velocity
   std::vector<std::vector<Vec3>> u_;         // per body, per node: Dt^-1 G^T lambda
   std::vector<double> lambda_old_;
 };

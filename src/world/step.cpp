@@ -60,6 +60,8 @@ void World::advance(double h) {
   StageRunner stage(stats_);
   stage.run(Stage::Collide, plan.collide, [&] { collide(dynamic); });
   if (!plan.collide) contacts_.clear();
+  rows_.clear();
+  lambda_.clear();
   stage.run(Stage::Loads, plan.loads, [&] {
     for (Body* b : dynamic)
       if (needs_loads(*b)) apply_loads(*b);
@@ -81,9 +83,11 @@ void World::advance(double h) {
   stage.run(Stage::Solve, plan.solve, [&] {
     if (settings_.solver == SolverKind::Mica) {
       solve_mica(dynamic, h);
+    } else if (!contacts_.empty() && settings_.solver == SolverKind::Direct) {
+      solve_exact(dynamic, h);
     } else {
       if (!contacts_.empty())
-        fail(Errc::Unsupported, "tool contact needs the MICA solver (MICA_SOLVER_MICA) in this version");
+        fail(Errc::Unsupported, "tool contact needs MICA_SOLVER_MICA or MICA_SOLVER_DIRECT in this version");
       for (Body* b : dynamic) solve_velocities(*b, h);
     }
   });
@@ -166,21 +170,43 @@ void World::solve_mica(const std::vector<Body*>& dynamic, double h) {
     mica_bodies_[k].projection = &b.projection;
     mica_bodies_[k].v = &b.v_next;
   }
-  // Warm start the impulses of contacts that persist from the last step.
-  lambda_.assign(contacts_.size(), 0.0);
-  for (size_t r = 0; r < contacts_.size(); ++r) {
-    const auto it = warm_start_.find(contacts_[r].key);
+  // Warm start the impulses of contact rows that persist from the last step.
+  rows_.build(contacts_, h, settings_.max_recovery_speed);
+  lambda_.assign(rows_.size(), 0.0);
+  for (size_t r = 0; r < rows_.size(); ++r) {
+    const auto it = warm_start_.find(rows_.key[r]);
     if (it != warm_start_.end()) lambda_[r] = it->second;
   }
   MicaSettings ms;
   ms.tolerance = settings_.tolerance;
   ms.max_iterations = settings_.max_iterations;
   ms.pgs_sweeps = settings_.pgs_sweeps;
-  ms.max_recovery_speed = settings_.max_recovery_speed;
   ms.paper_norm = settings_.paper_norm;
-  const MicaReport report = mica_.solve(mica_bodies_, contacts_, h, ms, lambda_);
+  const MicaReport report = mica_.solve(mica_bodies_, rows_, ms, lambda_);
   for (size_t k = 0; k < dynamic.size(); ++k) std::swap(dynamic[k]->contact_impulse, mica_bodies_[k].contact_impulse);
   record(report);
+}
+
+void World::solve_exact(const std::vector<Body*>& dynamic, double h) {
+  exact_bodies_.resize(dynamic.size());
+  for (size_t k = 0; k < dynamic.size(); ++k) {
+    Body& b = *dynamic[k];
+    form_rhs(b, h);
+    factorize(b);
+    exact_bodies_[k] = ExactBody{&b.fem.pattern, &b.A, &b.b, &b.projection, &b.direct, &b.v_next, {}};
+  }
+  rows_.build(contacts_, h, settings_.max_recovery_speed);
+  record(solve_exact_contact(exact_bodies_, rows_, lambda_));
+  for (size_t k = 0; k < dynamic.size(); ++k) std::swap(dynamic[k]->contact_impulse, exact_bodies_[k].contact_impulse);
+}
+
+void World::factorize(Body& b) {
+  if (!b.direct.analyzed()) b.direct.analyze(b.fem.pattern);
+  if (!b.factor_current || b.factored_lpc_version != b.lpc_version) {
+    b.direct.factorize(ProjectedSystem{b.fem.pattern, b.A, b.projection});
+    b.factor_current = true;
+    b.factored_lpc_version = b.lpc_version;
+  }
 }
 
 void World::compute_forces(const std::vector<Body*>& dynamic, double h) {
@@ -190,13 +216,14 @@ void World::compute_forces(const std::vector<Body*>& dynamic, double h) {
     t->torque.setZero();
     t->contact_count = 0;
   }
-  for (size_t r = 0; r < contacts_.size(); ++r) {
-    const Contact& c = contacts_[r];
+  for (size_t r = 0; r < rows_.size(); ++r) {
+    const Contact& c = contacts_[rows_.contact[r]];
+    if (c.tool < 0) continue;
     Tool& t = *step_tools_[c.tool];
-    const Vec3 f = -c.normal * lambda_[r] / h;
+    const Vec3 f = -rows_.direction[r] * lambda_[r] / h;
     t.force += f;
     t.torque += (c.point - t.position).cross(f);
-    t.contact_count += lambda_[r] > 0 ? 1 : 0;
+    t.contact_count += (rows_.normal_of[r] < 0 && lambda_[r] > 0) ? 1 : 0;
   }
   // Constraints: the impulse r = (I - S)(A v - b - G^T lambda) holds the body; whoever holds
   // the constraint (the user's hand) feels the opposite force, -r / h.
@@ -219,12 +246,7 @@ void World::solve_velocities(Body& b, double h) {
   const ProjectedSystem sys{b.fem.pattern, b.A, b.projection};
   SolveReport report;
   if (settings_.solver == SolverKind::Direct) {
-    if (!b.direct.analyzed()) b.direct.analyze(b.fem.pattern);
-    if (!b.factor_current || b.factored_lpc_version != b.lpc_version) {
-      b.direct.factorize(sys);
-      b.factor_current = true;
-      b.factored_lpc_version = b.lpc_version;
-    }
+    factorize(b);
     report = b.direct.solve(sys, b.b, b.v_next);
   } else {
     b.v_next = b.v;  // warm start from the last velocity
@@ -254,7 +276,7 @@ void World::commit(const std::vector<Body*>& dynamic) {
     std::swap(b->v, b->v_next);
   }
   warm_start_.clear();
-  for (size_t r = 0; r < contacts_.size(); ++r) warm_start_[contacts_[r].key] = lambda_[r];
+  for (size_t r = 0; r < rows_.size(); ++r) warm_start_[rows_.key[r]] = lambda_[r];
 }
 
 }  // namespace mica

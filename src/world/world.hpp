@@ -9,6 +9,7 @@
 #include <unordered_map>
 
 #include "collision/contact.hpp"
+#include "solver/exact_contact_solver.hpp"
 #include "solver/mica_solver.hpp"
 #include "world/body.hpp"
 #include "world/slot_map.hpp"
@@ -80,7 +81,8 @@ class World {
   const Tool& tool(Id id) const { return tools_.get(id, "tool"); }
   void set_tool_pose(Id id, const Vec3& position, const Eigen::Quaterniond& orientation);
   const std::vector<Contact>& contacts() const { return contacts_; }
-  const std::vector<double>& impulses() const { return lambda_; }
+  const ContactRows& contact_rows() const { return rows_; }
+  const std::vector<double>& impulses() const { return lambda_; }  // per contact row, N s
 
   // One implicit step of h seconds. Throws Error(Numerical) and keeps the old state when
   // the result is not finite.
@@ -95,6 +97,8 @@ class World {
  private:
   void collide(const std::vector<Body*>& dynamic);
   void solve_mica(const std::vector<Body*>& dynamic, double h);
+  void solve_exact(const std::vector<Body*>& dynamic, double h);
+  void factorize(Body& b);
   void compute_forces(const std::vector<Body*>& dynamic, double h);
   void apply_loads(Body& b) const;
   void assemble_elements(Body& b, double h, bool damping) const;
@@ -117,10 +121,12 @@ class World {
   std::vector<Body*> dynamic_;                      // this step's dynamic bodies
   std::vector<Tool*> step_tools_;
   std::vector<Contact> contacts_;
-  std::vector<double> lambda_;                      // impulse per contact, N s
-  std::unordered_map<uint64_t, double> warm_start_; // last step's impulses by contact key
+  ContactRows rows_;                                // this step's rows of G
+  std::vector<double> lambda_;                      // impulse per row, N s
+  std::unordered_map<uint64_t, double> warm_start_; // last step's impulses by row key
   MicaSolver mica_;
   std::vector<MicaBody> mica_bodies_;
+  std::vector<ExactBody> exact_bodies_;
   WorldStats stats_;
   int64_t bodies_created_ = 0;
 };

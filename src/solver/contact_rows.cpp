@@ -1,0 +1,44 @@
+#include "solver/contact_rows.hpp"
+
+#include <algorithm>
+
+namespace mica {
+
+void ContactRows::clear() {
+  start.assign(1, 0);
+  terms.clear();
+  direction.clear();
+  bias.clear();
+  normal_of.clear();
+  mu.clear();
+  contact.clear();
+  key.clear();
+}
+
+void ContactRows::build(const std::vector<Contact>& contacts, double h, double max_recovery_speed) {
+  clear();
+  auto add_row = [&](size_t c, const Vec3& d, double b, int32_t normal_row, double friction, uint64_t kind) {
+    const Contact& ct = contacts[c];
+    for (int k = 0; k < ct.a.count; ++k) terms.push_back({ct.a.body, ct.a.nodes[k], ct.a.weights[k]});
+    for (int k = 0; k < ct.b.count; ++k) terms.push_back({ct.b.body, ct.b.nodes[k], -ct.b.weights[k]});
+    start.push_back(int32_t(terms.size()));
+    direction.push_back(d);
+    bias.push_back(b);
+    normal_of.push_back(normal_row);
+    mu.push_back(friction);
+    contact.push_back(int32_t(c));
+    key.push_back(ct.key * 3 + kind);
+  };
+  for (size_t c = 0; c < contacts.size(); ++c) {
+    const Contact& ct = contacts[c];
+    const int32_t normal_row = int32_t(direction.size());
+    add_row(c, ct.normal, std::max(ct.gap / h, -max_recovery_speed), -1, 0.0, 0);
+    if (ct.friction <= 0) continue;
+    // Any orthonormal tangent pair: the box bounds make friction isotropic enough for PGS.
+    const Vec3 t1 = ct.normal.unitOrthogonal(), t2 = ct.normal.cross(t1);
+    add_row(c, t1, 0.0, normal_row, ct.friction, 1);
+    add_row(c, t2, 0.0, normal_row, ct.friction, 2);
+  }
+}
+
+}  // namespace mica
