@@ -90,6 +90,11 @@ inline mica::Vec3 vec3(const double* v, const char* name) {
   return {v[0], v[1], v[2]};
 }
 
+inline Eigen::Quaterniond quaternion(const double* q, const char* name) {
+  require(q, name);
+  return {q[0], q[1], q[2], q[3]};  // (w, x, y, z)
+}
+
 // Copies `count` items of `width` values to a caller buffer with the size-query protocol.
 template <class T>
 mica_status copy_out(const T* source, int32_t count, int32_t width, T* out, int32_t capacity, int32_t* out_count) {

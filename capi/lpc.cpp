@@ -44,6 +44,54 @@ MICA_API mica_status mica_add_lpc(mica_world* world, mica_body_id body, const in
   });
 }
 
+MICA_API mica_status mica_lpc_set_velocity(mica_world* world, mica_lpc_id lpc, const double velocity[3]) {
+  return guarded(world, "mica_lpc_set_velocity", [&] {
+    require(world, "world");
+    world->world.set_lpc_velocity(lpc, vec3(velocity, "velocity"));
+    return MICA_OK;
+  });
+}
+
+MICA_API mica_status mica_lpc_set_targets(mica_world* world, mica_lpc_id lpc, const double* targets, int32_t count) {
+  return guarded(world, "mica_lpc_set_targets", [&] {
+    require(world, "world");
+    require(targets, "targets");
+    if (count < 0) refuse(MICA_ERR_INVALID_ARGUMENT, "count is " + std::to_string(count) + ", must be >= 0");
+    mica::Vec3List t(static_cast<size_t>(count));
+    for (int32_t k = 0; k < count; ++k) t[k] = {targets[3 * k], targets[3 * k + 1], targets[3 * k + 2]};
+    world->world.set_lpc_targets(lpc, t);
+    return MICA_OK;
+  });
+}
+
+MICA_API mica_status mica_lpc_grab(mica_world* world, mica_body_id body, const double center[3], double radius,
+                                   mica_tool_id tool, mica_lpc_id* out_lpc) {
+  return guarded(world, "mica_lpc_grab", [&] {
+    require(world, "world");
+    require(out_lpc, "out_lpc");
+    *out_lpc = world->world.grab(body, vec3(center, "center"), radius, tool);
+    return MICA_OK;
+  });
+}
+
+MICA_API mica_status mica_lpc_set_handle_pose(mica_world* world, mica_lpc_id lpc, const double position[3],
+                                              const double orientation[4]) {
+  return guarded(world, "mica_lpc_set_handle_pose", [&] {
+    require(world, "world");
+    world->world.set_handle_pose(lpc, vec3(position, "position"), quaternion(orientation, "orientation"));
+    return MICA_OK;
+  });
+}
+
+MICA_API mica_status mica_lpc_get_nodes(const mica_world* world, mica_lpc_id lpc, int32_t* out, int32_t capacity,
+                                        int32_t* out_count) {
+  return guarded(world, "mica_lpc_get_nodes", [&] {
+    require(world, "world");
+    const std::vector<int32_t>& nodes = world->world.lpc(lpc).nodes;
+    return copy_out(nodes.data(), int32_t(nodes.size()), 1, out, capacity, out_count);
+  });
+}
+
 MICA_API mica_status mica_lpc_get_reaction(const mica_world* world, mica_lpc_id lpc, double out_force[3]) {
   return guarded(world, "mica_lpc_get_reaction", [&] {
     require(world, "world");

@@ -12,12 +12,8 @@ mica_tool_def tool_defaults() {
   d.radius = 0.01;
   d.normal[2] = 1;
   d.orientation[0] = 1;
+  d.margin = 0.001;
   return d;
-}
-
-Eigen::Quaterniond quaternion(const double* q, const char* name) {
-  require(q, name);
-  return {q[0], q[1], q[2], q[3]};  // (w, x, y, z)
 }
 
 }  // namespace
@@ -44,6 +40,7 @@ MICA_API mica_status mica_tool_create(mica_world* world, const mica_tool_def* de
     t.position = vec3(d.position, "def->position");
     t.orientation = quaternion(d.orientation, "def->orientation");
     t.margin = d.margin;
+    t.friction = d.friction;
     *out_tool = world->world.add_tool(t);
     return MICA_OK;
   });

@@ -305,6 +305,32 @@ MICA_API mica_status mica_add_lpc(mica_world* world, mica_body_id body, const in
 /** Removes a constraint. The world's thread. */
 MICA_API mica_status mica_lpc_remove(mica_world* world, mica_lpc_id lpc);
 
+/** Changes the prescribed velocity (m/s) of a constraint's constrained components (and drops
+ *  any targets or handle it had). The world's thread. */
+MICA_API mica_status mica_lpc_set_velocity(mica_world* world, mica_lpc_id lpc, const double velocity[3]);
+
+/** Gives each node of the constraint a target position (m): every step the constrained
+ *  components move so that the node reaches its target in that step. `targets` holds
+ *  3 * count values, count = the constraint's node count. The world's thread. */
+MICA_API mica_status mica_lpc_set_targets(mica_world* world, mica_lpc_id lpc, const double* targets,
+                                          int32_t count);
+
+/** Picking: holds every node of `body` within `radius` (m) of `center` (m, current positions)
+ *  on a handle, fully constrained (S = 0). The handle starts at `center` and moves with
+ *  mica_lpc_set_handle_pose(); given a tool (not MICA_NULL_ID), it follows that tool's pose
+ *  instead, like forceps. Release with mica_lpc_remove(). The world's thread. */
+MICA_API mica_status mica_lpc_grab(mica_world* world, mica_body_id body, const double center[3], double radius,
+                                   mica_tool_id tool, mica_lpc_id* out_lpc);
+
+/** Moves a grab's handle: position (m) and unit quaternion (w, x, y, z). The held nodes keep
+ *  their offsets in the handle frame. The world's thread. */
+MICA_API mica_status mica_lpc_set_handle_pose(mica_world* world, mica_lpc_id lpc, const double position[3],
+                                              const double orientation[4]);
+
+/** The nodes a constraint holds; buffer protocol as mica_body_get_positions(). */
+MICA_API mica_status mica_lpc_get_nodes(const mica_world* world, mica_lpc_id lpc, int32_t* out, int32_t capacity,
+                                        int32_t* out_count);
+
 /** Reaction force (N) of a constraint group of the last step: the force on whoever holds the
  *  constraint (the user's hand in a grasp). Lifting a grasped region up against gravity gives
  *  a downward force. The world's thread. */
@@ -326,7 +352,8 @@ typedef struct mica_tool_def {
   double normal[3];      /**< plane normal in the tool frame; default (0, 0, 1) */
   double position[3];    /**< m, initial tool origin; default 0 */
   double orientation[4]; /**< initial unit quaternion (w, x, y, z); default identity */
-  double margin;         /**< m: contacts are made for gaps below this; default 0 */
+  double margin;         /**< m: contacts are made for gaps below this; default 0.001 */
+  double friction;       /**< Coulomb coefficient between tool and tissue, >= 0; default 0 */
 } mica_tool_def;
 
 /** Fills `def` with defaults, writing only its first `struct_size` bytes. Any thread. */

@@ -78,7 +78,7 @@ void World::advance(double h) {
       if (needs_damping(*b)) add_damping(*b, h);
   });
   stage.run(Stage::Constraints, plan.constraints, [&] {
-    for (Body* b : dynamic) build_projection(*b);
+    for (Body* b : dynamic) build_projection(*b, h);
   });
   stage.run(Stage::Solve, plan.solve, [&] {
     if (settings_.solver == SolverKind::Mica) {
@@ -129,11 +129,23 @@ void World::add_damping(Body& b, double h) const {
   if (b.matrix_rebuilt) add_scaled_mass(b.fem, h * b.settings.rayleigh_alpha, b.A);
 }
 
-void World::build_projection(Body& b) const {
+void World::build_projection(Body& b, double h) const {
   b.projection.reset(b.fem.node_count());
   lpcs_.for_each([&](Id, const Lpc& c) {
     if (&bodies_.get(c.body, "body") != &b) return;
-    for (int32_t node : c.nodes) b.projection.constrain(node, c.constrained, c.velocity);
+    if (!c.handle) {
+      for (int32_t node : c.nodes) b.projection.constrain(node, c.constrained, c.velocity);
+      return;
+    }
+    // Dragging: each node gets the velocity that brings it to its target in this step.
+    const Handle& hd = *c.handle;
+    const Tool* tool = hd.tool ? tools_.find(hd.tool) : nullptr;
+    const Vec3& p = tool ? tool->position : hd.position;
+    const Eigen::Quaterniond& q = tool ? tool->orientation : hd.orientation;
+    for (size_t k = 0; k < c.nodes.size(); ++k) {
+      const Vec3 target = p + q * hd.offsets[k];
+      b.projection.constrain(c.nodes[k], c.constrained, (target - b.x[c.nodes[k]]) / h);
+    }
   });
 }
 

@@ -96,7 +96,7 @@ Id World::add_lpc(Id body_id, const std::vector<int32_t>& nodes, const LpcSpec& 
       fail(Errc::OutOfRange, b.name + ": node index " + std::to_string(nodes[k]) + " at position " +
                                  std::to_string(k) + " is outside 0.." + std::to_string(b.fem.node_count() - 1));
   require_finite(spec.velocity, "the prescribed velocity");
-  auto lpc = std::make_unique<Lpc>(Lpc{body_id, nodes, constrained_projector(spec), spec.velocity});
+  auto lpc = std::make_unique<Lpc>(Lpc{body_id, nodes, constrained_projector(spec), spec.velocity, nullptr});
   const Id id = lpcs_.insert(std::move(lpc));
   ++b.lpc_version;
   return id;
@@ -118,6 +118,14 @@ Id World::add_tool(const Tool& tool) {
 
 void World::remove_tool(Id id) {
   tool(id);
+  // Grabs that followed this tool stay where the tool left them.
+  lpcs_.for_each([&](Id, Lpc& c) {
+    if (c.handle && c.handle->tool == id) {
+      c.handle->position = tools_.get(id, "tool").position;
+      c.handle->orientation = tools_.get(id, "tool").orientation;
+      c.handle->tool = 0;
+    }
+  });
   tools_.erase(id);
 }
 
@@ -127,6 +135,56 @@ void World::set_tool_pose(Id id, const Vec3& position, const Eigen::Quaterniond&
     fail(Errc::InvalidArgument, "the tool pose must be finite with a non-zero quaternion");
   t.position = position;
   t.orientation = orientation.normalized();
+}
+
+void World::set_lpc_velocity(Id id, const Vec3& velocity) {
+  Lpc& c = lpcs_.get(id, "constraint");
+  require_finite(velocity, "the prescribed velocity");
+  c.velocity = velocity;
+  c.handle.reset();
+}
+
+void World::set_lpc_targets(Id id, const Vec3List& targets) {
+  Lpc& c = lpcs_.get(id, "constraint");
+  if (targets.size() != c.nodes.size())
+    fail(Errc::InvalidArgument, "the constraint holds " + std::to_string(c.nodes.size()) + " nodes, got " +
+                                    std::to_string(targets.size()) + " targets");
+  for (size_t k = 0; k < targets.size(); ++k) require_finite(targets[k], "target " + std::to_string(k));
+  auto handle = std::make_unique<Handle>();
+  handle->offsets = targets;
+  c.handle = std::move(handle);
+}
+
+Id World::grab(Id body_id, const Vec3& center, double radius, Id tool_id) {
+  const Body& b = body(body_id);
+  require_finite(center, "the grab centre");
+  if (!(radius > 0) || !std::isfinite(radius)) fail(Errc::InvalidArgument, "the grab radius must be finite and > 0 m");
+  if (tool_id) tool(tool_id);  // throws for a stale tool id
+  std::vector<int32_t> nodes;
+  for (int32_t i = 0; i < b.fem.node_count(); ++i)
+    if ((b.x[i] - center).norm() <= radius) nodes.push_back(i);
+  if (nodes.empty())
+    fail(Errc::InvalidArgument, b.name + ": no node within " + std::to_string(radius) + " m of the grab centre");
+  auto handle = std::make_unique<Handle>();
+  handle->tool = tool_id;
+  // The handle starts at the tool's pose (or the centre) and carries the nodes where they are.
+  handle->position = tool_id ? tool(tool_id).position : center;
+  handle->orientation = tool_id ? tool(tool_id).orientation : Eigen::Quaterniond::Identity();
+  for (int32_t i : nodes) handle->offsets.push_back(handle->orientation.inverse() * (b.x[i] - handle->position));
+  const Id id = add_lpc(body_id, nodes, LpcSpec{});
+  lpcs_.get(id, "constraint").handle = std::move(handle);
+  return id;
+}
+
+void World::set_handle_pose(Id id, const Vec3& position, const Eigen::Quaterniond& orientation) {
+  Lpc& c = lpcs_.get(id, "constraint");
+  if (!c.handle) fail(Errc::WrongState, "the constraint has no handle: create it with a grab or set its targets");
+  if (c.handle->tool) fail(Errc::WrongState, "the handle follows a tool: move the tool instead");
+  require_finite(position, "the handle position");
+  if (!orientation.coeffs().allFinite() || !(orientation.norm() > 1e-12))
+    fail(Errc::InvalidArgument, "the handle orientation must be a finite non-zero quaternion");
+  c.handle->position = position;
+  c.handle->orientation = orientation.normalized();
 }
 
 void World::remove_lpc(Id id) {

@@ -43,11 +43,21 @@ struct LpcSpec {
 // The constrained directions (I - S) of a constraint kind; throws on a zero or parallel direction.
 Mat3 constrained_projector(const LpcSpec& spec);
 
+// A handle that carries target positions: node i follows position + orientation * offset_i.
+// Following a tool, the handle takes the tool's pose every step (picking with forceps).
+struct Handle {
+  Vec3List offsets;  // m, in the handle frame
+  Vec3 position = Vec3::Zero();
+  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();
+  Id tool = 0;       // 0: the host moves the handle
+};
+
 struct Lpc {
   Id body;
   std::vector<int32_t> nodes;
   Mat3 constrained;  // I - S
-  Vec3 velocity;
+  Vec3 velocity;     // prescribed when there is no handle
+  std::unique_ptr<Handle> handle;  // targets: z_i = C (target_i - x_i) / h each step
   Vec3 reaction = Vec3::Zero();  // N: the force on whoever holds the constraint (the user), last step
 };
 
@@ -74,6 +84,13 @@ class World {
   Id add_lpc(Id body, const std::vector<int32_t>& nodes, const LpcSpec& spec);
   void remove_lpc(Id id);
   const Lpc& lpc(Id id) const { return lpcs_.get(id, "constraint"); }
+  void set_lpc_velocity(Id id, const Vec3& velocity);
+  // Per-node target positions (m) the constrained nodes reach in one step; count = node count.
+  void set_lpc_targets(Id id, const Vec3List& targets);
+  // Picking: holds the nodes of `body` within `radius` of `center` (current positions) on a
+  // handle at `center`, following `tool` if it is not 0. Throws if no node is in reach.
+  Id grab(Id body, const Vec3& center, double radius, Id tool);
+  void set_handle_pose(Id lpc, const Vec3& position, const Eigen::Quaterniond& orientation);
 
   Id add_tool(const Tool& tool);
   void remove_tool(Id id);
@@ -103,7 +120,7 @@ class World {
   void apply_loads(Body& b) const;
   void assemble_elements(Body& b, double h, bool damping) const;
   void add_damping(Body& b, double h) const;
-  void build_projection(Body& b) const;
+  void build_projection(Body& b, double h) const;
   void form_rhs(Body& b, double h) const;
   void solve_velocities(Body& b, double h);
   void advance(double h);
