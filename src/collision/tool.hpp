@@ -17,6 +17,7 @@ struct Tool {
   Vec3 position = Vec3::Zero();  // m, the tool origin (sphere centre, a point of the plane)
   Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();
   double margin = 0.0;           // m, contacts are made for gaps below this
+  double friction = 0.0;         // Coulomb coefficient between the tool and tissue
 
   // Results of the last step: the force and torque (about `position`) the bodies put on the tool.
   Vec3 force = Vec3::Zero();     // N
