@@ -1,11 +1,22 @@
 #!/usr/bin/env bash
-# The main demo: install what is missing, build, run the scene, draw its pictures.
+# The main demo: install what is missing, build, run the scenes, draw their pictures.
 # Output (CSV, PNG, VTK frames for ParaView) goes to ./out/demo.
+#   1. sphere_indent: a sphere presses into a soft cube fixed at its base, holds, and lets go
+#      (MICA solver, tool contact); the force the tissue puts on the sphere over time and
+#      against depth.
+#   2. cantilever_sag: a block clamped at one end sags under its own weight.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 out="$root/out/demo"
 bash "$root/scripts/build.sh"
 mkdir -p "$out"
+
+"$root/build/examples_c/sphere_indent" "$out" 300
+/usr/bin/python3 "$root/scripts/plot_sphere_indent.py" "$out/sphere_indent.csv" "$out/sphere_indent.png"
+
 "$root/build/examples_c/cantilever_sag" "$out" 300
 /usr/bin/python3 "$root/scripts/plot_cantilever.py" "$out/cantilever.csv" "$out/cantilever.png"
-echo "demo: pictures in $out (cantilever.png; cantilever_*.vtk open in ParaView)"
+
+echo "demo: pictures in $out"
+echo "  sphere_indent.png  (tool force over time and against depth; sphere_indent_*.vtk open in ParaView)"
+echo "  cantilever.png     (tip deflection against Euler-Bernoulli; cantilever_*.vtk open in ParaView)"

@@ -18,8 +18,9 @@
 namespace mica {
 
 struct MicaSettings {
-  // Stop when the change of v between iterations is below tolerance * max(|v|, |Dt^-1 b|) and
-  // the change of lambda below tolerance * max(|lambda|, the first anticipated impulse).
+  // Stop when the change of v between iterations is below tolerance * max(|v|, |Dt^-1 b|, 1 um/s
+  // RMS per node) and the change of lambda below tolerance * max(|lambda|, the first anticipated
+  // impulse).
   double tolerance = 1e-8;
   int32_t max_iterations = 200;
   int32_t pgs_sweeps = 1;           // PGS sweeps over the contact rows per iteration
