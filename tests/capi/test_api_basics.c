@@ -91,32 +91,20 @@ static int32_t node_count(const mica_world* w, mica_body_id b) {
 }
 
 /* Newly allocated copies of the body's arrays (3 doubles per node). */
-static double* positions(const mica_world* w, mica_body_id b) {
+typedef mica_status (*node_getter)(const mica_world*, mica_body_id, double*, int32_t, int32_t*);
+static double* node_array(node_getter get, const mica_world* w, mica_body_id b) {
   const int32_t n = node_count(w, b);
   double* x = malloc(sizeof(double) * 3 * (size_t)n);
-  if (mica_body_get_positions(w, b, x, n, NULL) != MICA_OK) {
+  if (get(w, b, x, n, NULL) != MICA_OK) {
     free(x);
     return NULL;
   }
   return x;
 }
-static double* velocities(const mica_world* w, mica_body_id b) {
-  const int32_t n = node_count(w, b);
-  double* v = malloc(sizeof(double) * 3 * (size_t)n);
-  if (mica_body_get_velocities(w, b, v, n, NULL) != MICA_OK) {
-    free(v);
-    return NULL;
-  }
-  return v;
-}
+static double* positions(const mica_world* w, mica_body_id b) { return node_array(mica_body_get_positions, w, b); }
+static double* velocities(const mica_world* w, mica_body_id b) { return node_array(mica_body_get_velocities, w, b); }
 static double* rest_positions(const mica_world* w, mica_body_id b) {
-  const int32_t n = node_count(w, b);
-  double* x = malloc(sizeof(double) * 3 * (size_t)n);
-  if (mica_body_get_rest_positions(w, b, x, n, NULL) != MICA_OK) {
-    free(x);
-    return NULL;
-  }
-  return x;
+  return node_array(mica_body_get_rest_positions, w, b);
 }
 
 /* The nodes on the plane through `point` with outward normal `normal` (rest positions):
