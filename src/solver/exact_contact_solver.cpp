@@ -4,38 +4,10 @@
 #include <cmath>
 
 #include "core/error.hpp"
+#include "solver/lcp.hpp"
 
 namespace mica {
 
-namespace {
-
-// Box-constrained projected Gauss-Seidel on the exact W, to round-off: normal rows
-// lambda >= 0, friction rows |lambda| <= mu lambda_normal. W is symmetric positive semidefinite.
-int32_t solve_complementarity(const Eigen::MatrixXd& W, const Eigen::VectorXd& q, const ContactRows& rows,
-                              Eigen::VectorXd& l) {
-  const Eigen::Index n = q.size();
-  l.setZero(n);
-  int32_t sweeps = 0;
-  for (; sweeps < 1000000; ++sweeps) {
-    double change = 0;
-    for (Eigen::Index r = 0; r < n; ++r) {
-      if (!(W(r, r) > 0)) continue;
-      double next = l[r] - (W.row(r).dot(l) + q[r]) / W(r, r);
-      if (rows.normal_of[r] < 0) {
-        next = std::max(0.0, next);
-      } else {
-        const double bound = rows.mu[r] * l[rows.normal_of[r]];
-        next = std::clamp(next, -bound, bound);
-      }
-      change = std::max(change, std::fabs(next - l[r]));
-      l[r] = next;
-    }
-    if (change <= 1e-15 * std::max(1e-300, l.cwiseAbs().maxCoeff())) break;
-  }
-  return sweeps + 1;
-}
-
-}  // namespace
 
 SolveReport solve_exact_contact(std::vector<ExactBody>& bodies, const ContactRows& rows, std::vector<double>& lambda) {
   const size_t nb = bodies.size(), nr = rows.size();
@@ -71,10 +43,17 @@ SolveReport solve_exact_contact(std::vector<ExactBody>& bodies, const ContactRow
           W(r, s) += term.coef * rows.direction[r].dot(response[s][term.body][term.node]);
     }
   }
-  Eigen::VectorXd l;
+  // Without friction the LCP is solved exactly by Lemke's pivoting; friction's box bounds by
+  // projected Gauss-Seidel on the exact W, to round-off.
+  const bool friction = std::any_of(rows.normal_of.begin(), rows.normal_of.end(), [](int32_t n) { return n >= 0; });
+  const Eigen::VectorXd mu = Eigen::Map<const Eigen::VectorXd>(rows.mu.data(), Eigen::Index(nr));
+  const LcpSolution sol = friction ? solve_box_lcp_pgs(W, q, mu, rows.normal_of, 1e-14, 1000000)
+                                   : solve_lcp_lemke(W, q);
+  if (!sol.solved || !sol.z.allFinite())
+    fail(Errc::Numerical, "the exact contact solve failed: " + sol.message);
+  const Eigen::VectorXd& l = sol.z;
   SolveReport report;
-  report.iterations = solve_complementarity(W, q, rows, l);
-  if (!l.allFinite()) fail(Errc::Numerical, "the exact contact solve produced non-finite impulses");
+  report.iterations = sol.pivots;
   lambda.assign(l.data(), l.data() + l.size());
   // v = v_free + A^-1 G^T lambda, and the impulses per node.
   for (size_t bi = 0; bi < nb; ++bi) bodies[bi].contact_impulse.assign(bodies[bi].v->size(), Vec3::Zero());
@@ -85,12 +64,7 @@ SolveReport solve_exact_contact(std::vector<ExactBody>& bodies, const ContactRow
     for (int32_t t = rows.start[s]; t < rows.start[s + 1]; ++t)
       bodies[rows.terms[t].body].contact_impulse[rows.terms[t].node] += rows.terms[t].coef * l[s] * rows.direction[s];
   }
-  // Complementarity of the result, reported as the residual.
-  const Eigen::VectorXd w = W * l + q;
-  double worst = 0;
-  for (size_t r = 0; r < nr; ++r)
-    if (rows.normal_of[r] < 0) worst = std::max({worst, -w[r], std::fabs(w[r] * l[r])});
-  report.residual = worst;
+  report.residual = friction ? box_lcp_error(W, q, mu, rows.normal_of, l) : complementarity_error(W, q, l);
   report.converged = true;
   return report;
 }

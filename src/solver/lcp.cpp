@@ -3,6 +3,7 @@
 #include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 
 #include "core/error.hpp"
@@ -117,12 +118,18 @@ class LemkeTableau {
 
 double infinity_norm(const Eigen::VectorXd& v) { return v.size() ? v.cwiseAbs().maxCoeff() : 0.0; }
 
-// Scale of the complementarity error of a computed z: round-off in w is ~eps times
-// max(|q|, |M| |z|), and in z w that much times |z|.
-double error_scale(const Eigen::MatrixXd& M, const Eigen::VectorXd& q, const Eigen::VectorXd& z) {
+// Complementarity row by row, each term against the size of what it is computed from:
+// z against max(1, |z|), w against max(1, |q|, |M| |z|), z w against both; round-off makes
+// it a few eps.
+double relative_complementarity_error(const Eigen::MatrixXd& M, const Eigen::VectorXd& q, const Eigen::VectorXd& z) {
   const double m = M.size() ? M.cwiseAbs().rowwise().sum().maxCoeff() : 0.0;
-  const double zn = infinity_norm(z);
-  return std::max({1.0, infinity_norm(q), m * zn}) * std::max(1.0, zn);
+  const double z_scale = std::max(1.0, infinity_norm(z));
+  const double w_scale = std::max({1.0, infinity_norm(q), m * infinity_norm(z)});
+  const Eigen::VectorXd w = M * z + q;
+  double error = 0.0;
+  for (Eigen::Index r = 0; r < z.size(); ++r)
+    error = std::max({error, -z(r) / z_scale, -w(r) / w_scale, std::fabs(z(r) * w(r)) / (z_scale * w_scale)});
+  return error;
 }
 
 // With the final complementary basis, w_i = 0 wherever z_i is basic, so z on that set solves
@@ -145,6 +152,13 @@ Eigen::VectorXd polish(const Eigen::MatrixXd& M, const Eigen::VectorXd& q, const
   Eigen::VectorXd polished = Eigen::VectorXd::Zero(z.size());
   for (Eigen::Index a = 0; a < k; ++a) polished(basic_z[size_t(a)]) = std::max(0.0, sub(a));
   return complementarity_error(M, q, polished) <= complementarity_error(M, q, z) ? polished : z;
+}
+
+std::string sweep_message(bool solved, int32_t sweeps, const char* what, double error) {
+  char text[160];
+  std::snprintf(text, sizeof text, "%s after %d sweeps, %s %.3g", solved ? "converged" : "sweep limit reached",
+                int(sweeps), what, error);
+  return text;
 }
 
 }  // namespace
@@ -216,11 +230,13 @@ LcpSolution solve_lcp_lemke(const Eigen::MatrixXd& M, const Eigen::VectorXd& q, 
   s.w = M * s.z + q;
 
   // A sanity bound far above round-off: only a numerically broken pivot sequence fails it.
-  const double error = complementarity_error(M, q, s.z);
-  if (!(error <= 1e-8 * error_scale(M, q, s.z))) {
+  const double error = relative_complementarity_error(M, q, s.z);
+  if (!(error <= 1e-8)) {
     s.solved = false;
-    s.message = "numerical breakdown: complementarity error " + std::to_string(error) + " after " +
-                std::to_string(s.pivots) + " pivots";
+    char text[160];
+    std::snprintf(text, sizeof text, "numerical breakdown: relative complementarity error %.3g after %d pivots", error,
+                  int(s.pivots));
+    s.message = text;
     return s;
   }
   s.message = "solved by Lemke's method in " + std::to_string(s.pivots) + " pivots";
@@ -248,8 +264,7 @@ LcpSolution solve_lcp_pgs(const Eigen::MatrixXd& M, const Eigen::VectorXd& q, do
   }
   s.w = M * s.z + q;
   s.solved = error <= tol;
-  s.message = (s.solved ? "converged" : "sweep limit reached") + std::string(" after ") + std::to_string(s.pivots) +
-              " sweeps, complementarity error " + std::to_string(error);
+  s.message = sweep_message(s.solved, s.pivots, "complementarity error", error);
   return s;
 }
 
@@ -321,8 +336,7 @@ LcpSolution solve_box_lcp_pgs(const Eigen::MatrixXd& M, const Eigen::VectorXd& q
   }
   s.w = M * s.z + q;
   s.solved = error <= tol;
-  s.message = (s.solved ? "converged" : "sweep limit reached") + std::string(" after ") + std::to_string(s.pivots) +
-              " sweeps, box complementarity error " + std::to_string(error);
+  s.message = sweep_message(s.solved, s.pivots, "box complementarity error", error);
   return s;
 }
 
