@@ -1,20 +1,89 @@
 #include "collision/contact.hpp"
 
+#include "collision/closest_point.hpp"
+#include "collision/triangle_contact.hpp"
+
 namespace mica {
 
-void collide_nodes(const Tool& tool, int32_t tool_index, uint64_t tool_key, int32_t body_index, uint64_t body_key,
-                   const Vec3List& x, const std::vector<int32_t>& nodes, std::vector<Contact>& out) {
-  for (int32_t node : nodes) {
+namespace {
+
+// Feature numbers in contact keys: nodes as they are, triangles above 2^40.
+constexpr uint64_t kTriangleFeature = uint64_t(1) << 40;
+// A triangle point this close to an edge is left to the node contacts.
+constexpr double kInteriorWeight = 1e-3;
+
+BodyPoint triangle_point(int32_t body, const Tri& t, const Vec3& w) {
+  BodyPoint p;
+  p.body = body;
+  p.count = 3;
+  for (int k = 0; k < 3; ++k) {
+    p.nodes[k] = t[k];
+    p.weights[k] = w[k];
+  }
+  return p;
+}
+
+Vec3 tool_point_velocity(const Tool& tool, const Vec3& p) {
+  return tool.velocity + tool.angular_velocity.cross(p - tool.position);
+}
+
+}  // namespace
+
+void collide_tool(const Tool& tool, int32_t tool_index, uint64_t tool_key, const SurfaceView& body,
+                  std::vector<Contact>& out) {
+  const Aabb reach = tool_bounds(tool, tool.margin);
+  const Vec3List& x = *body.x;
+  for (int32_t node : *body.nodes) {
+    if (!reach.contains(x[node])) continue;
     const SurfacePoint s = closest_surface_point(tool, x[node]);
     if (s.distance >= tool.margin) continue;
-    Contact c;
-    c.key = contact_key(tool_key, body_key, uint64_t(node));
-    c.tool = tool_index;
-    c.a = node_point(body_index, node);
-    c.normal = s.normal;
-    c.point = x[node];
-    c.gap = s.distance;
-    c.friction = tool.friction;
+    out.push_back(Contact{contact_key(tool_key, body.key, uint64_t(node)), tool_index, node_point(body.index, node),
+                          BodyPoint{}, s.normal, x[node], s.distance, tool.friction, tool_point_velocity(tool, x[node])});
+  }
+  body.bvh->query(reach, [&](int32_t tri) {
+    const Tri& t = (*body.triangles)[tri];
+    TriangleHit hit;
+    if (!collide_triangle(tool, x[t[0]], x[t[1]], x[t[2]], tool.margin, hit)) return;
+    if (hit.weights.minCoeff() <= kInteriorWeight) return;
+    out.push_back(Contact{contact_key(tool_key, body.key, kTriangleFeature + uint64_t(tri)), tool_index,
+                          triangle_point(body.index, t, hit.weights), BodyPoint{}, hit.normal, hit.point, hit.gap,
+                          tool.friction, tool_point_velocity(tool, hit.point)});
+  });
+}
+
+void collide_bodies(const SurfaceView& a, const SurfaceView& b, double margin, double friction,
+                    std::vector<Contact>& out) {
+  const Vec3List& xa = *a.x;
+  const Vec3List& xb = *b.x;
+  const double reach = std::max(margin, b.depth);
+  for (int32_t node : *a.nodes) {
+    const Vec3& p = xa[node];
+    // The nearest triangle of b within reach, and which side of it p is on.
+    double best = HUGE_VAL;
+    int32_t best_tri = -1;
+    TrianglePoint best_point{};
+    b.bvh->query(Aabb{p, p}.inflated(reach), [&](int32_t tri) {
+      const Tri& t = (*b.triangles)[tri];
+      const TrianglePoint q = closest_on_triangle(p, xb[t[0]], xb[t[1]], xb[t[2]]);
+      const double d = (p - q.point).norm();
+      if (d < best) {
+        best = d;
+        best_tri = tri;
+        best_point = q;
+      }
+    });
+    if (best_tri < 0 || best > reach) continue;
+    const Tri& t = (*b.triangles)[best_tri];
+    const Vec3 face = (xb[t[1]] - xb[t[0]]).cross(xb[t[2]] - xb[t[0]]).normalized();  // outward
+    const Vec3 d = p - best_point.point;
+    const bool inside = d.dot(face) < 0;
+    const double gap = inside ? -best : best;
+    if (gap >= margin) continue;
+    // The normal separates a's node from b: along d outside, against it inside.
+    const Vec3 normal = best > 1e-12 ? Vec3((inside ? -d : d) / best) : face;
+    Contact c{contact_key(a.key, b.key, uint64_t(node)), -1, node_point(a.index, node), BodyPoint{}, normal, p, gap,
+              friction, Vec3::Zero()};
+    if (b.index >= 0) c.b = triangle_point(b.index, t, best_point.weights);  // a static b is an obstacle
     out.push_back(c);
   }
 }

@@ -4,6 +4,7 @@
 #include <array>
 #include <vector>
 
+#include "collision/bvh.hpp"
 #include "collision/tool.hpp"
 
 namespace mica {
@@ -25,6 +26,7 @@ struct Contact {
   Vec3 point;        // m, the contact point when detected
   double gap;        // m, signed distance at the start of the step (negative: penetrating)
   double friction;   // Coulomb coefficient, 0 for none
+  Vec3 other_velocity = Vec3::Zero();  // m/s: a tool's velocity at the point (friction sticks to it)
 };
 
 inline BodyPoint node_point(int32_t body, int32_t node) {
@@ -41,8 +43,26 @@ inline uint64_t contact_key(uint64_t a, uint64_t b, uint64_t feature) {
   return (a * 0x9E3779B97F4A7C15ull) ^ (b * 0xC2B2AE3D27D4EB4Full) ^ (feature * 0x165667B19E3779F9ull);
 }
 
-// Appends a contact for each listed node closer to the tool than its margin.
-void collide_nodes(const Tool& tool, int32_t tool_index, uint64_t tool_key, int32_t body_index, uint64_t body_key,
-                   const Vec3List& x, const std::vector<int32_t>& nodes, std::vector<Contact>& out);
+// The surface of a body as collision sees it.
+struct SurfaceView {
+  int32_t index;                    // in the step's dynamic-body list, -1 for a static body
+  uint64_t key;                     // the body's id
+  const Vec3List* x;
+  const std::vector<Tri>* triangles;
+  const std::vector<int32_t>* nodes;  // surface nodes
+  const TriangleBvh* bvh;
+  double depth;                     // m, the deepest penetration looked for
+};
+
+// Tool against a body: a contact for each surface node closer to the tool than its margin,
+// and one for each triangle whose closest point to the tool lies inside the face (there the
+// nodes alone would let the tool slip between them).
+void collide_tool(const Tool& tool, int32_t tool_index, uint64_t tool_key, const SurfaceView& body,
+                  std::vector<Contact>& out);
+
+// Surface nodes of body a against the surface triangles of body b (b may be static: an
+// obstacle). Call it for (a, b) and (b, a).
+void collide_bodies(const SurfaceView& a, const SurfaceView& b, double margin, double friction,
+                    std::vector<Contact>& out);
 
 }  // namespace mica

@@ -1,5 +1,9 @@
 // Kinematic rigid tools: the host sets their pose every step; bodies cannot push them.
 #pragma once
+#include <memory>
+
+#include "collision/aabb.hpp"
+#include "collision/convex_hull.hpp"
 #include "core/types.hpp"
 
 namespace mica {
@@ -19,17 +23,37 @@ struct Tool {
   double margin = 0.0;           // m, contacts are made for gaps below this
   double friction = 0.0;         // Coulomb coefficient between the tool and tissue
 
+  // Derived from hull_points by prepare_tool_shape (null for other shapes); shared by copies.
+  std::shared_ptr<const HullData> hull;
+
+  // The pose at the start of the step, and the velocities the step's pose change implies.
+  Vec3 previous_position = Vec3::Zero();
+  Eigen::Quaterniond previous_orientation = Eigen::Quaterniond::Identity();
+  Vec3 velocity = Vec3::Zero();          // m/s
+  Vec3 angular_velocity = Vec3::Zero();  // rad/s
+
   // Results of the last step: the force and torque (about `position`) the bodies put on the tool.
   Vec3 force = Vec3::Zero();     // N
   Vec3 torque = Vec3::Zero();    // N m
   int32_t contact_count = 0;
 };
 
+// Checks the parameters the shape uses (finite; radius, half_length, half_extents > 0; a plane
+// normal that is not zero; 4..kMaxHullPoints hull points that are not coplanar) and throws
+// Error(InvalidArgument) naming the field; normalises plane_normal and builds the hull data.
+// Call it again after changing any shape field.
+void prepare_tool_shape(Tool& tool);
+
 // Signed distance of p to the tool surface (negative inside) and the outward unit normal there.
+// A ConvexHull tool must have been through prepare_tool_shape (WrongState otherwise).
 struct SurfacePoint {
   double distance;
   Vec3 normal;
 };
 SurfacePoint closest_surface_point(const Tool& tool, const Vec3& p);
+
+// World-space bounds of the tool inflated by margin; a Plane gets a huge box (+-kPlaneBound).
+constexpr double kPlaneBound = 1e30;  // m
+Aabb tool_bounds(const Tool& tool, double margin);
 
 }  // namespace mica

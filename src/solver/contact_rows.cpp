@@ -36,8 +36,9 @@ void ContactRows::build(const std::vector<Contact>& contacts, double h, double m
     if (ct.friction <= 0) continue;
     // Any orthonormal tangent pair: the box bounds make friction isotropic enough for PGS.
     const Vec3 t1 = ct.normal.unitOrthogonal(), t2 = ct.normal.cross(t1);
-    add_row(c, t1, 0.0, normal_row, ct.friction, 1);
-    add_row(c, t2, 0.0, normal_row, ct.friction, 2);
+    // Sticking moves the body point with the tool: t . v = t . v_tool.
+    add_row(c, t1, -t1.dot(ct.other_velocity), normal_row, ct.friction, 1);
+    add_row(c, t2, -t2.dot(ct.other_velocity), normal_row, ct.friction, 2);
   }
 }
 

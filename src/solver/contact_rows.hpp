@@ -17,7 +17,7 @@ struct ContactRows {
   std::vector<int32_t> start;     // rows + 1 offsets into terms
   std::vector<RowTerm> terms;
   std::vector<Vec3> direction;    // n for a normal row, a unit tangent for a friction row
-  std::vector<double> bias;       // gap / h (clamped) for normal rows, 0 for friction rows
+  std::vector<double> bias;       // gap / h (clamped) for normal rows; -t . v_tool for friction rows
   std::vector<int32_t> normal_of; // -1 for a normal row; the normal row of a friction row
   std::vector<double> mu;         // friction coefficient of a friction row
   std::vector<int32_t> contact;   // the contact each row belongs to

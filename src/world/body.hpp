@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "collision/bvh.hpp"
 #include "fem/fem_model.hpp"
 #include "solver/direct_solver.hpp"
 #include "solver/pcg.hpp"
@@ -29,6 +30,8 @@ struct Body {
   std::vector<Tet> tets;
   std::vector<Tri> surface;
   std::vector<int32_t> surface_node_list;  // candidates for contact
+  TriangleBvh bvh;                         // over the surface triangles, refit every step
+  double surface_edge = 0;                 // m, mean surface edge length: the deepest penetration looked for
 
   // State.
   Vec3List x, v;

@@ -20,6 +20,10 @@ Plan World::plan() const {
   });
   lpcs_.for_each([&](Id, const Lpc& c) { p.constraints = p.constraints || bodies_.get(c.body, "body").is_dynamic(); });
   tools_.for_each([&](Id, const Tool&) { p.collide = p.solve; });
+  // Two bodies (at least one dynamic) may touch.
+  int32_t bodies = 0;
+  bodies_.for_each([&](Id, const Body&) { ++bodies; });
+  if (settings_.body_contact && bodies > 1) p.collide = p.collide || p.solve;
   if (all) {
     p.constraints = p.constraints || p.solve;
     p.collide = p.collide || p.solve;
@@ -58,7 +62,7 @@ void World::advance(double h) {
   stats_.converged = true;
 
   StageRunner stage(stats_);
-  stage.run(Stage::Collide, plan.collide, [&] { collide(dynamic); });
+  stage.run(Stage::Collide, plan.collide, [&] { collide(dynamic, h); });
   if (!plan.collide) contacts_.clear();
   rows_.clear();
   lambda_.clear();
@@ -156,18 +160,37 @@ void World::form_rhs(Body& b, double h) const {
   for (size_t i = 0; i < b.b.size(); ++i) b.b[i] += h * (loads ? b.f_int[i] + b.f_ext[i] : b.f_int[i]);
 }
 
-void World::collide(const std::vector<Body*>& dynamic) {
+void World::collide(const std::vector<Body*>& dynamic, double h) {
   contacts_.clear();
   step_tools_.clear();
-  tools_.for_each([&](Id tool_id, Tool& t) {
-    const int32_t ti = int32_t(step_tools_.size());
-    step_tools_.push_back(&t);
-    bodies_.for_each([&](Id body_id, const Body& b) {
-      const auto it = std::find(dynamic.begin(), dynamic.end(), &b);
-      if (it == dynamic.end()) return;
-      collide_nodes(t, ti, tool_id, int32_t(it - dynamic.begin()), body_id, b.x, b.surface_node_list, contacts_);
-    });
+  // Tool velocities from the pose change the host made since the last step.
+  tools_.for_each([&](Id, Tool& t) {
+    t.velocity = (t.position - t.previous_position) / h;
+    const Eigen::AngleAxisd turn(t.orientation * t.previous_orientation.inverse());
+    t.angular_velocity = turn.axis() * (turn.angle() > M_PI ? turn.angle() - 2 * M_PI : turn.angle()) / h;
   });
+  // Every body's surface as collision sees it; dynamic bodies' trees follow their nodes.
+  views_.clear();
+  bodies_.for_each([&](Id id, Body& b) {
+    const auto it = std::find(dynamic.begin(), dynamic.end(), &b);
+    const int32_t index = it == dynamic.end() ? -1 : int32_t(it - dynamic.begin());
+    if (index >= 0) b.bvh.refit(b.x);
+    views_.push_back(SurfaceView{index, id, &b.x, &b.surface, &b.surface_node_list, &b.bvh, b.surface_edge});
+  });
+  tools_.for_each([&](Id tool_id, Tool& t) {
+    step_tools_.push_back(&t);
+    for (const SurfaceView& v : views_)
+      if (v.index >= 0) collide_tool(t, int32_t(step_tools_.size() - 1), tool_id, v, contacts_);
+  });
+  if (!settings_.body_contact) return;
+  for (const SurfaceView& a : views_)
+    for (const SurfaceView& b : views_)
+      if (a.index >= 0 && &a != &b && (b.index < 0 || bounds_overlap(a, b)))
+        collide_bodies(a, b, settings_.body_margin, settings_.body_friction, contacts_);
+}
+
+bool World::bounds_overlap(const SurfaceView& a, const SurfaceView& b) const {
+  return a.bvh->bounds().inflated(settings_.body_margin + b.depth).overlaps(b.bvh->bounds());
 }
 
 void World::solve_mica(const std::vector<Body*>& dynamic, double h) {
@@ -289,6 +312,10 @@ void World::commit(const std::vector<Body*>& dynamic) {
   }
   warm_start_.clear();
   for (size_t r = 0; r < rows_.size(); ++r) warm_start_[rows_.key[r]] = lambda_[r];
+  tools_.for_each([&](Id, Tool& t) {
+    t.previous_position = t.position;
+    t.previous_orientation = t.orientation;
+  });
 }
 
 }  // namespace mica

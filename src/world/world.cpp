@@ -15,6 +15,10 @@ World::World(const WorldSettings& settings) : settings_(settings) {
   if (!(settings.tolerance > 0) || !std::isfinite(settings.tolerance))
     fail(Errc::InvalidArgument, "tolerance must be finite and > 0");
   if (settings.max_iterations < 1) fail(Errc::InvalidArgument, "max_iterations must be >= 1");
+  if (!(settings.body_margin >= 0) || !std::isfinite(settings.body_margin))
+    fail(Errc::InvalidArgument, "the body contact margin must be finite and >= 0 m");
+  if (!(settings.body_friction >= 0) || !std::isfinite(settings.body_friction))
+    fail(Errc::InvalidArgument, "the body friction coefficient must be finite and >= 0");
 }
 
 void World::set_gravity(const Vec3& g) {
@@ -105,14 +109,13 @@ Id World::add_lpc(Id body_id, const std::vector<int32_t>& nodes, const LpcSpec& 
 Id World::add_tool(const Tool& tool) {
   if (!tool.position.allFinite() || !tool.orientation.coeffs().allFinite() || !(tool.orientation.norm() > 1e-12))
     fail(Errc::InvalidArgument, "the tool pose must be finite with a non-zero quaternion");
-  if (tool.shape == ToolShape::Sphere && !(tool.radius > 0 && std::isfinite(tool.radius)))
-    fail(Errc::InvalidArgument, "the sphere radius must be finite and > 0 m");
-  if (tool.shape == ToolShape::Plane && !(tool.plane_normal.norm() > 1e-12 && tool.plane_normal.allFinite()))
-    fail(Errc::InvalidArgument, "the plane normal must be a finite non-zero vector");
   if (!(tool.margin >= 0 && std::isfinite(tool.margin))) fail(Errc::InvalidArgument, "the contact margin must be finite and >= 0 m");
+  if (!(tool.friction >= 0 && std::isfinite(tool.friction))) fail(Errc::InvalidArgument, "the friction coefficient must be finite and >= 0");
   Tool t = tool;
-  t.plane_normal.normalize();
+  prepare_tool_shape(t);  // validates the shape's own fields and builds a hull's faces
   t.orientation.normalize();
+  t.previous_position = t.position;
+  t.previous_orientation = t.orientation;
   return tools_.insert(std::make_unique<Tool>(t));
 }
 

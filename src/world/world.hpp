@@ -29,6 +29,9 @@ struct WorldSettings {
   int32_t pgs_sweeps = 1;          // MICA: PGS sweeps over the contacts per iteration
   double max_recovery_speed = 1.0; // m/s, clamps gap / h for penetrating contacts
   bool paper_norm = false;         // MICA: stop on the paper's 2-norm of the change
+  bool body_contact = true;        // contact between bodies (and with static bodies)
+  double body_margin = 1e-3;       // m, contacts between bodies are made for gaps below this
+  double body_friction = 0;        // Coulomb coefficient between bodies
   std::function<void(LogLevel, const std::string&)> log;  // optional
 };
 
@@ -112,7 +115,8 @@ class World {
   void for_each_body(F&& f) const { bodies_.for_each(f); }
 
  private:
-  void collide(const std::vector<Body*>& dynamic);
+  void collide(const std::vector<Body*>& dynamic, double h);
+  bool bounds_overlap(const SurfaceView& a, const SurfaceView& b) const;
   void solve_mica(const std::vector<Body*>& dynamic, double h);
   void solve_exact(const std::vector<Body*>& dynamic, double h);
   void factorize(Body& b);
@@ -137,6 +141,7 @@ class World {
   SlotMap<Tool, IdKind::Tool> tools_;
   std::vector<Body*> dynamic_;                      // this step's dynamic bodies
   std::vector<Tool*> step_tools_;
+  std::vector<SurfaceView> views_;
   std::vector<Contact> contacts_;
   ContactRows rows_;                                // this step's rows of G
   std::vector<double> lambda_;                      // impulse per row, N s

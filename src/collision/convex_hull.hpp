@@ -1,0 +1,30 @@
+// The convex hull of a small point set as outward face planes and face polygons, built once per tool.
+#pragma once
+#include <memory>
+#include <string>
+
+#include "core/types.hpp"
+
+namespace mica {
+
+// Faces are found by brute force over point triples (O(n^4)): fine for this many points, refused beyond.
+constexpr size_t kMaxHullPoints = 64;
+
+struct HullFace {
+  Vec3 normal;       // outward, unit
+  double offset;     // normal . x = offset on the face plane
+  Vec3List polygon;  // the face's corners, counter-clockwise seen from outside
+};
+
+struct HullData {
+  std::vector<HullFace> faces;
+  Vec3List vertices;  // the hull's corners (a subset of the input points)
+  Vec3List edge_directions;  // unit, one per set of parallel edges (for separating-axis tests)
+  Vec3 centre;        // the mean of the corners: a point strictly inside
+};
+
+// Throws Error(InvalidArgument), naming `field`, unless there are 4..kMaxHullPoints finite points
+// that are not (nearly) coplanar.
+std::shared_ptr<const HullData> build_convex_hull(const Vec3List& points, const std::string& field);
+
+}  // namespace mica
