@@ -13,6 +13,8 @@ mica_tool_def tool_defaults() {
   d.normal[2] = 1;
   d.orientation[0] = 1;
   d.margin = 0.001;
+  d.half_length = 0.01;
+  d.half_extents[0] = d.half_extents[1] = d.half_extents[2] = 0.01;
   return d;
 }
 
@@ -33,9 +35,21 @@ MICA_API mica_status mica_tool_create(mica_world* world, const mica_tool_def* de
     switch (d.shape) {
       case MICA_TOOL_SPHERE: t.shape = mica::ToolShape::Sphere; break;
       case MICA_TOOL_PLANE: t.shape = mica::ToolShape::Plane; break;
+      case MICA_TOOL_CAPSULE: t.shape = mica::ToolShape::Capsule; break;
+      case MICA_TOOL_BOX: t.shape = mica::ToolShape::Box; break;
+      case MICA_TOOL_HULL: t.shape = mica::ToolShape::ConvexHull; break;
       default: refuse(MICA_ERR_INVALID_ARGUMENT, "def->shape is " + std::to_string(d.shape) + ", not a MICA_TOOL_* value");
     }
     t.radius = d.radius;
+    t.half_length = d.half_length;
+    t.half_extents = vec3(d.half_extents, "def->half_extents");
+    if (t.shape == mica::ToolShape::ConvexHull) {
+      require(d.hull_points, "def->hull_points");
+      if (d.hull_point_count < 4 || d.hull_point_count > 64)
+        refuse(MICA_ERR_INVALID_ARGUMENT, "def->hull_point_count is " + std::to_string(d.hull_point_count) + ", must be 4..64");
+      for (int32_t k = 0; k < d.hull_point_count; ++k)
+        t.hull_points.emplace_back(d.hull_points[3 * k], d.hull_points[3 * k + 1], d.hull_points[3 * k + 2]);
+    }
     t.plane_normal = vec3(d.normal, "def->normal");
     t.position = vec3(d.position, "def->position");
     t.orientation = quaternion(d.orientation, "def->orientation");

@@ -23,6 +23,8 @@ mica_world_def world_defaults() {
   d.tolerance = 1e-8;
   d.pgs_sweeps = 1;
   d.max_recovery_speed = 1.0;
+  d.body_contact = 1;
+  d.body_margin = 0.001;
   return d;
 }
 
@@ -42,6 +44,10 @@ mica::WorldSettings translate(const mica_world_def& d) {
   s.pgs_sweeps = d.pgs_sweeps;
   s.paper_norm = d.paper_norm == 1;
   s.max_recovery_speed = d.max_recovery_speed;
+  if (d.body_contact != 0 && d.body_contact != 1) refuse(MICA_ERR_INVALID_ARGUMENT, "def->body_contact must be 0 or 1");
+  s.body_contact = d.body_contact == 1;
+  s.body_margin = d.body_margin;
+  s.body_friction = d.body_friction;
   s.max_iterations = d.max_iterations;
   s.tolerance = d.tolerance;
   s.plan_all_stages = d.plan_all_stages != 0;

@@ -131,6 +131,10 @@ typedef struct mica_world_def {
   int32_t paper_norm;      /**< MICA: 1 stops on the paper's 2-norm of the change of (v, lambda);
                                 default 0: relative changes of v and of lambda, each below tolerance */
   double max_recovery_speed; /**< m/s: the penetration recovery gap/h is clamped at -this; default 1 */
+  int32_t body_contact;    /**< 1: bodies collide with each other and with static bodies; default 1 */
+  int32_t reserved1;       /**< zero */
+  double body_margin;      /**< m: contacts between bodies are made for gaps below this; default 0.001 */
+  double body_friction;    /**< Coulomb coefficient between bodies, >= 0; default 0 */
 } mica_world_def;
 
 /** Fills `def` with defaults, writing only its first `struct_size` bytes, and records
@@ -341,8 +345,11 @@ MICA_API mica_status mica_lpc_get_reaction(const mica_world* world, mica_lpc_id 
  *  Kinematic rigid tools: the host sets their pose; bodies cannot push them, they feel the
  *  force of the contact.
  *  @{ */
-#define MICA_TOOL_SPHERE 0 /**< a sphere of `radius` around the tool origin */
-#define MICA_TOOL_PLANE 1  /**< a half-space: bodies stay on the side `normal` points to */
+#define MICA_TOOL_SPHERE 0  /**< a sphere of `radius` around the tool origin */
+#define MICA_TOOL_PLANE 1   /**< a half-space: bodies stay on the side `normal` points to */
+#define MICA_TOOL_CAPSULE 2 /**< the segment from -half_length to +half_length along local z, inflated by `radius` */
+#define MICA_TOOL_BOX 3     /**< a box of `half_extents` centred on the tool origin */
+#define MICA_TOOL_HULL 4    /**< the convex hull of `hull_points` (4 to 64 points, tool frame) */
 
 /** A kinematic tool: shape, size, initial pose, contact margin. Fill with mica_tool_def_default(). */
 typedef struct mica_tool_def {
@@ -354,6 +361,11 @@ typedef struct mica_tool_def {
   double orientation[4]; /**< initial unit quaternion (w, x, y, z); default identity */
   double margin;         /**< m: contacts are made for gaps below this; default 0.001 */
   double friction;       /**< Coulomb coefficient between tool and tissue, >= 0; default 0 */
+  double half_length;    /**< m, capsule; default 0.01 */
+  double half_extents[3];/**< m, box; default 0.01 each */
+  const double* hull_points; /**< m, hull: 3 * hull_point_count coordinates in the tool frame (copied) */
+  int32_t hull_point_count;  /**< hull: number of points, 4 to 64 */
+  int32_t reserved0;     /**< zero */
 } mica_tool_def;
 
 /** Fills `def` with defaults, writing only its first `struct_size` bytes. Any thread. */

@@ -29,21 +29,25 @@ Vec3 tool_point_velocity(const Tool& tool, const Vec3& p) {
 
 }  // namespace
 
-void collide_tool(const Tool& tool, int32_t tool_index, uint64_t tool_key, const SurfaceView& body,
+void collide_tool(const Tool& tool, int32_t tool_index, uint64_t tool_key, const SurfaceView& body, double h,
                   std::vector<Contact>& out) {
-  const Aabb reach = tool_bounds(tool, tool.margin);
+  // The tool's own travel: its translation plus its turn at the far end of its bounds.
+  const Aabb bounds = tool_bounds(tool, 0);
+  const double lever = tool.shape == ToolShape::Plane ? 0 : 0.5 * bounds.size().norm();
+  const double margin = tool.margin + body.travel + h * (tool.velocity.norm() + tool.angular_velocity.norm() * lever);
+  const Aabb reach = tool_bounds(tool, margin);
   const Vec3List& x = *body.x;
   for (int32_t node : *body.nodes) {
     if (!reach.contains(x[node])) continue;
     const SurfacePoint s = closest_surface_point(tool, x[node]);
-    if (s.distance >= tool.margin) continue;
+    if (s.distance >= margin) continue;
     out.push_back(Contact{contact_key(tool_key, body.key, uint64_t(node)), tool_index, node_point(body.index, node),
                           BodyPoint{}, s.normal, x[node], s.distance, tool.friction, tool_point_velocity(tool, x[node])});
   }
   body.bvh->query(reach, [&](int32_t tri) {
     const Tri& t = (*body.triangles)[tri];
     TriangleHit hit;
-    if (!collide_triangle(tool, x[t[0]], x[t[1]], x[t[2]], tool.margin, hit)) return;
+    if (!collide_triangle(tool, x[t[0]], x[t[1]], x[t[2]], margin, hit)) return;
     if (hit.weights.minCoeff() <= kInteriorWeight) return;
     out.push_back(Contact{contact_key(tool_key, body.key, kTriangleFeature + uint64_t(tri)), tool_index,
                           triangle_point(body.index, t, hit.weights), BodyPoint{}, hit.normal, hit.point, hit.gap,
@@ -51,10 +55,11 @@ void collide_tool(const Tool& tool, int32_t tool_index, uint64_t tool_key, const
   });
 }
 
-void collide_bodies(const SurfaceView& a, const SurfaceView& b, double margin, double friction,
+void collide_bodies(const SurfaceView& a, const SurfaceView& b, double margin_at_rest, double friction,
                     std::vector<Contact>& out) {
   const Vec3List& xa = *a.x;
   const Vec3List& xb = *b.x;
+  const double margin = margin_at_rest + a.travel + b.travel;
   const double reach = std::max(margin, b.depth);
   for (int32_t node : *a.nodes) {
     const Vec3& p = xa[node];

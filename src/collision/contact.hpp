@@ -52,16 +52,19 @@ struct SurfaceView {
   const std::vector<int32_t>* nodes;  // surface nodes
   const TriangleBvh* bvh;
   double depth;                     // m, the deepest penetration looked for
+  double travel;                    // m, how far a node may move this step (h times the top speed; 0 when static)
 };
 
 // Tool against a body: a contact for each surface node closer to the tool than its margin,
 // and one for each triangle whose closest point to the tool lies inside the face (there the
-// nodes alone would let the tool slip between them).
-void collide_tool(const Tool& tool, int32_t tool_index, uint64_t tool_key, const SurfaceView& body,
+// nodes alone would let the tool slip between them). Speculative: the margin grows by how
+// far the tool and the body can travel in the step (h), so a fast approach is caught before it
+// crosses; the constraint keeps the true gap, so the sides may close it but not cross it.
+void collide_tool(const Tool& tool, int32_t tool_index, uint64_t tool_key, const SurfaceView& body, double h,
                   std::vector<Contact>& out);
 
 // Surface nodes of body a against the surface triangles of body b (b may be static: an
-// obstacle). Call it for (a, b) and (b, a).
+// obstacle). Call it for (a, b) and (b, a). Speculative like collide_tool.
 void collide_bodies(const SurfaceView& a, const SurfaceView& b, double margin, double friction,
                     std::vector<Contact>& out);
 

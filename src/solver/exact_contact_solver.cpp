@@ -43,17 +43,42 @@ SolveReport solve_exact_contact(std::vector<ExactBody>& bodies, const ContactRow
           W(r, s) += term.coef * rows.direction[r].dot(response[s][term.body][term.node]);
     }
   }
+  // Rows whose points cannot move along them (W_rr ~ 0: fixed nodes) carry no impulse: they are
+  // left out, as in MICA, or a penetrating one would make the problem infeasible.
+  const double scale = std::max(W.diagonal().cwiseAbs().maxCoeff(), 1e-300);
+  std::vector<int32_t> kept, kept_at(nr, -1);
+  for (size_t r = 0; r < nr; ++r) {
+    // A friction row goes with its normal row (rows come normal first).
+    const bool normal_kept = rows.normal_of[r] < 0 || kept_at[rows.normal_of[r]] >= 0;
+    if (W(r, r) > 1e-12 * scale && normal_kept) {
+      kept_at[r] = int32_t(kept.size());
+      kept.push_back(int32_t(r));
+    }
+  }
+  const Eigen::Index nk = Eigen::Index(kept.size());
+  Eigen::MatrixXd Wk(nk, nk);
+  Eigen::VectorXd qk(nk), mu(nk);
+  std::vector<int32_t> normal_of(kept.size());
+  bool friction = false;
+  for (Eigen::Index i = 0; i < nk; ++i) {
+    for (Eigen::Index j = 0; j < nk; ++j) Wk(i, j) = W(kept[i], kept[j]);
+    qk[i] = q[kept[i]];
+    mu[i] = rows.mu[kept[i]];
+    const int32_t n = rows.normal_of[kept[i]];
+    normal_of[i] = n < 0 ? -1 : kept_at[n];
+    friction = friction || normal_of[i] >= 0;
+  }
   // Without friction the LCP is solved exactly by Lemke's pivoting; friction's box bounds by
   // projected Gauss-Seidel on the exact W, to round-off.
-  const bool friction = std::any_of(rows.normal_of.begin(), rows.normal_of.end(), [](int32_t n) { return n >= 0; });
-  const Eigen::VectorXd mu = Eigen::Map<const Eigen::VectorXd>(rows.mu.data(), Eigen::Index(nr));
-  const LcpSolution sol = friction ? solve_box_lcp_pgs(W, q, mu, rows.normal_of, 1e-14, 1000000)
-                                   : solve_lcp_lemke(W, q);
+  const LcpSolution sol = friction ? solve_box_lcp_pgs(Wk, qk, mu, normal_of, 1e-14, 1000000) : solve_lcp_lemke(Wk, qk);
   if (!sol.solved || !sol.z.allFinite())
     fail(Errc::Numerical, "the exact contact solve failed: " + sol.message);
-  const Eigen::VectorXd& l = sol.z;
+  Eigen::VectorXd l = Eigen::VectorXd::Zero(Eigen::Index(nr));
+  for (Eigen::Index i = 0; i < nk; ++i) l[kept[i]] = sol.z[i];
   SolveReport report;
   report.iterations = sol.pivots;
+  report.residual = friction ? box_lcp_error(Wk, qk, mu, normal_of, sol.z) : complementarity_error(Wk, qk, sol.z);
+  report.converged = true;
   lambda.assign(l.data(), l.data() + l.size());
   // v = v_free + A^-1 G^T lambda, and the impulses per node.
   for (size_t bi = 0; bi < nb; ++bi) bodies[bi].contact_impulse.assign(bodies[bi].v->size(), Vec3::Zero());
@@ -64,8 +89,6 @@ SolveReport solve_exact_contact(std::vector<ExactBody>& bodies, const ContactRow
     for (int32_t t = rows.start[s]; t < rows.start[s + 1]; ++t)
       bodies[rows.terms[t].body].contact_impulse[rows.terms[t].node] += rows.terms[t].coef * l[s] * rows.direction[s];
   }
-  report.residual = friction ? box_lcp_error(W, q, mu, rows.normal_of, l) : complementarity_error(W, q, l);
-  report.converged = true;
   return report;
 }
 

@@ -174,13 +174,17 @@ void World::collide(const std::vector<Body*>& dynamic, double h) {
   bodies_.for_each([&](Id id, Body& b) {
     const auto it = std::find(dynamic.begin(), dynamic.end(), &b);
     const int32_t index = it == dynamic.end() ? -1 : int32_t(it - dynamic.begin());
-    if (index >= 0) b.bvh.refit(b.x);
-    views_.push_back(SurfaceView{index, id, &b.x, &b.surface, &b.surface_node_list, &b.bvh, b.surface_edge});
+    double speed = 0;
+    if (index >= 0) {
+      b.bvh.refit(b.x);
+      for (int32_t i : b.surface_node_list) speed = std::max(speed, b.v[i].norm());
+    }
+    views_.push_back(SurfaceView{index, id, &b.x, &b.surface, &b.surface_node_list, &b.bvh, b.surface_edge, h * speed});
   });
   tools_.for_each([&](Id tool_id, Tool& t) {
     step_tools_.push_back(&t);
     for (const SurfaceView& v : views_)
-      if (v.index >= 0) collide_tool(t, int32_t(step_tools_.size() - 1), tool_id, v, contacts_);
+      if (v.index >= 0) collide_tool(t, int32_t(step_tools_.size() - 1), tool_id, v, h, contacts_);
   });
   if (!settings_.body_contact) return;
   for (const SurfaceView& a : views_)
@@ -190,7 +194,8 @@ void World::collide(const std::vector<Body*>& dynamic, double h) {
 }
 
 bool World::bounds_overlap(const SurfaceView& a, const SurfaceView& b) const {
-  return a.bvh->bounds().inflated(settings_.body_margin + b.depth).overlaps(b.bvh->bounds());
+  const double reach = std::max(settings_.body_margin + a.travel + b.travel, b.depth);
+  return a.bvh->bounds().inflated(reach).overlaps(b.bvh->bounds());
 }
 
 void World::solve_mica(const std::vector<Body*>& dynamic, double h) {

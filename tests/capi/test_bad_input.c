@@ -1794,7 +1794,7 @@ static void test_tools_bad_input(void** state) {
     d.normal[0] = d.normal[1] = d.normal[2] = 0;
     EXPECT_FAIL(fx, MICA_ERR_INVALID_ARGUMENT, mica_tool_create(w, &d, &out), NULL);
   }
-  const int32_t bad_shape[3] = {2, -1, 42};
+  const int32_t bad_shape[3] = {5, -1, 42};
   for (int i = 0; i < 3; ++i) {
     mica_tool_def d = mica_tool_def_default();
     d.shape = bad_shape[i];
