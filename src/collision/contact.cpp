@@ -44,6 +44,7 @@ void collide_tool(const Tool& tool, int32_t tool_index, uint64_t tool_key, const
     out.push_back(Contact{contact_key(tool_key, body.key, uint64_t(node)), tool_index, node_point(body.index, node),
                           BodyPoint{}, s.normal, x[node], s.distance, tool.friction, tool_point_velocity(tool, x[node])});
   }
+  if (tool.shape == ToolShape::Plane) return;  // a plane's deepest point on a triangle is a node
   body.bvh->query(reach, [&](int32_t tri) {
     const Tri& t = (*body.triangles)[tri];
     TriangleHit hit;
