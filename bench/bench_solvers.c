@@ -79,7 +79,8 @@ int main(int argc, char** argv) {
     double tol;
   } configs[] = {{"exact (DIRECT)", MICA_SOLVER_DIRECT, 0},  {"MICA tol 1e-2", MICA_SOLVER_MICA, 1e-2},
                  {"MICA tol 1e-4", MICA_SOLVER_MICA, 1e-4}, {"MICA tol 1e-6", MICA_SOLVER_MICA, 1e-6},
-                 {"MICA tol 1e-8", MICA_SOLVER_MICA, 1e-8}};
+                 {"MICA tol 1e-8", MICA_SOLVER_MICA, 1e-8}, {"PCG tol 1e-6", MICA_SOLVER_PCG, 1e-6},
+                 {"PCG tol 1e-10", MICA_SOLVER_PCG, 1e-10}};
   const int nconf = (int)(sizeof configs / sizeof configs[0]);
   scene ref;
   if (!make_scene(&ref, MICA_SOLVER_DIRECT, 0, cells)) {

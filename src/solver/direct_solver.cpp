@@ -65,10 +65,13 @@ SolveReport DirectSolver::solve(const ProjectedSystem& sys, const Vec3List& b, V
   return report;
 }
 
-void DirectSolver::solve_homogeneous(const ProjectedSystem& sys, const Vec3List& f, Vec3List& y) {
+SolveReport DirectSolver::solve_homogeneous(const ProjectedSystem& sys, const Vec3List& f, Vec3List& y) {
   rhs_ = f;
   for (int32_t i : sys.projection.nodes) rhs_[i] = sys.projection.S[i] * f[i];
   flat(y) = llt_.solve(flat(rhs_));
+  SolveReport report;
+  report.iterations = 1;
+  return report;
 }
 
 }  // namespace mica

@@ -10,17 +10,16 @@
 
 namespace mica {
 
-class DirectSolver {
+class DirectSolver : public LinearSolver {
  public:
   // Builds the scalar lower-triangular pattern from the block pattern and analyses it.
   void analyze(const BlockPattern& pattern);
   bool analyzed() const { return analyzed_; }
   // Numeric factorization of S A S + I - S. Throws Error(Numerical) if not positive definite.
   void factorize(const ProjectedSystem& sys);
-  // v = y + z with y solving the factored system for the right-hand side of b.
-  SolveReport solve(const ProjectedSystem& sys, const Vec3List& b, Vec3List& v);
-  // y = (S A S + I - S)^-1 S f: the response to a force f with no prescribed velocity.
-  void solve_homogeneous(const ProjectedSystem& sys, const Vec3List& f, Vec3List& y);
+  // Both solves use the last factorization.
+  SolveReport solve(const ProjectedSystem& sys, const Vec3List& b, Vec3List& v) override;
+  SolveReport solve_homogeneous(const ProjectedSystem& sys, const Vec3List& f, Vec3List& y) override;
   int64_t factorizations() const { return factorizations_; }
 
  private:

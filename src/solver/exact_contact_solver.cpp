@@ -9,12 +9,18 @@
 namespace mica {
 
 
-SolveReport solve_exact_contact(std::vector<ExactBody>& bodies, const ContactRows& rows, std::vector<double>& lambda) {
+SolveReport solve_contact_delassus(std::vector<ExactBody>& bodies, const ContactRows& rows, std::vector<double>& lambda) {
   const size_t nb = bodies.size(), nr = rows.size();
+  SolveReport linear;
+  auto record = [&linear](const SolveReport& r) {
+    linear.iterations += r.iterations;
+    if (!(r.residual <= linear.residual)) linear.residual = r.residual;
+    linear.converged = linear.converged && r.converged;
+  };
   // Free velocities: the step without contact.
   for (ExactBody& body : bodies) {
     const ProjectedSystem sys{*body.pattern, *body.A, *body.projection};
-    body.direct->solve(sys, *body.b, *body.v);
+    record(body.solver->solve(sys, *body.b, *body.v));
   }
   // Responses A^-1 G_s^T, per row and per body the row touches.
   std::vector<std::vector<Vec3List>> response(nr, std::vector<Vec3List>(nb));
@@ -28,7 +34,7 @@ SolveReport solve_exact_contact(std::vector<ExactBody>& bodies, const ContactRow
         if (rows.terms[u].body == bi) f[rows.terms[u].node] += rows.terms[u].coef * rows.direction[s];
       response[s][bi].resize(f.size());
       const ProjectedSystem sys{*body.pattern, *body.A, *body.projection};
-      body.direct->solve_homogeneous(sys, f, response[s][bi]);
+      record(body.solver->solve_homogeneous(sys, f, response[s][bi]));
     }
   // W = G A^-1 G^T and q = G v_free + gap / h.
   Eigen::MatrixXd W = Eigen::MatrixXd::Zero(Eigen::Index(nr), Eigen::Index(nr));
@@ -75,10 +81,10 @@ SolveReport solve_exact_contact(std::vector<ExactBody>& bodies, const ContactRow
     fail(Errc::Numerical, "the exact contact solve failed: " + sol.message);
   Eigen::VectorXd l = Eigen::VectorXd::Zero(Eigen::Index(nr));
   for (Eigen::Index i = 0; i < nk; ++i) l[kept[i]] = sol.z[i];
-  SolveReport report;
-  report.iterations = sol.pivots;
-  report.residual = friction ? box_lcp_error(Wk, qk, mu, normal_of, sol.z) : complementarity_error(Wk, qk, sol.z);
-  report.converged = true;
+  SolveReport report = linear;
+  const double complementarity =
+      friction ? box_lcp_error(Wk, qk, mu, normal_of, sol.z) : complementarity_error(Wk, qk, sol.z);
+  if (!(complementarity <= report.residual)) report.residual = complementarity;
   lambda.assign(l.data(), l.data() + l.size());
   // v = v_free + A^-1 G^T lambda, and the impulses per node.
   for (size_t bi = 0; bi < nb; ++bi) bodies[bi].contact_impulse.assign(bodies[bi].v->size(), Vec3::Zero());

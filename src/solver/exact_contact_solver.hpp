@@ -1,6 +1,7 @@
-// The exact reference for contact: each body's projected A factored by CHOLMOD, the Delassus
-// matrix W = G A^-1 G^T formed column by column, and its complementarity problem solved to
-// round-off. Costly (one solve per contact row), exact: what MICA is measured against.
+// Contact through the Delassus matrix: W = G A^-1 G^T formed column by column with each body's
+// linear solver, and its complementarity problem solved to round-off (Lemke; box PGS with
+// friction). With CHOLMOD it is exact, the reference MICA is measured against; with projected
+// PCG it is as exact as the PCG tolerance. Costly: one linear solve per contact row.
 #pragma once
 #include <vector>
 
@@ -14,13 +15,14 @@ struct ExactBody {
   const BlockValues* A;
   const Vec3List* b;
   const Projection* projection;
-  DirectSolver* direct;      // factored for this A and projection
+  LinearSolver* solver;      // ready for this A and projection (a DirectSolver: factored)
   Vec3List* v;               // out
   Vec3List contact_impulse;  // out: G^T lambda per node, N s
 };
 
 // lambda: out, impulse per row (N s). Throws Error(Numerical) if the complementarity problem
-// has no solution the pivoting can find.
-SolveReport solve_exact_contact(std::vector<ExactBody>& bodies, const ContactRows& rows, std::vector<double>& lambda);
+// has no solution the pivoting can find. The report sums the linear solves' iterations and
+// takes the worst of their residuals and the complementarity error.
+SolveReport solve_contact_delassus(std::vector<ExactBody>& bodies, const ContactRows& rows, std::vector<double>& lambda);
 
 }  // namespace mica

@@ -16,31 +16,42 @@ namespace {
 double dot(const Vec3List& a, const Vec3List& b) { return flat(a).dot(flat(b)); }
 }  // namespace
 
-SolveReport solve_pcg(const ProjectedSystem& sys, const Vec3List& b, Vec3List& v, double tolerance,
-                      int32_t max_iterations, PcgWorkspace& ws) {
-  const int32_t n = sys.pattern.rows;
-  const Projection& proj = sys.projection;
-  ws.resize(size_t(n));
-  for (int32_t i = 0; i < n; ++i) ws.inv_diag[i] = sys.diagonal_block(i).inverse();
-
+SolveReport PcgSolver::solve(const ProjectedSystem& sys, const Vec3List& b, Vec3List& v) {
+  ws_.resize(b.size());
+  sys.right_hand_side(b, ws_.rhs, ws_.tmp);
   // Unknown y = S (v - z): start from the warm start's free part.
-  Vec3List& y = v;
-  for (int32_t i : proj.nodes) y[i] = proj.S[i] * y[i];
-  sys.right_hand_side(b, ws.rhs, ws.tmp);
+  for (int32_t i : sys.projection.nodes) v[i] = sys.projection.S[i] * v[i];
+  const SolveReport report = iterate(sys, v);
+  for (int32_t i : sys.projection.nodes) v[i] += sys.projection.z[i];
+  return report;
+}
+
+SolveReport PcgSolver::solve_homogeneous(const ProjectedSystem& sys, const Vec3List& f, Vec3List& y) {
+  ws_.resize(f.size());
+  ws_.rhs = f;
+  for (int32_t i : sys.projection.nodes) ws_.rhs[i] = sys.projection.S[i] * f[i];
+  for (Vec3& yi : y) yi.setZero();
+  return iterate(sys, y);
+}
+
+SolveReport PcgSolver::iterate(const ProjectedSystem& sys, Vec3List& y) {
+  PcgWorkspace& ws = ws_;
+  const int32_t n = sys.pattern.rows;
+  for (int32_t i = 0; i < n; ++i) ws.inv_diag[i] = sys.diagonal_block(i).inverse();
   sys.apply(y, ws.q, ws.tmp);
   for (int32_t i = 0; i < n; ++i) ws.r[i] = ws.rhs[i] - ws.q[i];
 
   SolveReport report;
   const double rhs_norm = std::sqrt(dot(ws.rhs, ws.rhs));
   if (!std::isfinite(rhs_norm)) fail(Errc::Numerical, "the right-hand side is not finite (loads or state overflow)");
-  const double stop = tolerance * rhs_norm;
+  const double stop = tolerance_ * rhs_norm;
   double r_norm = std::sqrt(dot(ws.r, ws.r));
   if (rhs_norm == 0) {
     for (auto& yi : y) yi.setZero();
     r_norm = 0;
   }
   double rz = 0;
-  while (r_norm > stop && report.iterations < max_iterations) {
+  while (r_norm > stop && report.iterations < max_iterations_) {
     for (int32_t i = 0; i < n; ++i) ws.z[i] = ws.inv_diag[i] * ws.r[i];
     const double rz_new = dot(ws.r, ws.z);
     if (report.iterations == 0) {
@@ -61,7 +72,6 @@ SolveReport solve_pcg(const ProjectedSystem& sys, const Vec3List& b, Vec3List& v
     r_norm = std::sqrt(dot(ws.r, ws.r));
     ++report.iterations;
   }
-  for (int32_t i : proj.nodes) v[i] = y[i] + proj.z[i];
   report.residual = rhs_norm > 0 ? r_norm / rhs_norm : 0;
   report.converged = r_norm <= stop;  // false for a NaN residual
   return report;

@@ -28,4 +28,14 @@ struct ProjectedSystem {
   Mat3 block(int32_t i, int32_t k) const;
 };
 
+// A method for the velocity solve of one body's projected system.
+class LinearSolver {
+ public:
+  virtual ~LinearSolver() = default;
+  // v = y + z with (S A S + I - S) y = S (b - A z); v holds a warm start on entry.
+  virtual SolveReport solve(const ProjectedSystem& sys, const Vec3List& b, Vec3List& v) = 0;
+  // y = (S A S + I - S)^-1 S f: the response to a force f with no prescribed velocity.
+  virtual SolveReport solve_homogeneous(const ProjectedSystem& sys, const Vec3List& f, Vec3List& y) = 0;
+};
+
 }  // namespace mica

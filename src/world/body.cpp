@@ -14,7 +14,7 @@ Body::Body(const TetMesh& mesh, const BodySettings& s, const std::string& body_n
   A.assign(fem.pattern.block_count(), Mat3::Zero());
   for (Vec3List* w : {&f_int, &f_ext, &b, &v_next, &x_next, &contact_impulse}) w->assign(n, Vec3::Zero());
   projection.reset(int32_t(n));
-  pcg.resize(n);
+  pcg.reserve(n);
   bvh.build(x, surface);
   for (const Tri& t : surface)
     for (int k = 0; k < 3; ++k) surface_edge += (x[t[k]] - x[t[(k + 1) % 3]]).norm();

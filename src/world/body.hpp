@@ -46,7 +46,7 @@ struct Body {
   Projection projection;
   Vec3List contact_impulse;    // G^T lambda of the last step, N s
   DirectSolver direct;
-  PcgWorkspace pcg;
+  PcgSolver pcg;
 
   // What A and the factorization were built for; a linear body reuses both while unchanged.
   struct MatrixKey {

@@ -87,11 +87,9 @@ void World::advance(double h) {
   stage.run(Stage::Solve, plan.solve, [&] {
     if (settings_.solver == SolverKind::Mica) {
       solve_mica(dynamic, h);
-    } else if (!contacts_.empty() && settings_.solver == SolverKind::Direct) {
-      solve_exact(dynamic, h);
+    } else if (!contacts_.empty()) {
+      solve_delassus(dynamic, h);
     } else {
-      if (!contacts_.empty())
-        fail(Errc::Unsupported, "tool contact needs MICA_SOLVER_MICA or MICA_SOLVER_DIRECT in this version");
       for (Body* b : dynamic) solve_velocities(*b, h);
     }
   });
@@ -227,26 +225,33 @@ void World::solve_mica(const std::vector<Body*>& dynamic, double h) {
   record(report);
 }
 
-void World::solve_exact(const std::vector<Body*>& dynamic, double h) {
+void World::solve_delassus(const std::vector<Body*>& dynamic, double h) {
   exact_bodies_.resize(dynamic.size());
   for (size_t k = 0; k < dynamic.size(); ++k) {
     Body& b = *dynamic[k];
     form_rhs(b, h);
-    factorize(b);
-    exact_bodies_[k] = ExactBody{&b.fem.pattern, &b.A, &b.b, &b.projection, &b.direct, &b.v_next, {}};
+    b.v_next = b.v;  // the warm start of an iterative solve
+    exact_bodies_[k] = ExactBody{&b.fem.pattern, &b.A, &b.b, &b.projection, &linear_solver(b), &b.v_next, {}};
   }
   rows_.build(contacts_, h, settings_.max_recovery_speed);
-  record(solve_exact_contact(exact_bodies_, rows_, lambda_));
+  record(solve_contact_delassus(exact_bodies_, rows_, lambda_));
   for (size_t k = 0; k < dynamic.size(); ++k) std::swap(dynamic[k]->contact_impulse, exact_bodies_[k].contact_impulse);
 }
 
-void World::factorize(Body& b) {
+LinearSolver& World::linear_solver(Body& b) {
+  if (settings_.solver == SolverKind::Pcg) {
+    b.pcg.configure(settings_.tolerance, settings_.max_iterations);
+    return b.pcg;
+  }
+  // CHOLMOD: analysed once; factored when A or the constraint set changed (a linear body with
+  // fixed constraints keeps its factor).
   if (!b.direct.analyzed()) b.direct.analyze(b.fem.pattern);
   if (!b.factor_current || b.factored_lpc_version != b.lpc_version) {
     b.direct.factorize(ProjectedSystem{b.fem.pattern, b.A, b.projection});
     b.factor_current = true;
     b.factored_lpc_version = b.lpc_version;
   }
+  return b.direct;
 }
 
 void World::compute_forces(const std::vector<Body*>& dynamic, double h) {
@@ -283,16 +288,8 @@ void World::compute_forces(const std::vector<Body*>& dynamic, double h) {
 void World::solve_velocities(Body& b, double h) {
   form_rhs(b, h);
 
-  const ProjectedSystem sys{b.fem.pattern, b.A, b.projection};
-  SolveReport report;
-  if (settings_.solver == SolverKind::Direct) {
-    factorize(b);
-    report = b.direct.solve(sys, b.b, b.v_next);
-  } else {
-    b.v_next = b.v;  // warm start from the last velocity
-    report = solve_pcg(sys, b.b, b.v_next, settings_.tolerance, settings_.max_iterations, b.pcg);
-  }
-  record(report);
+  b.v_next = b.v;  // the warm start of an iterative solve
+  record(linear_solver(b).solve(ProjectedSystem{b.fem.pattern, b.A, b.projection}, b.b, b.v_next));
 }
 
 void World::record(const SolveReport& report) {

@@ -118,8 +118,8 @@ class World {
   void collide(const std::vector<Body*>& dynamic, double h);
   bool bounds_overlap(const SurfaceView& a, const SurfaceView& b) const;
   void solve_mica(const std::vector<Body*>& dynamic, double h);
-  void solve_exact(const std::vector<Body*>& dynamic, double h);
-  void factorize(Body& b);
+  void solve_delassus(const std::vector<Body*>& dynamic, double h);
+  LinearSolver& linear_solver(Body& b);
   void compute_forces(const std::vector<Body*>& dynamic, double h);
   void apply_loads(Body& b) const;
   void assemble_elements(Body& b, double h, bool damping) const;

@@ -1933,31 +1933,6 @@ static void test_numerical_failure_mica(void** state) {
   check_numerical_failure(MICA_SOLVER_MICA);
 }
 
-/* A step that is refused part-way (a tool touching a body in a world whose solver cannot
- * handle contact: PCG has no contact path yet) must also leave everything as it was, the
- * statistics included. */
-static void test_unsupported_step_leaves_world_unchanged(void** state) {
-  (void)state;
-  fixture* fx = new_fixture(MICA_SOLVER_PCG);
-  assert_non_null(fx);
-  mica_tool_def td = mica_tool_def_default();
-  td.position[0] = 0.3; /* a 1 cm sphere around the corner node at (0.3, 0, 0) */
-  mica_tool_id tool = 0;
-  const mica_status created = mica_tool_create(fx->world, &td, &tool);
-  if (created == MICA_OK) {
-    EXPECT_FAIL(fx, MICA_ERR_UNSUPPORTED, mica_step(fx->world, 0.01), NULL);
-    EXPECT_FAIL(fx, MICA_ERR_UNSUPPORTED, mica_step(fx->world, 0.01), NULL);
-    REQUIRE_OK_W(fx->world, mica_tool_destroy(fx->world, tool));
-  } else {
-    /* Refusing the tool itself is the other acceptable design. */
-    assert_int_equal(created, MICA_ERR_UNSUPPORTED);
-  }
-  REQUIRE_OK_W(fx->world, mica_step(fx->world, 0.01));
-  mica_world_destroy(fx->world);
-  free(fx);
-}
-
-/* The world's message and the thread's message are separate. */
 static void test_error_message_scopes(void** state) {
   fixture* fx = *state;
   EXPECT_FAIL(fx, MICA_ERR_INVALID_ARGUMENT, mica_step(fx->world, -2.0), NULL);
@@ -2010,7 +1985,6 @@ int main(void) {
       cmocka_unit_test(test_numerical_failure_direct),
       cmocka_unit_test(test_numerical_failure_pcg),
       cmocka_unit_test(test_numerical_failure_mica),
-      cmocka_unit_test(test_unsupported_step_leaves_world_unchanged),
       cmocka_unit_test_setup_teardown(test_error_message_scopes, setup, teardown),
   };
   return cmocka_run_group_tests(tests, group_setup, group_teardown);

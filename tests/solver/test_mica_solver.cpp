@@ -150,6 +150,34 @@ static void test_sliding_with_friction_matches_reference(void**) {
   assert_true(std::fabs(f.x()) < 0.5 * f.y() * 1.2);
 }
 
+// The projected PCG solves contact through the same Delassus matrix, as exact as its tolerance.
+static void test_pcg_contact_matches_reference(void**) {
+  Scene pcg{World(settings(SolverKind::Pcg, 1e-13))}, exact{World(settings(SolverKind::Direct, 1e-10))};
+  SceneSpec spec;
+  spec.tool = true;
+  spec.grasp = true;
+  build(pcg, spec);
+  build(exact, spec);
+  double worst = 0;
+  for (int k = 0; k < 5; ++k) {
+    for (Scene* s : {&pcg, &exact}) {
+      const Vec3 p = s->world.tool(s->tool).position + Vec3(0, -0.002, 0);
+      s->world.set_tool_pose(s->tool, p, Eigen::Quaterniond::Identity());
+      s->world.step(0.01);
+    }
+    assert_true(pcg.world.stats().converged);
+    const Vec3List& a = pcg.world.body(pcg.body).v;
+    const Vec3List& e = exact.world.body(exact.body).v;
+    Vec3List d(a.size());
+    for (size_t i = 0; i < a.size(); ++i) d[i] = a[i] - e[i];
+    worst = std::max(worst, max_norm(d) / max_norm(e));
+  }
+  print_message("PCG with contact: worst relative difference in v %.3g, %d PCG iterations in the last step\n", worst,
+                pcg.world.stats().solver_iterations);
+  assert_true(pcg.world.tool(pcg.tool).force.y() > 0);
+  assert_le(worst, 1e-8);
+}
+
 // Pressed and settled: the tool's force, the support reaction and the weight balance, and
 // the tool is pushed up (away from the tissue).
 static void test_static_equilibrium_of_forces(void**) {
@@ -248,6 +276,7 @@ int main(void) {
       cmocka_unit_test(test_sphere_press_matches_reference),
       cmocka_unit_test(test_press_and_grasp_on_one_body_match_reference),
       cmocka_unit_test(test_sliding_with_friction_matches_reference),
+      cmocka_unit_test(test_pcg_contact_matches_reference),
       cmocka_unit_test(test_static_equilibrium_of_forces),
       cmocka_unit_test(test_lifting_a_grasp_pulls_down),
       cmocka_unit_test(test_degenerate_contacts_stay_bounded),
