@@ -11,6 +11,8 @@
 #include <mica/mica.h>
 
 /* A 0.1 m block fixed at y = 0, no gravity; the tool is lowered into its top face over 10 steps. */
+static double last_torque[3];
+
 static double press(mica_tool_def td, double depth, int32_t* contacts) {
   mica_world_def wd = mica_world_def_default();
   wd.gravity[1] = 0;
@@ -40,7 +42,7 @@ static double press(mica_tool_def td, double depth, int32_t* contacts) {
     assert_true(mica_step(w, 0.01) >= 0);
   }
   double f[3];
-  assert_int_equal(mica_tool_get_force(w, tool, f, NULL, contacts), MICA_OK);
+  assert_int_equal(mica_tool_get_force(w, tool, f, last_torque, contacts), MICA_OK);
   assert_true(isfinite(f[0]) && isfinite(f[1]) && isfinite(f[2]));
   mica_world_destroy(w);
   return f[1];
@@ -104,10 +106,39 @@ static void test_capsule_and_plane_push_up(void** state) {
   assert_int_equal(np, 49);
 }
 
+/* Torque about the tool origin: none for a frictionless sphere (every contact normal passes
+ * through its centre); a box pressing with only its -x half on the block (centred on the edge
+ * x = 0.1) is pushed up left of its centre, so it turns clockwise about z (negative). */
+static void test_torque(void** state) {
+  (void)state;
+  mica_tool_def sphere = mica_tool_def_default();
+  sphere.radius = 0.03;
+  sphere.position[0] = 0.04;
+  sphere.position[1] = 0.13;
+  sphere.position[2] = 0.05;
+  int32_t n = 0;
+  const double fs = press(sphere, 0.01, &n);
+  const double ts = sqrt(last_torque[0] * last_torque[0] + last_torque[1] * last_torque[1] + last_torque[2] * last_torque[2]);
+  print_message("sphere: force %.4f N, |torque| %.3g N m\n", fs, ts);
+  assert_true(fs > 0.1 && ts <= 1e-9 * fs * 0.03);
+  mica_tool_def box = mica_tool_def_default();
+  box.shape = MICA_TOOL_BOX;
+  box.half_extents[0] = box.half_extents[1] = box.half_extents[2] = 0.02;
+  box.position[0] = 0.1;
+  box.position[1] = 0.12;
+  box.position[2] = 0.05;
+  const double fb = press(box, 0.006, &n);
+  print_message("box on the edge: force %.4f N, torque z %.4g N m\n", fb, last_torque[2]);
+  assert_true(fb > 0.1);
+  assert_true(last_torque[2] < -0.002 * fb); /* lever of at least 2 mm */
+  assert_true(last_torque[2] > -0.02 * fb);  /* and at most the half width */
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_hull_of_box_corners_presses_like_the_box),
       cmocka_unit_test(test_capsule_and_plane_push_up),
+      cmocka_unit_test(test_torque),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
