@@ -59,6 +59,8 @@ typedef int32_t mica_status;
 #define MICA_OK 0
 /** Warning: the step finished but the solver stopped at its cap before its tolerance. */
 #define MICA_WARN_NOT_CONVERGED 1
+/** Warning: the haptic device reported a warning (warm motors, force clamped by the device). */
+#define MICA_WARN_DEVICE 2
 #define MICA_ERR_NULL_ARGUMENT (-1)    /**< a required pointer is NULL */
 #define MICA_ERR_INVALID_ARGUMENT (-2) /**< a value is outside its domain (NaN, negative, bad enum) */
 #define MICA_ERR_OUT_OF_RANGE (-3)     /**< an index is outside its array */

@@ -36,6 +36,7 @@ struct Tool {
   Vec3 force = Vec3::Zero();     // N
   Vec3 torque = Vec3::Zero();    // N m
   int32_t contact_count = 0;
+  Mat3 stiffness = Mat3::Zero(); // N/m, dF/dx of the force on the tool around its pose (negative semidefinite)
 };
 
 // Checks the parameters the shape uses (finite; radius, half_length, half_extents > 0; a plane

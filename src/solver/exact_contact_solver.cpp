@@ -9,7 +9,8 @@
 namespace mica {
 
 
-SolveReport solve_contact_delassus(std::vector<ExactBody>& bodies, const ContactRows& rows, std::vector<double>& lambda) {
+SolveReport solve_contact_delassus(std::vector<ExactBody>& bodies, const ContactRows& rows, std::vector<double>& lambda,
+                                   std::vector<double>& diagonal) {
   const size_t nb = bodies.size(), nr = rows.size();
   SolveReport linear;
   auto record = [&linear](const SolveReport& r) {
@@ -49,6 +50,7 @@ SolveReport solve_contact_delassus(std::vector<ExactBody>& bodies, const Contact
           W(r, s) += term.coef * rows.direction[r].dot(response[s][term.body][term.node]);
     }
   }
+  diagonal.assign(W.diagonal().data(), W.diagonal().data() + nr);
   // Rows whose points cannot move along them (W_rr ~ 0: fixed nodes) carry no impulse: they are
   // left out, as in MICA, or a penetrating one would make the problem infeasible.
   const double scale = std::max(W.diagonal().cwiseAbs().maxCoeff(), 1e-300);

@@ -23,6 +23,8 @@ struct ExactBody {
 // lambda: out, impulse per row (N s). Throws Error(Numerical) if the complementarity problem
 // has no solution the pivoting can find. The report sums the linear solves' iterations and
 // takes the worst of their residuals and the complementarity error.
-SolveReport solve_contact_delassus(std::vector<ExactBody>& bodies, const ContactRows& rows, std::vector<double>& lambda);
+// `diagonal` receives W_rr per row.
+SolveReport solve_contact_delassus(std::vector<ExactBody>& bodies, const ContactRows& rows, std::vector<double>& lambda,
+                                   std::vector<double>& diagonal);
 
 }  // namespace mica

@@ -48,6 +48,8 @@ class MicaSolver {
   // lambda: in, the warm start (projected onto its bounds); out, the impulses (N s) per row.
   MicaReport solve(std::vector<MicaBody>& bodies, const ContactRows& rows, const MicaSettings& settings,
                    std::vector<double>& lambda);
+  // B_rr of the last solve, per row: the compliance each row sees (its diagonal of G Dt^-1 G^T).
+  const std::vector<double>& row_diagonal() const { return diag_; }
 
  private:
   double anticipated_velocity(const std::vector<MicaBody>& bodies, const ContactRows& rows, size_t r) const;

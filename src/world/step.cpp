@@ -221,6 +221,7 @@ void World::solve_mica(const std::vector<Body*>& dynamic, double h) {
   ms.pgs_sweeps = settings_.pgs_sweeps;
   ms.paper_norm = settings_.paper_norm;
   const MicaReport report = mica_.solve(mica_bodies_, rows_, ms, lambda_);
+  row_diagonal_ = mica_.row_diagonal();
   for (size_t k = 0; k < dynamic.size(); ++k) std::swap(dynamic[k]->contact_impulse, mica_bodies_[k].contact_impulse);
   record(report);
 }
@@ -234,7 +235,7 @@ void World::solve_delassus(const std::vector<Body*>& dynamic, double h) {
     exact_bodies_[k] = ExactBody{&b.fem.pattern, &b.A, &b.b, &b.projection, &linear_solver(b), &b.v_next, {}};
   }
   rows_.build(contacts_, h, settings_.max_recovery_speed);
-  record(solve_contact_delassus(exact_bodies_, rows_, lambda_));
+  record(solve_contact_delassus(exact_bodies_, rows_, lambda_, row_diagonal_));
   for (size_t k = 0; k < dynamic.size(); ++k) std::swap(dynamic[k]->contact_impulse, exact_bodies_[k].contact_impulse);
 }
 
@@ -260,6 +261,7 @@ void World::compute_forces(const std::vector<Body*>& dynamic, double h) {
     t->force.setZero();
     t->torque.setZero();
     t->contact_count = 0;
+    t->stiffness.setZero();
   }
   for (size_t r = 0; r < rows_.size(); ++r) {
     const Contact& c = contacts_[rows_.contact[r]];
@@ -268,7 +270,13 @@ void World::compute_forces(const std::vector<Body*>& dynamic, double h) {
     const Vec3 f = -rows_.direction[r] * lambda_[r] / h;
     t.force += f;
     t.torque += (c.point - t.position).cross(f);
-    t.contact_count += (rows_.normal_of[r] < 0 && lambda_[r] > 0) ? 1 : 0;
+    if (rows_.normal_of[r] < 0 && lambda_[r] > 0) {
+      t.contact_count += 1;
+      // Around the pose it used, pushing the tool in by dx along n raises this row's impulse by
+      // n.dx / (h W_rr): the force changes by -n n^T dx / (h^2 W_rr).
+      if (row_diagonal_.size() == rows_.size() && row_diagonal_[r] > 0)
+        t.stiffness -= rows_.direction[r] * rows_.direction[r].transpose() / (h * h * row_diagonal_[r]);
+    }
   }
   // Constraints: the impulse r = (I - S)(A v - b - G^T lambda) holds the body; whoever holds
   // the constraint (the user's hand) feels the opposite force, -r / h.

@@ -139,6 +139,7 @@ class World {
   SlotMap<Body, IdKind::Body> bodies_;
   SlotMap<Lpc, IdKind::Lpc> lpcs_;
   SlotMap<Tool, IdKind::Tool> tools_;
+  std::vector<double> row_diagonal_;                // W_rr (or B_rr) per row: the compliance a row sees
   std::vector<Body*> dynamic_;                      // this step's dynamic bodies
   std::vector<Tool*> step_tools_;
   std::vector<SurfaceView> views_;
