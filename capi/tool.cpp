@@ -77,6 +77,23 @@ MICA_API mica_status mica_tool_set_pose(mica_world* world, mica_tool_id tool, co
   });
 }
 
+MICA_API mica_status mica_tool_get_pose(const mica_world* world, mica_tool_id tool, double out_position[3],
+                                        double out_orientation[4]) {
+  return guarded(world, "mica_tool_get_pose", [&] {
+    require(world, "world");
+    const mica::Tool& t = world->world.tool(tool);
+    if (out_position)
+      for (int k = 0; k < 3; ++k) out_position[k] = t.position[k];
+    if (out_orientation) {
+      out_orientation[0] = t.orientation.w();
+      out_orientation[1] = t.orientation.x();
+      out_orientation[2] = t.orientation.y();
+      out_orientation[3] = t.orientation.z();
+    }
+    return MICA_OK;
+  });
+}
+
 MICA_API mica_status mica_tool_get_force(const mica_world* world, mica_tool_id tool, double out_force[3],
                                          double out_torque[3], int32_t* out_contacts) {
   return guarded(world, "mica_tool_get_force", [&] {

@@ -387,6 +387,10 @@ MICA_API mica_status mica_tool_destroy(mica_world* world, mica_tool_id tool);
 /** Moves a tool: position (m) and unit quaternion (w, x, y, z) for the next step. The world's thread. */
 MICA_API mica_status mica_tool_set_pose(mica_world* world, mica_tool_id tool, const double position[3],
                                         const double orientation[4]);
+/** The tool's current pose: position (m) and unit quaternion (w, x, y, z); either may be NULL.
+ *  A tool driven by a device takes the device's pose at each step. The world's thread. */
+MICA_API mica_status mica_tool_get_pose(const mica_world* world, mica_tool_id tool, double out_position[3],
+                                        double out_orientation[4]);
 /** Force (N) and torque about the tool origin (N m) the bodies put on the tool in the last step,
  *  and the number of active contacts; any output may be NULL. The world's thread. */
 MICA_API mica_status mica_tool_get_force(const mica_world* world, mica_tool_id tool, double out_force[3],

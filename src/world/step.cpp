@@ -61,6 +61,7 @@ void World::advance(double h) {
   stats_.solver_residual = 0;
   stats_.converged = true;
 
+  follow_devices();
   StageRunner stage(stats_);
   stage.run(Stage::Collide, plan.collide, [&] { collide(dynamic, h); });
   if (!plan.collide) contacts_.clear();
@@ -100,8 +101,37 @@ void World::advance(double h) {
   check_finite(dynamic);  // throws before anything observable has changed
   stage.run(Stage::Forces, plan.forces, [&] { compute_forces(dynamic, h); });
   commit(dynamic);
+  publish_force_models();
   stats_.step_count += 1;
   stats_.ms_last_step = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+void World::follow_devices() {
+  // Each device's newest pose moves its tool before the step (the servo thread wrote it).
+  devices_.for_each([&](Id, DeviceLink& link) {
+    ScenePose pose;
+    if (link.settings().tool && link.latest_pose(pose)) {
+      Tool& t = tool(link.settings().tool);
+      t.position = pose.position;
+      t.orientation = pose.orientation;
+    }
+  });
+}
+
+void World::publish_force_models() {
+  devices_.for_each([&](Id, DeviceLink& link) {
+    ForceModel model;
+    model.step = stats_.step_count;
+    if (const Tool* t = link.settings().tool ? tools_.find(link.settings().tool) : nullptr) {
+      model.f0 = t->force;
+      model.x0 = t->position;
+      model.in_contact = t->contact_count > 0;
+      // The device can render only so stiff a spring: cap the model's stiffness at its nominal one.
+      const double k = t->stiffness.norm(), k_max = link.info().nominal_stiffness;
+      model.H = k > k_max ? Mat3(t->stiffness * (k_max / k)) : t->stiffness;
+    }
+    link.publish(model);
+  });
 }
 
 void World::apply_loads(Body& b) const {
@@ -220,6 +250,7 @@ void World::solve_mica(const std::vector<Body*>& dynamic, double h) {
   ms.max_iterations = settings_.max_iterations;
   ms.pgs_sweeps = settings_.pgs_sweeps;
   ms.paper_norm = settings_.paper_norm;
+  ms.relaxation = settings_.relaxation;
   const MicaReport report = mica_.solve(mica_bodies_, rows_, ms, lambda_);
   row_diagonal_ = mica_.row_diagonal();
   for (size_t k = 0; k < dynamic.size(); ++k) std::swap(dynamic[k]->contact_impulse, mica_bodies_[k].contact_impulse);

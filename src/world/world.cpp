@@ -119,8 +119,35 @@ Id World::add_tool(const Tool& tool) {
   return tools_.insert(std::make_unique<Tool>(t));
 }
 
+Id World::add_device(std::unique_ptr<Device> device, const DeviceSettings& settings) {
+  if (settings.tool) tool(settings.tool);  // throws for a stale tool id
+  if (!(settings.scale > 0) || !std::isfinite(settings.scale)) fail(Errc::InvalidArgument, "the workspace scale must be finite and > 0");
+  require_finite(settings.offset, "the workspace offset");
+  if (!settings.rotation.coeffs().allFinite() || !(settings.rotation.norm() > 1e-12))
+    fail(Errc::InvalidArgument, "the workspace rotation must be a finite non-zero quaternion");
+  if (settings.filter_window < 1) fail(Errc::InvalidArgument, "the filter window must be >= 1 sample");
+  const SafetySettings& s = settings.safety;
+  if (!(s.max_force >= 0) || !(s.max_rate > 0) || !(s.stall_timeout > 0) || !(s.stall_ramp > 0) ||
+      !std::isfinite(s.max_force + s.max_rate + s.stall_timeout + s.stall_ramp))
+    fail(Errc::InvalidArgument, "the safety limits must be finite: max_force >= 0, max_force_rate, stall_timeout and stall_ramp > 0");
+  if (!(settings.coupling_stiffness >= 0) || !(settings.coupling_damping >= 0) ||
+      !std::isfinite(settings.coupling_stiffness + settings.coupling_damping))
+    fail(Errc::InvalidArgument, "the coupling stiffness and damping must be finite and >= 0");
+  DeviceSettings normalised = settings;
+  normalised.rotation.normalize();
+  return devices_.insert(std::make_unique<DeviceLink>(std::move(device), normalised));
+}
+
+void World::remove_device(Id id) {
+  device(id).stop();
+  devices_.erase(id);
+}
+
 void World::remove_tool(Id id) {
   tool(id);
+  devices_.for_each([&](Id, DeviceLink& link) {
+    if (link.settings().tool == id) fail(Errc::WrongState, "a device drives this tool: destroy the device first");
+  });
   // Grabs that followed this tool stay where the tool left them.
   lpcs_.for_each([&](Id, Lpc& c) {
     if (c.handle && c.handle->tool == id) {

@@ -9,6 +9,7 @@
 #include <unordered_map>
 
 #include "collision/contact.hpp"
+#include "haptics/device_link.hpp"
 #include "solver/exact_contact_solver.hpp"
 #include "solver/mica_solver.hpp"
 #include "world/body.hpp"
@@ -29,6 +30,7 @@ struct WorldSettings {
   int32_t pgs_sweeps = 1;          // MICA: PGS sweeps over the contacts per iteration
   double max_recovery_speed = 1.0; // m/s, clamps gap / h for penetrating contacts
   bool paper_norm = false;         // MICA: stop on the paper's 2-norm of the change
+  double relaxation = 1.0;         // MICA: MBGS over-relaxation omega in (0, 2)
   bool body_contact = true;        // contact between bodies (and with static bodies)
   double body_margin = 1e-3;       // m, contacts between bodies are made for gaps below this
   double body_friction = 0;        // Coulomb coefficient between bodies
@@ -100,6 +102,13 @@ class World {
   Tool& tool(Id id) { return tools_.get(id, "tool"); }
   const Tool& tool(Id id) const { return tools_.get(id, "tool"); }
   void set_tool_pose(Id id, const Vec3& position, const Eigen::Quaterniond& orientation);
+  // Devices: added and removed only while no servo loop runs.
+  Id add_device(std::unique_ptr<Device> device, const DeviceSettings& settings);
+  void remove_device(Id id);
+  DeviceLink& device(Id id) { return devices_.get(id, "device"); }
+  const DeviceLink& device(Id id) const { return devices_.get(id, "device"); }
+  DeviceLink* find_device(Id id) noexcept { return devices_.find(id); }  // the servo path: no throw
+
   const std::vector<Contact>& contacts() const { return contacts_; }
   const ContactRows& contact_rows() const { return rows_; }
   const std::vector<double>& impulses() const { return lambda_; }  // per contact row, N s
@@ -115,6 +124,8 @@ class World {
   void for_each_body(F&& f) const { bodies_.for_each(f); }
 
  private:
+  void follow_devices();
+  void publish_force_models();
   void collide(const std::vector<Body*>& dynamic, double h);
   bool bounds_overlap(const SurfaceView& a, const SurfaceView& b) const;
   void solve_mica(const std::vector<Body*>& dynamic, double h);
@@ -139,6 +150,7 @@ class World {
   SlotMap<Body, IdKind::Body> bodies_;
   SlotMap<Lpc, IdKind::Lpc> lpcs_;
   SlotMap<Tool, IdKind::Tool> tools_;
+  SlotMap<DeviceLink, IdKind::Device> devices_;
   std::vector<double> row_diagonal_;                // W_rr (or B_rr) per row: the compliance a row sees
   std::vector<Body*> dynamic_;                      // this step's dynamic bodies
   std::vector<Tool*> step_tools_;

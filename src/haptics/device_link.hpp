@@ -1,0 +1,89 @@
+// One device attached to the world: the servo cycle (read, map, evaluate, filter, limit,
+// write) on the servo thread, and the exchange with the simulation thread — the device pose
+// goes one way, the force model of each step the other — through lock-free buffers.
+// poll() never allocates, locks, blocks or throws.
+#pragma once
+#include <atomic>
+#include <memory>
+
+#include "devices/device.hpp"
+#include "haptics/force_model.hpp"
+#include "haptics/force_safety.hpp"
+#include "haptics/moving_average.hpp"
+#include "haptics/servo_thread.hpp"
+#include "haptics/triple_buffer.hpp"
+
+namespace mica {
+
+struct DeviceSettings {
+  uint64_t tool = 0;  // the tool id the device drives, 0 for none
+  double scale = 1;   // scene = rotation * (scale * device) + offset
+  Vec3 offset = Vec3::Zero();
+  Eigen::Quaterniond rotation = Eigen::Quaterniond::Identity();
+  ForceMode mode = ForceMode::LocalModel;
+  int32_t filter_window = 20;
+  SafetySettings safety{0, 1000, 0.1, 0.05};  // max_force 0: the device's own
+  double coupling_stiffness = 300;  // N/m
+  double coupling_damping = 2;      // N s/m
+};
+
+// The device's pose mapped into the scene, as the servo thread last read it.
+struct ScenePose {
+  Vec3 position = Vec3::Zero();
+  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();
+  Vec3 velocity = Vec3::Zero();
+  int64_t sequence = 0;  // 0: nothing read yet
+};
+
+struct ServoStats {
+  std::atomic<int64_t> polls{0}, failures{0}, clamped{0};
+  std::atomic<int32_t> last_code{0};
+  std::atomic<double> rate_hz{0};
+  std::atomic<double> last_force[3] = {0, 0, 0};
+};
+
+class DeviceLink {
+ public:
+  DeviceLink(std::unique_ptr<Device> device, const DeviceSettings& settings);
+  ~DeviceLink();
+
+  // Servo thread.
+  DeviceResult poll(DeviceState* out_state, Vec3* out_force) noexcept;
+
+  // Simulation thread: the newest device pose (false before the first poll), and the force
+  // model of the step just taken.
+  bool latest_pose(ScenePose& out);
+  void publish(const ForceModel& model);
+
+  // The world's thread: the servo loop on libmica's own 1 kHz thread or the backend's scheduler.
+  void start();
+  void stop();
+
+  const DeviceSettings& settings() const { return settings_; }
+  const DeviceInfo& info() const { return info_; }
+  const ServoStats& stats() const { return stats_; }
+
+ private:
+  static void tick(void* self);
+  double now() const;  // s since the link was made, steady clock
+
+  std::unique_ptr<Device> device_;
+  DeviceSettings settings_;
+  DeviceInfo info_;
+  TripleBuffer<ForceModel> model_;
+  TripleBuffer<ScenePose> pose_;
+  MovingAverage filter_;
+  ForceSafety safety_;
+  ServoThread thread_;
+  bool on_scheduler_ = false;
+  // Servo-thread state.
+  double last_timestamp_ = -HUGE_VAL;
+  double last_poll_ = -1;
+  int64_t sequence_ = 0;
+  double rate_window_start_ = 0;
+  int64_t rate_window_polls_ = 0;
+  ServoStats stats_;
+  const int64_t epoch_;
+};
+
+}  // namespace mica

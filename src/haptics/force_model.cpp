@@ -1,0 +1,25 @@
+#include "haptics/force_model.hpp"
+
+#include <cmath>
+
+#include "core/error.hpp"
+
+namespace mica {
+
+Vec3 ForceModel::evaluate(const Vec3& x, ForceMode mode) const noexcept {
+  if (mode == ForceMode::LocalModel) return f0 + H * (x - x0);
+  return f0;
+}
+
+Vec3 coupling_force(const Vec3& x_device, const Vec3& v_device, const Vec3& x_tool, const Vec3& v_tool,
+                    double k, double b) noexcept {
+  return -k * (x_device - x_tool) - b * (v_device - v_tool);
+}
+
+double passive_coupling_damping(double k, double period) {
+  if (!(std::isfinite(k) && k >= 0)) fail(Errc::InvalidArgument, "coupling stiffness must be finite and >= 0");
+  if (!(std::isfinite(period) && period > 0)) fail(Errc::InvalidArgument, "servo period must be finite and > 0");
+  return k * period / 2;
+}
+
+}  // namespace mica
