@@ -4,7 +4,8 @@
 set -eu
 
 PACKAGES="g++ cmake make pkg-config libeigen3-dev libsuitesparse-dev libccd-dev libcmocka-dev
-doxygen python3 python3-numpy python3-matplotlib libsiconos-numerics-dev"
+doxygen python3 python3-numpy python3-matplotlib libsiconos-numerics-dev
+luajit mono-mcs mono-runtime abigail-tools"
 
 missing=""
 for pkg in $PACKAGES; do

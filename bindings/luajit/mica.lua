@@ -1,0 +1,236 @@
+-- libmica for LuaJIT: the C API through the ffi, plus a few helpers.
+--
+--   local mica = require("mica")
+--   local world = mica.world{ gravity = {0, 0, 0}, solver = mica.C.MICA_SOLVER_MICA }
+--   local cube = world:create_box({-0.05, 0, -0.05}, {0.05, 0.1, 0.05}, {4, 4, 4}, 5, { youngs_modulus = 1e4 })
+--   local tool = world:create_tool{ radius = 0.02, position = {0, 0.125, 0} }
+--   world:step(0.01)
+--   local force, torque, contacts = world:tool_force(tool)
+--
+-- The declarations come from mica_cdef.lua, generated from include/mica/*.h at build time
+-- (bindings/luajit/gen_cdef.py): require finds it in <build>/bindings/luajit. The library is
+-- $MICA_LIBRARY, else libmica.so.<major> two folders above this file (a build tree), else
+-- ffi.load("mica") (the system's search path).
+--
+-- mica.C is the library namespace: every function of mica.h and mica_device.h, and the
+-- constants (mica.C.MICA_OK). Errors (status < 0) raise a mica.Error {status, message};
+-- warnings (status > 0) are returned: world:step() returns converged, status.
+local ffi = require("ffi")
+
+local M = {}
+
+ffi.cdef(require("mica_cdef"))
+
+local function module_dir()
+  local source = debug.getinfo(1, "S").source
+  return source:sub(1, 1) == "@" and source:sub(2):match("^(.*)/[^/]*$") or "."
+end
+
+local function file_exists(path)
+  local f = io.open(path, "rb")
+  if f then f:close() end
+  return f ~= nil
+end
+
+local function load_library()
+  local env = os.getenv("MICA_LIBRARY")
+  if env and env ~= "" then return ffi.load(env), env end
+  -- A build tree: <build>/bindings/luajit/mica.lua beside <build>/libmica.so.<major>.
+  for _, up in ipairs({ "/../..", "/..", "" }) do
+    local path = module_dir() .. up .. "/libmica.so.0"
+    if file_exists(path) then return ffi.load(path), path end
+  end
+  return ffi.load("mica"), "mica"
+end
+
+local C, path = load_library()
+M.C = C
+M.path = path
+
+-- Errors ----------------------------------------------------------------------------------
+
+local Error = {}
+Error.__index = Error
+Error.__tostring = function(e)
+  return (e.message ~= "" and e.message .. " " or "") .. "(" .. e.name .. ")"
+end
+M.Error = Error
+
+-- Raises a mica.Error for status < 0 (message from mica_world_last_error(world_ptr), which may
+-- be nil); returns the status otherwise, so warnings (status > 0) reach the caller.
+function M.check(status, world_ptr)
+  if status < 0 then
+    local message = ffi.string(C.mica_world_last_error(world_ptr))
+    error(setmetatable({ status = status, message = message,
+                         name = ffi.string(C.mica_status_string(status)) }, Error), 2)
+  end
+  return status
+end
+local check = M.check
+
+function M.version() return C.mica_version() end
+
+-- Definitions -----------------------------------------------------------------------------
+
+-- Copies a table of field values (Lua tables for arrays) over a def.
+local function fill(def, fields)
+  for k, v in pairs(fields or {}) do
+    assert(k ~= "struct_size", "struct_size is set by the *_init function")
+    def[k] = v
+  end
+  return def
+end
+
+-- Each def is filled by its *_init function with this side's ffi.sizeof.
+function M.world_def(fields)
+  local d = ffi.new("mica_world_def")
+  check(C.mica_world_def_init(d, ffi.sizeof(d), C.MICA_VERSION_NUMBER), nil)
+  return fill(d, fields)
+end
+
+local function def_maker(ctype, init)
+  return function(fields)
+    local d = ffi.new(ctype)
+    check(C[init](d, ffi.sizeof(d)), nil)
+    return fill(d, fields)
+  end
+end
+M.body_def = def_maker("mica_body_def", "mica_body_def_init")
+M.lpc_def = def_maker("mica_lpc_def", "mica_lpc_def_init")
+M.tool_def = def_maker("mica_tool_def", "mica_tool_def_init")
+M.device_def = def_maker("mica_device_def", "mica_device_def_init")
+
+local function vec(values, n)
+  return ffi.new("double[?]", n or 3, values)
+end
+M.vec = vec
+
+-- World -----------------------------------------------------------------------------------
+
+local World = {}
+World.__index = World
+M.World = World
+
+-- Creates a world from a table of mica_world_def fields (or a filled mica_world_def). The
+-- world is destroyed by world:close() or, failing that, by the garbage collector (ffi.gc).
+function M.world(fields)
+  local def = ffi.istype("mica_world_def", fields) and fields or M.world_def(fields)
+  local out = ffi.new("mica_world*[1]")
+  check(C.mica_world_create(def, out), nil)
+  return setmetatable({ ptr = ffi.gc(out[0], C.mica_world_destroy), callbacks = {} }, World)
+end
+
+-- Destroys the world now (ids and position views die with it), then frees the callbacks made
+-- for its devices.
+function World:close()
+  if self.ptr ~= nil then
+    C.mica_world_destroy(ffi.gc(self.ptr, nil))
+    self.ptr = nil
+    for _, cb in ipairs(self.callbacks) do cb:free() end
+    self.callbacks = {}
+  end
+end
+
+function World:check(status) return check(status, self.ptr) end
+
+function World:last_error() return ffi.string(C.mica_world_last_error(self.ptr)) end
+
+-- One step of dt seconds: returns converged (false on MICA_WARN_NOT_CONVERGED) and the status.
+function World:step(dt)
+  local status = self:check(C.mica_step(self.ptr, dt))
+  return status == C.MICA_OK, status
+end
+
+function World:create_box(lo, hi, cells, tets_per_cell, fields)
+  local id = ffi.new("mica_body_id[1]")
+  self:check(C.mica_body_create_box(self.ptr, M.body_def(fields), vec(lo), vec(hi),
+                                    ffi.new("int32_t[3]", cells), tets_per_cell or 5, id))
+  return id[0]
+end
+
+function World:create_tool(fields)
+  local id = ffi.new("mica_tool_id[1]")
+  self:check(C.mica_tool_create(self.ptr, M.tool_def(fields), id))
+  return id[0]
+end
+
+-- Runs a buffer-protocol call (size query, then fill): returns an int32_t array and its count.
+local function read_indices(self, call)
+  local count = ffi.new("int32_t[1]")
+  self:check(call(nil, 0, count))
+  local out = ffi.new("int32_t[?]", math.max(count[0], 1))
+  self:check(call(out, count[0], count))
+  return out, count[0]
+end
+
+function World:select_nodes_by_plane(body, point, normal, tolerance, use_rest)
+  local p, n = vec(point), vec(normal)
+  return read_indices(self, function(out, cap, count)
+    return C.mica_body_select_nodes_by_plane(self.ptr, body, p, n, tolerance or 1e-9,
+                                             use_rest == false and 0 or 1, out, cap, count)
+  end)
+end
+
+function World:add_lpc(body, nodes, count, fields)
+  local id = ffi.new("mica_lpc_id[1]")
+  self:check(C.mica_add_lpc(self.ptr, body, nodes, count, M.lpc_def(fields), id))
+  return id[0]
+end
+
+function World:set_tool_pose(tool, position, orientation)
+  self:check(C.mica_tool_set_pose(self.ptr, tool, vec(position), vec(orientation or { 1, 0, 0, 0 }, 4)))
+end
+
+-- Force (double[3], N), torque (double[3], N m) and contacts of a tool in the last step.
+function World:tool_force(tool)
+  local force, torque, contacts = ffi.new("double[3]"), ffi.new("double[3]"), ffi.new("int32_t[1]")
+  self:check(C.mica_tool_get_force(self.ptr, tool, force, torque, contacts))
+  return force, torque, contacts[0]
+end
+
+-- Zero-copy positions: a const double* (3 per node) and the node count. The memory belongs to
+-- the world: valid until the next step, and only while the world is alive (keep it referenced).
+function World:positions(body)
+  local ptr, n = ffi.new("const double*[1]"), ffi.new("int32_t[1]")
+  self:check(C.mica_body_positions_view(self.ptr, body, ptr, n))
+  return ptr[0], n[0]
+end
+
+-- A device whose callbacks are Lua functions: `callbacks` has read_state(state) and
+-- write_force(force, torque), optionally open(), close(), info(out); each returns nothing
+-- (success) or a mica_status. An error inside one becomes MICA_ERR_DEVICE.
+-- LuaJIT callbacks run only on the thread of this Lua state: call mica.C.mica_device_poll()
+-- yourself, never mica_device_start() (its servo thread would enter Lua concurrently).
+function World:create_device(fields, callbacks)
+  local def = M.device_def(fields)
+  local tbl
+  if callbacks then
+    tbl = ffi.new("mica_device_callbacks")
+    tbl.struct_size = ffi.sizeof(tbl)
+    for _, name in ipairs({ "open", "close", "info", "read_state", "write_force" }) do
+      local fn = callbacks[name]
+      if fn then
+        local wrapped
+        if name == "close" then
+          wrapped = function() pcall(fn) end
+        else
+          wrapped = function(_, ...)
+            local ok, status = pcall(fn, ...)
+            if not ok then return C.MICA_ERR_DEVICE end
+            return status or C.MICA_OK
+          end
+        end
+        local cb = ffi.cast(ffi.typeof(tbl[name]), wrapped)
+        self.callbacks[#self.callbacks + 1] = cb -- freed by close(), after the device is gone
+        tbl[name] = cb
+      end
+    end
+    def.backend = C.MICA_DEVICE_CALLBACKS
+    def.callbacks = tbl
+  end
+  local id = ffi.new("mica_device_id[1]")
+  self:check(C.mica_device_create(self.ptr, def, id))
+  return id[0]
+end
+
+return M

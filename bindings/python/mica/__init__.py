@@ -1,0 +1,576 @@
+"""libmica from Python: deformable bodies and haptic tools through ctypes (no compiler needed).
+
+    import mica
+    with mica.World(gravity=(0, 0, 0), solver=mica.MICA_SOLVER_MICA) as world:
+        cube = world.create_box((-0.05, 0, -0.05), (0.05, 0.1, 0.05), (4, 4, 4), youngs_modulus=1e4)
+        tool = world.create_tool(radius=0.02, position=(0, 0.125, 0))
+        world.step(0.01)
+        force, torque, contacts = tool.force()
+        p = cube.positions          # numpy (n, 3) view: valid until the next step
+
+The library is found through $MICA_LIBRARY, else next to a build tree holding this package,
+else ctypes.util.find_library("mica") (see mica._native.find_library). The raw C API is in
+mica.native: every function of mica.h and mica_device.h with its argtypes, and the structs.
+
+Statuses: an error (status < 0) raises MicaError (.status, .message from
+mica_world_last_error). A warning (status > 0: the call did its work) is issued as a
+MicaWarning through the warnings module (filter it like any warning) and World.step()
+returns False instead of True.
+
+Threads: a World is used by one thread at a time; Device.poll() runs on the servo thread.
+"""
+import ctypes
+import os
+import sys
+import warnings
+from ctypes import POINTER, byref, c_double, c_int32, c_void_p, sizeof
+
+import numpy as np
+
+from . import _native as native
+from ._native import MICA_VERSION_NUMBER
+
+_HERE = os.path.dirname(os.path.abspath(__file__))
+
+# Every MICA_* constant at the package level too (mica.MICA_SOLVER_MICA).
+globals().update({k: v for k, v in vars(native).items() if k.startswith("MICA_")})
+
+__all__ = ["MicaError", "MicaWarning", "World", "Body", "Tool", "Lpc", "Device", "DeviceBackend",
+           "version", "world_def", "body_def", "lpc_def", "tool_def", "device_def", "native"]
+
+
+class MicaError(Exception):
+    """A libmica call failed: .status is the mica_status (< 0), .message the library's detail."""
+
+    def __init__(self, status, message="", function=""):
+        self.status = status
+        self.message = message
+        self.function = function
+        name = native.mica_status_string(status).decode()
+        # The library's message already names the function; the status name follows it.
+        super().__init__("%s (%s)" % (message, name) if message else "%s: %s" % (function or "libmica", name))
+
+
+class MicaWarning(RuntimeWarning):
+    """A libmica call did its work but warns (status > 0), e.g. MICA_WARN_NOT_CONVERGED."""
+
+    def __init__(self, status, message=""):
+        self.status = status
+        super().__init__(native.mica_status_string(status).decode() + (": " + message if message else ""))
+
+
+def _check(status, world_handle=None, function=""):
+    """Raises MicaError for status < 0, issues a MicaWarning for status > 0, returns the status."""
+    if status < 0:
+        message = native.mica_world_last_error(world_handle) or b""
+        raise MicaError(status, message.decode(errors="replace"), function)
+    if status > 0:
+        warnings.warn(MicaWarning(status), stacklevel=_caller_level())
+    return status
+
+
+def _caller_level():
+    # The warning points at the first frame outside this package: the user's call.
+    level, frame = 1, sys._getframe(1)
+    while frame is not None and frame.f_code.co_filename.startswith(_HERE):
+        level, frame = level + 1, frame.f_back
+    return level
+
+
+def version():
+    """The version of the loaded library, as MICA_VERSION_NUMBER (major*10000 + minor*100 + patch)."""
+    return native.mica_version()
+
+
+def _assign(array, value):
+    # Copies a (nested) Python sequence into a ctypes array field.
+    if len(value) != len(array):
+        raise ValueError("expected %d values, got %d" % (len(array), len(value)))
+    for i, v in enumerate(value):
+        if isinstance(array[i], ctypes.Array):
+            _assign(array[i], v)
+        else:
+            array[i] = v
+
+
+def _fill(struct, fields):
+    names = {f[0] for f in struct._fields_}
+    for key, value in fields.items():
+        if key not in names or key == "struct_size":
+            raise TypeError("%s has no settable field '%s'" % (type(struct).__name__, key))
+        current = getattr(struct, key)
+        if isinstance(current, ctypes.Array) and not isinstance(value, ctypes.Array):
+            _assign(current, value)
+        else:
+            setattr(struct, key, value)
+    return struct
+
+
+# The defs are filled by the *_init functions with this side's sizeof, so a newer library
+# sees exactly the fields this binding knows.
+def world_def(**fields):
+    """A mica_world_def with the library's defaults, then `fields` (gravity=(0, 0, 0), ...)."""
+    d = native.mica_world_def()
+    _check(native.mica_world_def_init(byref(d), sizeof(d), MICA_VERSION_NUMBER), None, "mica_world_def_init")
+    return _fill(d, fields)
+
+
+def body_def(**fields):
+    """A mica_body_def with the library's defaults, then `fields`."""
+    d = native.mica_body_def()
+    _check(native.mica_body_def_init(byref(d), sizeof(d)), None, "mica_body_def_init")
+    return _fill(d, fields)
+
+
+def lpc_def(**fields):
+    """A mica_lpc_def with the library's defaults, then `fields`."""
+    d = native.mica_lpc_def()
+    _check(native.mica_lpc_def_init(byref(d), sizeof(d)), None, "mica_lpc_def_init")
+    return _fill(d, fields)
+
+
+def tool_def(**fields):
+    """A mica_tool_def with the library's defaults, then `fields`."""
+    d = native.mica_tool_def()
+    _check(native.mica_tool_def_init(byref(d), sizeof(d)), None, "mica_tool_def_init")
+    return _fill(d, fields)
+
+
+def device_def(**fields):
+    """A mica_device_def with the library's defaults, then `fields`."""
+    d = native.mica_device_def()
+    _check(native.mica_device_def_init(byref(d), sizeof(d)), None, "mica_device_def_init")
+    return _fill(d, fields)
+
+
+def _doubles(values, n):
+    a = (c_double * n)(*values)
+    if len(values) != n:
+        raise ValueError("expected %d values, got %d" % (n, len(values)))
+    return a
+
+
+def _id_of(obj):
+    return getattr(obj, "id", obj) if obj is not None else native.MICA_NULL_ID
+
+
+class _PositionsView:
+    """Exposes the world's position buffer to numpy without a copy and keeps the world alive."""
+
+    def __init__(self, world, address, node_count):
+        self.world = world
+        self.__array_interface__ = {"shape": (node_count, 3), "typestr": "<f8", "data": (address, True),
+                                    "version": 3}
+
+
+class World:
+    """A simulation world (mica_world). Use it as a context manager, or call close().
+
+    Keyword arguments set mica_world_def fields over the defaults (gravity, solver, tolerance,
+    ...); `log` is an optional callable(level, message) for the library's messages.
+    """
+
+    def __init__(self, definition=None, log=None, **fields):
+        d = definition if definition is not None else world_def()
+        _fill(d, fields)
+        self._keepalive = []  # callbacks the library may call while the world exists
+        if log is not None:
+            def on_log(level, message, user):
+                log(level, message.decode(errors="replace"))
+            d.log = native.mica_log_fn(on_log)
+            self._keepalive.append(d.log)
+        handle = c_void_p()
+        _check(native.mica_world_create(byref(d), byref(handle)), None, "mica_world_create")
+        self._handle = handle
+
+    # --- lifetime
+    @property
+    def handle(self):
+        """The mica_world* as a c_void_p; raises if the world was closed."""
+        if self._handle is None:
+            raise MicaError(native.MICA_ERR_WRONG_STATE, "the world is closed")
+        return self._handle
+
+    @property
+    def closed(self):
+        return self._handle is None
+
+    def close(self):
+        """Destroys the world and everything in it. Views and ids from it become invalid."""
+        if getattr(self, "_handle", None) is not None:
+            native.mica_world_destroy(self._handle)
+            self._handle = None
+            self._keepalive = []
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    def __del__(self):
+        try:
+            self.close()
+        except Exception:  # interpreter shutdown: the module may be half torn down
+            pass
+
+    def _check(self, status, function=""):
+        return _check(status, self.handle, function)
+
+    @property
+    def last_error(self):
+        return (native.mica_world_last_error(self.handle) or b"").decode(errors="replace")
+
+    # --- world
+    def step(self, dt):
+        """Advances by dt seconds. Returns True, or False (and warns) when the solver stopped
+        at its iteration cap. Every positions view taken before is invalid afterwards."""
+        return self._check(native.mica_step(self.handle, dt), "mica_step") == native.MICA_OK
+
+    def set_gravity(self, gravity):
+        self._check(native.mica_world_set_gravity(self.handle, _doubles(gravity, 3)), "mica_world_set_gravity")
+
+    def stats(self):
+        """A mica_world_stats of the last step (stages indexed by MICA_STAGE_*)."""
+        s = native.mica_world_stats()
+        s.struct_size = sizeof(s)
+        self._check(native.mica_world_get_stats(self.handle, byref(s)), "mica_world_get_stats")
+        return s
+
+    def write_vtk(self, path):
+        self._check(native.mica_world_write_vtk(self.handle, str(path).encode()), "mica_world_write_vtk")
+
+    # --- creation
+    def create_body(self, nodes, tets, definition=None, **fields):
+        """A body from nodes (n, 3) in m and tets (m, 4) of 0-based indices."""
+        d = _fill(definition if definition is not None else body_def(), fields)
+        nodes = np.ascontiguousarray(nodes, dtype=np.float64).reshape(-1, 3)
+        tets = np.ascontiguousarray(tets, dtype=np.int32).reshape(-1, 4)
+        out = native.mica_body_id()
+        self._check(native.mica_body_create(self.handle, byref(d), nodes.ctypes.data_as(POINTER(c_double)),
+                                            len(nodes), tets.ctypes.data_as(POINTER(c_int32)), len(tets),
+                                            byref(out)), "mica_body_create")
+        return Body(self, out.value)
+
+    def create_body_from_file(self, path, definition=None, **fields):
+        d = _fill(definition if definition is not None else body_def(), fields)
+        out = native.mica_body_id()
+        self._check(native.mica_body_create_from_file(self.handle, byref(d), str(path).encode(), byref(out)),
+                    "mica_body_create_from_file")
+        return Body(self, out.value)
+
+    def create_box(self, lo, hi, cells, tets_per_cell=5, definition=None, **fields):
+        """A box [lo, hi] (m) of cells[0] x cells[1] x cells[2] cubes, 5 or 6 tets each."""
+        d = _fill(definition if definition is not None else body_def(), fields)
+        c = (c_int32 * 3)(*cells)
+        out = native.mica_body_id()
+        self._check(native.mica_body_create_box(self.handle, byref(d), _doubles(lo, 3), _doubles(hi, 3), c,
+                                                tets_per_cell, byref(out)), "mica_body_create_box")
+        return Body(self, out.value)
+
+    def create_tool(self, definition=None, hull_points=None, **fields):
+        """A kinematic tool; fields of mica_tool_def (shape, radius, position, ...)."""
+        d = _fill(definition if definition is not None else tool_def(), fields)
+        if hull_points is not None:
+            pts = np.ascontiguousarray(hull_points, dtype=np.float64).reshape(-1, 3)
+            d.hull_points = pts.ctypes.data_as(POINTER(c_double))  # copied by the library
+            d.hull_point_count = len(pts)
+        out = native.mica_tool_id()
+        self._check(native.mica_tool_create(self.handle, byref(d), byref(out)), "mica_tool_create")
+        return Tool(self, out.value)
+
+    def create_device(self, backend=None, tool=None, trajectory=None, definition=None, **fields):
+        """A haptic device driving `tool`. `backend` is a DeviceBackend (its methods become the
+        callback table) or None for the def's backend (MICA_DEVICE_NULL by default);
+        `trajectory` is a callable t -> (x, y, z) for a simulated device."""
+        d = _fill(definition if definition is not None else device_def(), fields)
+        d.tool = _id_of(tool)
+        table = None
+        if backend is not None:
+            table = backend._table()
+            d.backend = native.MICA_DEVICE_CALLBACKS
+            d.callbacks = ctypes.pointer(table)
+            self._keepalive.append(table)
+        if trajectory is not None:
+            def on_trajectory(t, position, user):
+                p = trajectory(t)
+                position[0], position[1], position[2] = p[0], p[1], p[2]
+            d.trajectory = native.mica_trajectory_fn(on_trajectory)
+            self._keepalive.append(d.trajectory)
+        out = native.mica_device_id()
+        self._check(native.mica_device_create(self.handle, byref(d), byref(out)), "mica_device_create")
+        return Device(self, out.value, backend)
+
+
+class _Object:
+    """An object of a world, named by its 64-bit id; it holds a reference to the World."""
+
+    def __init__(self, world, id_):
+        self.world = world
+        self.id = id_
+
+    def __repr__(self):
+        return "%s(0x%016x)" % (type(self).__name__, self.id)
+
+    def __eq__(self, other):
+        return type(self) is type(other) and self.world is other.world and self.id == other.id
+
+    def __hash__(self):
+        return hash((id(self.world), self.id))
+
+
+def _read_items(call, width, dtype):
+    # The size-query protocol: ask for the count, then fill a buffer of that size.
+    count = c_int32()
+    call(None, 0, byref(count))
+    ctype = c_double if dtype == np.float64 else c_int32
+    out = np.empty((count.value, width), dtype=dtype)
+    call(out.ctypes.data_as(POINTER(ctype)), count.value, byref(count))
+    return out
+
+
+class Body(_Object):
+    """A deformable (or static) body."""
+
+    def counts(self):
+        """(node_count, tet_count, triangle_count)."""
+        n, t, tri = c_int32(), c_int32(), c_int32()
+        self.world._check(native.mica_body_get_counts(self.world.handle, self.id, byref(n), byref(t), byref(tri)),
+                          "mica_body_get_counts")
+        return n.value, t.value, tri.value
+
+    @property
+    def positions(self):
+        """Read-only numpy (n, 3) view of the current positions (m), no copy. It keeps the World
+        alive but is valid only until the next step (or the body's or world's destruction):
+        fetch it again after every step, or copy it (get_positions())."""
+        ptr, n = POINTER(c_double)(), c_int32()
+        self.world._check(native.mica_body_positions_view(self.world.handle, self.id, byref(ptr), byref(n)),
+                          "mica_body_positions_view")
+        if n.value == 0:
+            return np.empty((0, 3))
+        return np.asarray(_PositionsView(self.world, ctypes.cast(ptr, c_void_p).value, n.value))
+
+    def _get(self, fn, width, dtype, name):
+        w = self.world
+        return _read_items(lambda out, cap, cnt: w._check(fn(w.handle, self.id, out, cap, cnt), name), width, dtype)
+
+    def get_positions(self):
+        """A copy of the current positions (m), (n, 3)."""
+        return self._get(native.mica_body_get_positions, 3, np.float64, "mica_body_get_positions")
+
+    def velocities(self):
+        return self._get(native.mica_body_get_velocities, 3, np.float64, "mica_body_get_velocities")
+
+    def rest_positions(self):
+        return self._get(native.mica_body_get_rest_positions, 3, np.float64, "mica_body_get_rest_positions")
+
+    def surface(self):
+        """Surface triangles (k, 3), counter-clockwise seen from outside."""
+        return self._get(native.mica_body_get_surface, 3, np.int32, "mica_body_get_surface")
+
+    def select_nodes_in_box(self, lo, hi, use_rest=True):
+        w, lo, hi = self.world, _doubles(lo, 3), _doubles(hi, 3)
+        return _read_items(lambda out, cap, cnt: w._check(native.mica_body_select_nodes_in_box(
+            w.handle, self.id, lo, hi, int(use_rest), out, cap, cnt), "mica_body_select_nodes_in_box"),
+            1, np.int32).ravel()
+
+    def select_nodes_by_plane(self, point, normal, tolerance=1e-9, use_rest=True):
+        """Nodes with (p - point) . normal <= tolerance."""
+        w, p, nrm = self.world, _doubles(point, 3), _doubles(normal, 3)
+        return _read_items(lambda out, cap, cnt: w._check(native.mica_body_select_nodes_by_plane(
+            w.handle, self.id, p, nrm, tolerance, int(use_rest), out, cap, cnt), "mica_body_select_nodes_by_plane"),
+            1, np.int32).ravel()
+
+    def set_node_forces(self, nodes, forces):
+        nodes = np.ascontiguousarray(nodes, dtype=np.int32).ravel()
+        forces = np.ascontiguousarray(forces, dtype=np.float64).reshape(-1, 3)
+        if len(forces) != len(nodes):
+            raise ValueError("one force per node")
+        self.world._check(native.mica_body_set_node_forces(
+            self.world.handle, self.id, nodes.ctypes.data_as(POINTER(c_int32)),
+            forces.ctypes.data_as(POINTER(c_double)), len(nodes)), "mica_body_set_node_forces")
+
+    def energy(self):
+        """(kinetic, elastic, potential) in J."""
+        k, e, p = c_double(), c_double(), c_double()
+        self.world._check(native.mica_body_get_energy(self.world.handle, self.id, byref(k), byref(e), byref(p)),
+                          "mica_body_get_energy")
+        return k.value, e.value, p.value
+
+    def add_lpc(self, nodes, definition=None, **fields):
+        """A projection constraint on `nodes` (kind=MICA_LPC_FIXED by default)."""
+        d = _fill(definition if definition is not None else lpc_def(), fields)
+        nodes = np.ascontiguousarray(nodes, dtype=np.int32).ravel()
+        out = native.mica_lpc_id()
+        self.world._check(native.mica_add_lpc(self.world.handle, self.id, nodes.ctypes.data_as(POINTER(c_int32)),
+                                              len(nodes), byref(d), byref(out)), "mica_add_lpc")
+        return Lpc(self.world, out.value)
+
+    def grab(self, center, radius, tool=None):
+        """Holds the nodes within `radius` of `center` on a handle (following `tool` if given)."""
+        out = native.mica_lpc_id()
+        self.world._check(native.mica_lpc_grab(self.world.handle, self.id, _doubles(center, 3), radius,
+                                               _id_of(tool), byref(out)), "mica_lpc_grab")
+        return Lpc(self.world, out.value)
+
+    def write_vtk(self, path):
+        self.world._check(native.mica_body_write_vtk(self.world.handle, self.id, str(path).encode()),
+                          "mica_body_write_vtk")
+
+    def destroy(self):
+        self.world._check(native.mica_body_destroy(self.world.handle, self.id), "mica_body_destroy")
+
+
+class Lpc(_Object):
+    """A linear projection constraint group (fixed nodes, a plane, a grab)."""
+
+    def set_velocity(self, velocity):
+        self.world._check(native.mica_lpc_set_velocity(self.world.handle, self.id, _doubles(velocity, 3)),
+                          "mica_lpc_set_velocity")
+
+    def set_targets(self, targets):
+        t = np.ascontiguousarray(targets, dtype=np.float64).reshape(-1, 3)
+        self.world._check(native.mica_lpc_set_targets(self.world.handle, self.id,
+                                                      t.ctypes.data_as(POINTER(c_double)), len(t)),
+                          "mica_lpc_set_targets")
+
+    def set_handle_pose(self, position, orientation=(1, 0, 0, 0)):
+        self.world._check(native.mica_lpc_set_handle_pose(self.world.handle, self.id, _doubles(position, 3),
+                                                          _doubles(orientation, 4)), "mica_lpc_set_handle_pose")
+
+    def nodes(self):
+        w = self.world
+        return _read_items(lambda out, cap, cnt: w._check(native.mica_lpc_get_nodes(w.handle, self.id, out, cap, cnt),
+                                                          "mica_lpc_get_nodes"), 1, np.int32).ravel()
+
+    def reaction(self):
+        """Reaction force (N) of the last step, as a numpy 3-vector."""
+        f = (c_double * 3)()
+        self.world._check(native.mica_lpc_get_reaction(self.world.handle, self.id, f), "mica_lpc_get_reaction")
+        return np.array(f[:])
+
+    def remove(self):
+        self.world._check(native.mica_lpc_remove(self.world.handle, self.id), "mica_lpc_remove")
+
+
+class Tool(_Object):
+    """A kinematic rigid tool: the host sets its pose, the bodies push back on it."""
+
+    def set_pose(self, position, orientation=(1, 0, 0, 0)):
+        self.world._check(native.mica_tool_set_pose(self.world.handle, self.id, _doubles(position, 3),
+                                                    _doubles(orientation, 4)), "mica_tool_set_pose")
+
+    def pose(self):
+        """(position m, orientation quaternion w, x, y, z) as numpy vectors; a tool driven by a
+        device takes the device's pose at each step."""
+        p, q = (c_double * 3)(), (c_double * 4)()
+        self.world._check(native.mica_tool_get_pose(self.world.handle, self.id, p, q), "mica_tool_get_pose")
+        return np.array(p[:]), np.array(q[:])
+
+    def force(self):
+        """(force N, torque N m, contacts) of the last step; force and torque as numpy 3-vectors."""
+        f, t, n = (c_double * 3)(), (c_double * 3)(), c_int32()
+        self.world._check(native.mica_tool_get_force(self.world.handle, self.id, f, t, byref(n)),
+                          "mica_tool_get_force")
+        return np.array(f[:]), np.array(t[:]), n.value
+
+    def destroy(self):
+        self.world._check(native.mica_tool_destroy(self.world.handle, self.id), "mica_tool_destroy")
+
+
+class DeviceBackend:
+    """A haptic device implemented in Python: override read_state and write_force (and open,
+    close, info if needed), pass it to World.create_device(backend=...).
+
+    read_state and write_force run on the servo thread (the caller of Device.poll(), or libmica's
+    own 1 kHz thread after Device.start()); they take the GIL, so a Python backend suits tests and
+    simulations, not a real 1 kHz device. An exception inside a callback becomes MICA_ERR_DEVICE
+    and is kept in .error.
+    """
+
+    error = None
+
+    def open(self):
+        pass
+
+    def close(self):
+        pass
+
+    def info(self, out):
+        """Fill `out` (a mica_device_info); leave this method alone to use libmica's defaults."""
+
+    def read_state(self, state):
+        """Fill `state` (a mica_device_state: position, orientation, velocity, buttons, timestamp)."""
+        raise NotImplementedError
+
+    def write_force(self, force, torque):
+        """Render `force` (N) and `torque` (N m), both 3-tuples in the device frame."""
+        raise NotImplementedError
+
+    def _guard(self, f):
+        # No Python exception may unwind into C: report it as a device failure.
+        def call(*args):
+            try:
+                f(*args)
+                return native.MICA_OK
+            except Exception as e:  # noqa: BLE001 - every failure is the device's
+                self.error = e
+                return native.MICA_ERR_DEVICE
+        return call
+
+    def _table(self):
+        t = native.mica_device_callbacks()
+        t.struct_size = sizeof(t)
+        t.open = native.mica_device_open_fn(self._guard(lambda user: self.open()))
+        close = self._guard(lambda user: self.close())
+        t.close = native.mica_device_close_fn(lambda user: close(user) and None)
+        if type(self).info is not DeviceBackend.info:
+            t.info = native.mica_device_info_fn(self._guard(lambda user, out: self.info(out.contents)))
+        t.read_state = native.mica_device_read_state_fn(self._guard(lambda user, out: self.read_state(out.contents)))
+        t.write_force = native.mica_device_write_force_fn(
+            self._guard(lambda user, f, tq: self.write_force((f[0], f[1], f[2]), (tq[0], tq[1], tq[2]))))
+        return t
+
+
+class Device(_Object):
+    """A haptic device driving a tool. poll() is the servo cycle: call it on the servo thread
+    (or start() libmica's own 1 kHz loop)."""
+
+    def __init__(self, world, id_, backend=None):
+        super().__init__(world, id_)
+        self.backend = backend
+
+    def poll(self):
+        """One servo cycle: returns (mica_device_state read, force sent as a numpy 3-vector).
+        A failing device (zero force sent) raises MicaError without a message: the world's
+        last error belongs to the simulation thread. Warnings (MICA_WARN_DEVICE) are not
+        issued here, at servo rate; stats().last_status has them."""
+        s = native.mica_device_state()
+        s.struct_size = sizeof(s)
+        f = (c_double * 3)()
+        status = native.mica_device_poll(self.world.handle, self.id, byref(s), f)
+        if status < 0:
+            raise MicaError(status, "", "mica_device_poll")
+        return s, np.array(f[:])
+
+    def start(self):
+        self.world._check(native.mica_device_start(self.world.handle, self.id), "mica_device_start")
+
+    def stop(self):
+        self.world._check(native.mica_device_stop(self.world.handle, self.id), "mica_device_stop")
+
+    def info(self):
+        i = native.mica_device_info()
+        i.struct_size = sizeof(i)
+        self.world._check(native.mica_device_get_info(self.world.handle, self.id, byref(i)), "mica_device_get_info")
+        return i
+
+    def stats(self):
+        s = native.mica_device_stats()
+        s.struct_size = sizeof(s)
+        self.world._check(native.mica_device_get_stats(self.world.handle, self.id, byref(s)), "mica_device_get_stats")
+        return s
+
+    def destroy(self):
+        self.world._check(native.mica_device_destroy(self.world.handle, self.id), "mica_device_destroy")

@@ -1,0 +1,384 @@
+// Tests of the C# binding (bindings/csharp/com.libmica.mica/Runtime): its declarations against the
+// header manifest (the drift guard), the sphere-indent scene against the C reference, errors,
+// the SafeHandle, the log callback and a device backend written in C#.
+// Environment (tests/bindings/CMakeLists.txt): MICA_MANIFEST_TSV, MICA_REFERENCE; libmica on
+// LD_LIBRARY_PATH.
+using System;
+using System.Collections.Generic;
+using System.Globalization;
+using System.IO;
+using System.Linq;
+using System.Reflection;
+using System.Runtime.CompilerServices;
+using System.Runtime.InteropServices;
+using LibMica;
+
+class Skip : Exception
+{
+    public Skip(string why) : base(why) { }
+}
+
+static class TestMica
+{
+    static int passed, failed, skipped;
+
+    static void Test(string name, Action body)
+    {
+        try
+        {
+            body();
+            passed++;
+            Console.WriteLine("ok   " + name);
+        }
+        catch (Skip s)
+        {
+            skipped++;
+            Console.WriteLine("SKIP " + name + ": " + s.Message);
+        }
+        catch (Exception e)
+        {
+            failed++;
+            Console.WriteLine("FAIL " + name + ": " + e);
+        }
+    }
+
+    static void Expect(bool condition, string message)
+    {
+        if (!condition) throw new Exception(message);
+    }
+
+    // --- The manifest (tab-separated, see tests/bindings/header_manifest.py)
+    class Param { public string Name, Class; public int Size; }
+    class Function { public string Name, ReturnClass; public int ReturnSize; public List<Param> Params = new List<Param>(); }
+    class Field { public string Name, Class; public int Offset, Size; }
+    class Struct { public string Name; public int Size; public List<Field> Fields = new List<Field>(); }
+
+    static readonly Dictionary<string, Function> functions = new Dictionary<string, Function>();
+    static readonly Dictionary<string, Struct> structs = new Dictionary<string, Struct>();
+    static readonly Dictionary<string, int> callbacks = new Dictionary<string, int>();
+    static readonly Dictionary<string, long> constants = new Dictionary<string, long>();
+
+    static void ReadManifest(string path)
+    {
+        foreach (var line in File.ReadAllLines(path))
+        {
+            var c = line.Split('\t');
+            switch (c[0])
+            {
+                case "function":
+                    functions[c[1]] = new Function { Name = c[1], ReturnClass = c[2], ReturnSize = int.Parse(c[3]) };
+                    break;
+                case "param":
+                    functions[c[1]].Params.Add(new Param { Name = c[3], Class = c[4], Size = int.Parse(c[5]) });
+                    break;
+                case "struct":
+                    structs[c[1]] = new Struct { Name = c[1], Size = int.Parse(c[2]) };
+                    break;
+                case "field":
+                    structs[c[1]].Fields.Add(new Field { Name = c[2], Offset = int.Parse(c[3]), Size = int.Parse(c[4]), Class = c[5] });
+                    break;
+                case "callback":
+                    callbacks[c[1]] = int.Parse(c[2]);
+                    break;
+                case "constant":
+                    constants[c[1]] = long.Parse(c[2], CultureInfo.InvariantCulture);
+                    break;
+            }
+        }
+    }
+
+    // (class, size) of a P/Invoke parameter or return type, as the manifest names them.
+    static string Classify(Type t, out int size)
+    {
+        size = IntPtr.Size;
+        if (t == typeof(void)) { size = 0; return "void"; }
+        if (t.IsByRef || t.IsArray || t.IsPointer || t == typeof(IntPtr) || t == typeof(string) ||
+            typeof(SafeHandle).IsAssignableFrom(t))
+            return "ptr";
+        size = Marshal.SizeOf(t);
+        if (t == typeof(double) || t == typeof(float)) return "float";
+        if (t == typeof(int) || t == typeof(long) || t == typeof(short) || t == typeof(sbyte)) return "int";
+        if (t == typeof(uint) || t == typeof(ulong) || t == typeof(ushort) || t == typeof(byte)) return "uint";
+        return "struct";
+    }
+
+    static void DriftFunctions()
+    {
+        var imports = typeof(MicaNative).GetMethods(BindingFlags.Public | BindingFlags.Static)
+            .Where(m => (m.Attributes & MethodAttributes.PinvokeImpl) != 0).ToList();
+        var names = new HashSet<string>(imports.Select(m => m.Name));
+        foreach (var f in functions.Keys) Expect(names.Contains(f), f + " is not declared");
+        foreach (var m in imports)
+        {
+            Function f;
+            Expect(functions.TryGetValue(m.Name, out f), m.Name + " is not in the header");
+            var ps = m.GetParameters();
+            Expect(ps.Length == f.Params.Count, m.Name + ": " + ps.Length + " parameters, the header has " + f.Params.Count);
+            int size;
+            Expect(Classify(m.ReturnType, out size) == f.ReturnClass && size == f.ReturnSize, m.Name + ": return type");
+            for (int i = 0; i < ps.Length; ++i)
+            {
+                string cls = Classify(ps[i].ParameterType, out size);
+                Expect(cls == f.Params[i].Class && size == f.Params[i].Size,
+                       string.Format("{0}: parameter {1} ({2}) is {3}/{4}, the header has {5}/{6}", m.Name, i,
+                                     f.Params[i].Name, cls, size, f.Params[i].Class, f.Params[i].Size));
+            }
+            var import = (DllImportAttribute)Attribute.GetCustomAttribute(m, typeof(DllImportAttribute));
+            if (import != null)
+            {
+                Expect(import.CallingConvention == CallingConvention.Cdecl, m.Name + ": Cdecl");
+                Expect(import.EntryPoint == null || import.EntryPoint == m.Name, m.Name + ": entry point");
+            }
+        }
+    }
+
+    static void DriftStructs()
+    {
+        var mirrors = typeof(MicaNative).GetNestedTypes().Where(t => t.IsValueType && t.Name.StartsWith("mica_")).ToList();
+        var names = new HashSet<string>(mirrors.Select(t => t.Name));
+        foreach (var s in structs.Keys) Expect(names.Contains(s), s + " has no mirror");
+        foreach (var t in mirrors)
+        {
+            Struct s;
+            Expect(structs.TryGetValue(t.Name, out s), t.Name + " is not in the header");
+            Expect(t.IsLayoutSequential, t.Name + ": sequential layout");
+            Expect(Marshal.SizeOf(t) == s.Size, t.Name + ": size " + Marshal.SizeOf(t) + ", header " + s.Size);
+            var fields = t.GetFields(BindingFlags.Instance | BindingFlags.Public | BindingFlags.NonPublic)
+                .OrderBy(f => (long)Marshal.OffsetOf(t, f.Name)).ToList();
+            Expect(string.Join(",", fields.Select(f => f.Name)) == string.Join(",", s.Fields.Select(f => f.Name)),
+                   t.Name + ": fields " + string.Join(",", fields.Select(f => f.Name)));
+            for (int i = 0; i < fields.Count; ++i)
+            {
+                var f = fields[i];
+                var h = s.Fields[i];
+                string where = t.Name + "." + f.Name;
+                Expect((int)Marshal.OffsetOf(t, f.Name) == h.Offset, where + ": offset");
+                var fixedBuffer = (FixedBufferAttribute)Attribute.GetCustomAttribute(f, typeof(FixedBufferAttribute));
+                int size;
+                string cls;
+                if (fixedBuffer != null)
+                {
+                    cls = Classify(fixedBuffer.ElementType, out size);
+                    size *= fixedBuffer.Length;
+                    // Bytes stand for char arrays and for arrays of structs (fixed buffers hold primitives only).
+                    if (fixedBuffer.ElementType == typeof(byte) && (h.Class == "char" || h.Class == "struct")) cls = h.Class;
+                }
+                else
+                {
+                    cls = Classify(f.FieldType, out size);
+                }
+                Expect(size == h.Size, where + ": size " + size + ", header " + h.Size);
+                Expect(cls == h.Class, where + ": " + cls + ", header " + h.Class);
+                Expect(f.FieldType != typeof(bool), where + ": no bool in a blittable struct");
+            }
+        }
+    }
+
+    static void DriftCallbacksAndConstants()
+    {
+        foreach (var kv in callbacks)
+        {
+            var d = typeof(MicaNative).GetNestedType(kv.Key);
+            Expect(d != null && typeof(Delegate).IsAssignableFrom(d), kv.Key + ": no delegate");
+            Expect(d.GetMethod("Invoke").GetParameters().Length == kv.Value, kv.Key + ": parameter count");
+            var ufp = (UnmanagedFunctionPointerAttribute)Attribute.GetCustomAttribute(d, typeof(UnmanagedFunctionPointerAttribute));
+            Expect(ufp != null && ufp.CallingConvention == CallingConvention.Cdecl, kv.Key + ": Cdecl");
+        }
+        var mine = typeof(MicaNative).GetFields(BindingFlags.Public | BindingFlags.Static)
+            .Where(f => f.IsLiteral && f.Name.StartsWith("MICA_")).ToDictionary(f => f.Name, f => Convert.ToInt64(f.GetRawConstantValue()));
+        foreach (var kv in constants)
+        {
+            Expect(mine.ContainsKey(kv.Key), kv.Key + " is not declared");
+            Expect(mine[kv.Key] == kv.Value, kv.Key + " = " + mine[kv.Key] + ", header " + kv.Value);
+        }
+        foreach (var k in mine.Keys) Expect(constants.ContainsKey(k), k + " is not in the header");
+    }
+
+    // --- The scene of examples_c/sphere_indent.c, the same operations in the same order.
+    static void SphereIndent()
+    {
+        var reference = File.ReadAllLines(Environment.GetEnvironmentVariable("MICA_REFERENCE"))
+            .Select(l => l.Split(',')).ToList();
+        double L = 0.1, E = 1e4, nu = 0.4, rho = 1000.0, dt = 0.01;
+        double R = 0.02, margin = 0.0015, start_gap = 0.005, max_depth = 0.015;
+        int cells = 12, steps = reference.Count;
+        var wdef = Mica.WorldDef();
+        unsafe { wdef.gravity[0] = wdef.gravity[1] = wdef.gravity[2] = 0; }
+        wdef.solver = MicaNative.MICA_SOLVER_MICA;
+        wdef.max_iterations = 2000;
+        wdef.tolerance = 1e-6;
+        double worst = 0;
+        using (var world = new World(wdef))
+        {
+            var bdef = Mica.BodyDef();
+            bdef.youngs_modulus = E;
+            bdef.poisson_ratio = nu;
+            bdef.density = rho;
+            bdef.rayleigh_alpha = 2.0;
+            bdef.rayleigh_beta = 0.005;
+            var cube = world.CreateBox(new[] { -L / 2, 0, -L / 2 }, new[] { L / 2, L, L / 2 }, new[] { cells, cells, cells }, 5, bdef);
+            var bottom = cube.SelectNodesByPlane(new double[] { 0, 0, 0 }, new double[] { 0, 1, 0 }, 1e-9, true);
+            var fixedDef = Mica.LpcDef();
+            fixedDef.kind = MicaNative.MICA_LPC_FIXED;
+            cube.AddLpc(bottom, fixedDef);
+            double y_start = L + R + start_gap;
+            var tdef = Mica.ToolDef();
+            tdef.shape = MicaNative.MICA_TOOL_SPHERE;
+            tdef.radius = R;
+            tdef.margin = margin;
+            unsafe { tdef.position[0] = 0; tdef.position[1] = y_start; tdef.position[2] = 0; }
+            var sphere = world.CreateTool(tdef);
+            int n_load = steps / 3, n_hold = steps / 6, n_unload = steps / 3;
+            double travel = start_gap + max_depth, speed = travel / (n_load * dt);
+            for (int k = 1; k <= steps; ++k)
+            {
+                double y;
+                if (k <= n_load) y = y_start - speed * k * dt;
+                else if (k <= n_load + n_hold) y = y_start - travel;
+                else if (k <= n_load + n_hold + n_unload) y = y_start - travel + speed * (k - n_load - n_hold) * dt;
+                else y = y_start;
+                sphere.SetPose(new[] { 0, y, 0 }, new double[] { 1, 0, 0, 0 });
+                world.Step(dt);
+                double[] torque;
+                int contacts;
+                var f = sphere.GetForce(out torque, out contacts);
+                var r = reference[k - 1];
+                var rf = new[] { double.Parse(r[1], CultureInfo.InvariantCulture), double.Parse(r[2], CultureInfo.InvariantCulture),
+                                 double.Parse(r[3], CultureInfo.InvariantCulture) };
+                Expect(contacts == int.Parse(r[4]), "step " + k + ": contacts");
+                double scale = Math.Max(Math.Sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]),
+                                        Math.Sqrt(rf[0] * rf[0] + rf[1] * rf[1] + rf[2] * rf[2]));
+                for (int i = 0; i < 3; ++i)
+                {
+                    double d = Math.Abs(f[i] - rf[i]);
+                    Expect(d <= 1e-9 * scale, string.Format(CultureInfo.InvariantCulture, "step {0}: force[{1}] {2:R} vs C {3:R}", k, i, f[i], rf[i]));
+                    if (scale > 0) worst = Math.Max(worst, d / scale);
+                }
+            }
+        }
+        Console.WriteLine("     ({0} steps, largest deviation from C {1:G3} of the force)", steps, worst);
+    }
+
+    static void Errors()
+    {
+        var messages = new List<string>();
+        var world = new World(Mica.WorldDef(), (level, text) => messages.Add(level + ": " + text));
+        try
+        {
+            world.CreateBox(new double[] { 0, 0, 0 }, new double[] { -1, 1, 1 }, new[] { 1, 1, 1 }, 5, Mica.BodyDef());
+            throw new Exception("no exception");
+        }
+        catch (MicaException e)
+        {
+            Expect(e.Status == MicaNative.MICA_ERR_INVALID_ARGUMENT, "status " + e.Status);
+            Expect(e.LibraryMessage.Contains("hi[0]"), "message: " + e.LibraryMessage);
+        }
+        Expect(messages.Count == 1 && messages[0].StartsWith(MicaNative.MICA_LOG_ERROR + ": "), "the log callback: " + string.Join("|", messages));
+        var body = world.CreateBox(new double[] { 0, 0, 0 }, new double[] { 1, 1, 1 }, new[] { 1, 1, 1 }, 5, Mica.BodyDef());
+        body.Destroy();
+        try { int n, t, tri; body.GetCounts(out n, out t, out tri); throw new Exception("no exception"); }
+        catch (MicaException e) { Expect(e.Status == MicaNative.MICA_ERR_STALE_ID, "stale id: " + e.Status); }
+        world.Dispose();
+        world.Dispose(); // twice is harmless
+        try { world.Step(0.01); throw new Exception("no exception"); }
+        catch (ObjectDisposedException) { }
+        var def = Mica.WorldDef();
+        def.header_version = (uint)((MicaNative.MICA_VERSION_MAJOR + 1) * 10000);
+        try { new World(def); throw new Exception("no exception"); }
+        catch (MicaException e) { Expect(e.Status == MicaNative.MICA_ERR_VERSION_MISMATCH, "version: " + e.Status); }
+    }
+
+    static void DefaultsAndViews()
+    {
+        var def = Mica.WorldDef();
+        unsafe
+        {
+            Expect(def.struct_size == (uint)sizeof(MicaNative.mica_world_def), "struct_size");
+            Expect(def.gravity[1] == -9.81, "default gravity");
+        }
+        Expect(def.header_version == MicaNative.MICA_VERSION_NUMBER, "header_version");
+        Expect(Mica.Version / 10000 == MicaNative.MICA_VERSION_MAJOR, "major version");
+        using (var world = new World(def))
+        {
+            var body = world.CreateBox(new double[] { 0, 0, 0 }, new double[] { 1, 1, 1 }, new[] { 2, 2, 2 }, 5, Mica.BodyDef());
+            var view = body.Positions();
+            var copy = body.GetPositions();
+            Expect(view.NodeCount * 3 == copy.Length, "node count");
+            for (int i = 0; i < view.NodeCount; ++i)
+                for (int a = 0; a < 3; ++a) Expect(view[i, a] == copy[3 * i + a], "view vs copy");
+            Expect(world.Step(0.01), "converged");
+            view = body.Positions(); // a new view after each step
+            Expect(view[0, 1] < 0, "the box falls");
+            var tdef = Mica.ToolDef();
+            unsafe { tdef.position[2] = 3; }
+            var tool = world.CreateTool(tdef);
+            double[] p = new double[3], q = new double[4];
+            tool.GetPose(p, q);
+            Expect(p[2] == 3 && q[0] == 1, "tool pose");
+            var stats = world.GetStats();
+            Expect(stats.step_count == 1 && stats.Stage(MicaNative.MICA_STAGE_SOLVE).runs_last_step == 1, "stats");
+        }
+    }
+
+    sealed class Stylus : DeviceBackend
+    {
+        public int Reads, Writes, Opened, Closed;
+        public double[] LastForce = new double[3];
+
+        public override void Open() { Opened++; }
+        public override void Close() { Closed++; }
+
+        public override void ReadState(ref MicaNative.mica_device_state state)
+        {
+            Reads++;
+            unsafe
+            {
+                // A ref parameter may point into the heap: fixed buffers in it are pinned first.
+                fixed (double* p = state.position) p[1] = 0.1;
+                fixed (double* q = state.orientation) q[0] = 1;
+            }
+            state.timestamp = Reads * 0.001;
+        }
+
+        public override void WriteForce(double fx, double fy, double fz, double tx, double ty, double tz)
+        {
+            Writes++;
+            LastForce[0] = fx; LastForce[1] = fy; LastForce[2] = fz;
+        }
+    }
+
+    static void DeviceBackendInCSharp()
+    {
+        try { Mica.DeviceDef(); }
+        catch (EntryPointNotFoundException) { throw new Skip("the loaded libmica has no device functions yet"); }
+        using (var world = new World(Mica.WorldDef()))
+        {
+            var tool = world.CreateTool(Mica.ToolDef());
+            var stylus = new Stylus();
+            var device = world.CreateDevice(Mica.DeviceDef(), tool, stylus);
+            Expect(stylus.Opened == 1, "opened");
+            var state = new MicaNative.mica_device_state();
+            var force = new double[3];
+            Expect(device.Poll(ref state, force) >= 0, "poll");
+            Expect(stylus.Reads >= 1 && stylus.Writes >= 1, "a read and a write per poll");
+            unsafe { Expect(state.position[1] == 0.1, "the state read"); }
+            Expect(force.SequenceEqual(stylus.LastForce), "the force sent is returned");
+            device.Destroy();
+            Expect(stylus.Closed == 1 && stylus.Error == null, "closed");
+        }
+    }
+
+    static int Main()
+    {
+        ReadManifest(Environment.GetEnvironmentVariable("MICA_MANIFEST_TSV"));
+        Test("drift: functions, parameter types and calling convention", DriftFunctions);
+        Test("drift: struct sizes, field offsets, sizes and types", DriftStructs);
+        Test("drift: callbacks and constants", DriftCallbacksAndConstants);
+        Test("defaults, views and stats", DefaultsAndViews);
+        Test("errors, the log callback and the SafeHandle", Errors);
+        Test("sphere indent matches C to 1e-9", SphereIndent);
+        Test("a device backend in C#", DeviceBackendInCSharp);
+        Console.WriteLine("{0} passed, {1} failed, {2} skipped", passed, failed, skipped);
+        return failed == 0 ? 0 : 1;
+    }
+}

@@ -1,0 +1,17 @@
+#!/bin/sh
+# run_csharp.sh <TestMica.cs>: compiles the C# binding (the Unity package's Runtime/) with its
+# test using mcs and runs it on mono (exit 77, a skip, without them or the manifest).
+set -eu
+if ! command -v mcs >/dev/null 2>&1 || ! command -v mono >/dev/null 2>&1; then
+  echo "SKIP: mcs or mono not found (Debian packages mono-mcs, mono-runtime)"
+  exit 77
+fi
+if [ ! -f "$MICA_MANIFEST_TSV" ]; then
+  echo "SKIP: $MICA_MANIFEST_TSV was not generated (configure found no python3)"
+  exit 77
+fi
+runtime=$MICA_SOURCE_DIR/bindings/csharp/com.libmica.mica/Runtime
+exe=$MICA_TEST_WORK_DIR/TestMica.exe
+mcs -nologo -warnaserror+ -unsafe -langversion:7.2 -out:"$exe" "$runtime"/*.cs "$1"
+# [DllImport("mica")] resolves to libmica.so on the library path.
+LD_LIBRARY_PATH=$MICA_LIBRARY_DIR${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH} exec mono --debug "$exe"

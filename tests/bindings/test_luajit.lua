@@ -1,0 +1,232 @@
+-- Tests of the LuaJIT binding (bindings/luajit): the generated cdef against the header
+-- manifest (the drift guard), the sphere-indent scene against the C reference, errors, devices.
+-- Environment (tests/bindings/CMakeLists.txt): MICA_LIBRARY, MICA_MANIFEST_TSV, MICA_REFERENCE;
+-- LUA_PATH finds mica.lua and the generated mica_cdef.lua.
+local ffi = require("ffi")
+local mica = require("mica")
+local C = mica.C
+
+local passed, failed, skipped = 0, 0, 0
+
+local function test(name, fn)
+  local ok, err = pcall(fn)
+  if ok and err == "skip" then
+    skipped = skipped + 1
+    print("SKIP " .. name)
+  elseif ok then
+    passed = passed + 1
+    print("ok   " .. name)
+  else
+    failed = failed + 1
+    print("FAIL " .. name .. ": " .. tostring(err))
+  end
+end
+
+local function expect(cond, message)
+  if not cond then error(message, 2) end
+end
+
+-- The manifest: tab-separated rows (see tests/bindings/header_manifest.py).
+local manifest = { functions = {}, function_order = {}, structs = {}, struct_order = {}, typedefs = {}, constants = {} }
+for line in io.lines(os.getenv("MICA_MANIFEST_TSV")) do
+  local row = {}
+  for cell in line:gmatch("[^\t]+") do row[#row + 1] = cell end
+  local kind = row[1]
+  if kind == "function" then
+    manifest.functions[row[2]] = tonumber(row[5])
+    manifest.function_order[#manifest.function_order + 1] = row[2]
+  elseif kind == "struct" then
+    manifest.structs[row[2]] = { size = tonumber(row[3]), align = tonumber(row[4]), fields = {} }
+    manifest.struct_order[#manifest.struct_order + 1] = row[2]
+  elseif kind == "field" then
+    local f = manifest.structs[row[2]].fields
+    f[#f + 1] = { name = row[3], offset = tonumber(row[4]), size = tonumber(row[5]) }
+  elseif kind == "typedef" then
+    manifest.typedefs[row[2]] = tonumber(row[3])
+  elseif kind == "constant" then
+    manifest.constants[row[2]] = tonumber(row[3])
+  end
+end
+
+-- Function declarations of the cdef string ffi.cdef received: name -> argument count.
+local function cdef_functions(cdef)
+  local found = {}
+  local depth, statement = 0, {}
+  for ch in cdef:gmatch(".") do
+    if ch == "{" then depth = depth + 1 elseif ch == "}" then depth = depth - 1 end
+    if ch == ";" and depth == 0 then
+      local s = table.concat(statement):gsub("%s+", " ")
+      statement = {}
+      if not s:match("^%s*typedef") and not s:match("^%s*static") then
+        local name, args = s:match("([%w_]+)%s*(%b())%s*$")
+        if name then
+          args = args:sub(2, -2)
+          local count = 0
+          if not args:match("^%s*void%s*$") and args:match("%S") then
+            local d = 0
+            count = 1
+            for c in args:gmatch(".") do
+              if c == "(" then d = d + 1 elseif c == ")" then d = d - 1 elseif c == "," and d == 0 then count = count + 1 end
+            end
+          end
+          found[name] = count
+        end
+      end
+    else
+      statement[#statement + 1] = ch
+    end
+  end
+  return found
+end
+
+test("drift: functions and argument counts", function()
+  local declared = cdef_functions(require("mica_cdef"))
+  for name, argc in pairs(manifest.functions) do
+    expect(declared[name] ~= nil, name .. " is not in the cdef")
+    expect(declared[name] == argc, name .. ": " .. declared[name] .. " arguments, the header has " .. argc)
+  end
+  for name in pairs(declared) do expect(manifest.functions[name], name .. " is not in the header") end
+end)
+
+test("drift: every function resolves in the library (device functions may be pending)", function()
+  local missing = {}
+  for _, name in ipairs(manifest.function_order) do
+    if not pcall(function() return C[name] end) then missing[#missing + 1] = name end
+  end
+  for _, name in ipairs(missing) do
+    expect(name:match("^mica_device_"), name .. " is declared but libmica does not export it")
+  end
+  if #missing > 0 then print("     (not exported yet: " .. table.concat(missing, ", ") .. ")") end
+end)
+
+test("drift: struct sizes, alignments and field offsets", function()
+  for _, name in ipairs(manifest.struct_order) do
+    local s = manifest.structs[name]
+    expect(ffi.sizeof(name) == s.size, name .. ": size " .. ffi.sizeof(name) .. ", header " .. s.size)
+    expect(ffi.alignof(name) == s.align, name .. ": alignment")
+    local value = ffi.new(name)
+    for _, f in ipairs(s.fields) do
+      local where = name .. "." .. f.name
+      expect(ffi.offsetof(name, f.name) == f.offset, where .. ": offset")
+      local v = value[f.name]
+      if type(v) == "cdata" then expect(ffi.sizeof(v) == f.size, where .. ": size") end
+    end
+  end
+end)
+
+test("drift: typedef sizes and constants", function()
+  for name, size in pairs(manifest.typedefs) do expect(ffi.sizeof(name) == size, name) end
+  for name, value in pairs(manifest.constants) do
+    expect(C[name] == value, name .. " = " .. tostring(C[name]) .. ", header " .. value)
+  end
+end)
+
+test("defaults come from the library", function()
+  local d = mica.world_def()
+  expect(d.struct_size == ffi.sizeof("mica_world_def"), "struct_size")
+  expect(d.header_version == C.MICA_VERSION_NUMBER, "header_version")
+  expect(d.gravity[1] == -9.81, "default gravity")
+  expect(math.floor(mica.version() / 10000) == C.MICA_VERSION_MAJOR, "major version")
+end)
+
+test("errors raise mica.Error with the library's message", function()
+  local world = mica.world()
+  local ok, e = pcall(world.create_box, world, { 0, 0, 0 }, { -1, 1, 1 }, { 1, 1, 1 })
+  expect(not ok and getmetatable(e) == mica.Error, "an error object")
+  expect(e.status == C.MICA_ERR_INVALID_ARGUMENT and e.message:find("hi%[0%]"), tostring(e))
+  ok, e = pcall(mica.world, { header_version = (C.MICA_VERSION_MAJOR + 1) * 10000 })
+  expect(not ok and e.status == C.MICA_ERR_VERSION_MISMATCH, tostring(e))
+  world:close()
+  world:close() -- twice is harmless
+end)
+
+test("positions view is zero-copy", function()
+  local world = mica.world()
+  local body = world:create_box({ 0, 0, 0 }, { 1, 1, 1 }, { 2, 2, 2 })
+  local p, n = world:positions(body)
+  local copy, count = ffi.new("double[?]", 3 * n), ffi.new("int32_t[1]")
+  world:check(C.mica_body_get_positions(world.ptr, body, copy, n, count))
+  for i = 0, 3 * n - 1 do expect(p[i] == copy[i], "view vs copy") end
+  local p2 = world:positions(body)
+  expect(p == p2, "the same memory")
+  world:close()
+end)
+
+test("sphere indent matches C to 1e-9", function()
+  local ref = {}
+  for line in io.lines(os.getenv("MICA_REFERENCE")) do
+    local k, fx, fy, fz, contacts = line:match("^(%d+),([^,]+),([^,]+),([^,]+),(%d+)$")
+    ref[#ref + 1] = { tonumber(fx), tonumber(fy), tonumber(fz), contacts = tonumber(contacts) }
+  end
+  -- examples_c/sphere_indent.c, the same operations in the same order.
+  local L, E, nu, rho, dt = 0.1, 1e4, 0.4, 1000.0, 0.01
+  local R, margin, start_gap, max_depth = 0.02, 0.0015, 0.005, 0.015
+  local cells = 12
+  local steps = #ref
+  local world = mica.world{ gravity = { 0, 0, 0 }, solver = C.MICA_SOLVER_MICA, max_iterations = 2000, tolerance = 1e-6 }
+  local cube = world:create_box({ -L / 2, 0, -L / 2 }, { L / 2, L, L / 2 }, { cells, cells, cells }, 5,
+    { youngs_modulus = E, poisson_ratio = nu, density = rho, rayleigh_alpha = 2.0, rayleigh_beta = 0.005 })
+  local bottom, count = world:select_nodes_by_plane(cube, { 0, 0, 0 }, { 0, 1, 0 }, 1e-9, true)
+  world:add_lpc(cube, bottom, count, { kind = C.MICA_LPC_FIXED })
+  local y_start = L + R + start_gap
+  local sphere = world:create_tool{ shape = C.MICA_TOOL_SPHERE, radius = R, margin = margin, position = { 0, y_start, 0 } }
+  local n_load, n_hold, n_unload = math.floor(steps / 3), math.floor(steps / 6), math.floor(steps / 3)
+  local travel = start_gap + max_depth
+  local speed = travel / (n_load * dt)
+  local worst = 0
+  for k = 1, steps do
+    local y
+    if k <= n_load then
+      y = y_start - speed * k * dt
+    elseif k <= n_load + n_hold then
+      y = y_start - travel
+    elseif k <= n_load + n_hold + n_unload then
+      y = y_start - travel + speed * (k - n_load - n_hold) * dt
+    else
+      y = y_start
+    end
+    world:set_tool_pose(sphere, { 0, y, 0 })
+    world:step(dt)
+    local f, _, contacts = world:tool_force(sphere)
+    local r = ref[k]
+    expect(contacts == r.contacts, "step " .. k .. ": contacts")
+    local scale = math.max(math.sqrt(f[0] ^ 2 + f[1] ^ 2 + f[2] ^ 2), math.sqrt(r[1] ^ 2 + r[2] ^ 2 + r[3] ^ 2))
+    for i = 0, 2 do
+      local d = math.abs(f[i] - r[i + 1])
+      expect(d <= 1e-9 * scale, string.format("step %d: force[%d] %.17g vs C %.17g", k, i, f[i], r[i + 1]))
+      if scale > 0 then worst = math.max(worst, d / scale) end
+    end
+  end
+  print(string.format("     (%d steps, largest deviation from C %.3g of the force)", steps, worst))
+  world:close()
+end)
+
+test("a device with Lua callbacks", function()
+  if not pcall(function() return C.mica_device_create end) then return "skip" end
+  local world = mica.world{ gravity = { 0, 0, 0 }, solver = C.MICA_SOLVER_MICA }
+  local tool = world:create_tool{ radius = 0.02, position = { 0, 0.2, 0 } }
+  local reads, writes, last = 0, 0, nil
+  local device = world:create_device({ tool = tool }, {
+    read_state = function(state)
+      reads = reads + 1
+      state.position[1] = 0.1
+      state.orientation[0] = 1
+      state.timestamp = reads * 0.001
+    end,
+    write_force = function(force)
+      writes = writes + 1
+      last = { force[0], force[1], force[2] }
+    end,
+  })
+  local state, force = ffi.new("mica_device_state"), ffi.new("double[3]")
+  state.struct_size = ffi.sizeof(state)
+  world:check(C.mica_device_poll(world.ptr, device, state, force))
+  expect(reads >= 1 and writes >= 1, "a read and a write per poll")
+  expect(state.position[1] == 0.1, "the state read")
+  expect(last[1] == force[0] and last[2] == force[1] and last[3] == force[2], "the force sent is returned")
+  world:check(C.mica_device_destroy(world.ptr, device))
+  world:close()
+end)
+
+print(string.format("%d passed, %d failed, %d skipped", passed, failed, skipped))
+os.exit(failed == 0 and 0 or 1)

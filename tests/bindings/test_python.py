@@ -1,0 +1,313 @@
+"""Tests of the Python binding (bindings/python/mica): its declarations against the header
+manifest (the drift guard), the sphere-indent scene against the C reference, errors, warnings,
+view lifetime, and devices implemented in Python.
+
+Environment (set by tests/bindings/CMakeLists.txt): MICA_LIBRARY, MICA_MANIFEST,
+MICA_REFERENCE, MICA_BINDINGS_BUILD_DIR; PYTHONPATH holds bindings/python.
+"""
+import ctypes
+import gc
+import json
+import os
+import subprocess
+import sys
+import unittest
+import warnings
+
+import numpy as np
+
+import mica
+from mica import native
+
+MANIFEST = json.load(open(os.environ["MICA_MANIFEST"]))
+
+
+def ctype_class(t):
+    """(class, size) of a ctypes type as the manifest names them."""
+    if t is None:
+        return "void", 0
+    if issubclass(t, (ctypes._Pointer, ctypes.c_char_p, ctypes.c_void_p, ctypes._CFuncPtr)):
+        return "ptr", ctypes.sizeof(t)
+    if issubclass(t, ctypes.Array):
+        return ctype_class(t._type_)[0], ctypes.sizeof(t)
+    if issubclass(t, ctypes.Structure):
+        return "struct", ctypes.sizeof(t)
+    if t in (ctypes.c_double, ctypes.c_float):
+        return "float", ctypes.sizeof(t)
+    if t is ctypes.c_char:
+        return "char", 1
+    signed = t(-1).value < 0
+    return ("int" if signed else "uint"), ctypes.sizeof(t)
+
+
+class DriftGuard(unittest.TestCase):
+    """The binding's declarations are the header's: functions, structs, typedefs, constants."""
+
+    def test_functions(self):
+        header = {f["name"]: f for f in MANIFEST["functions"]}
+        self.assertEqual(sorted(set(header) - set(native.PROTOTYPES)), [], "in the header, not in the binding")
+        self.assertEqual(sorted(set(native.PROTOTYPES) - set(header)), [], "in the binding, not in the header")
+        for name, f in header.items():
+            restype, argtypes = native.PROTOTYPES[name]
+            self.assertEqual(len(argtypes), len(f["params"]), name + ": argument count")
+            self.assertEqual(ctype_class(restype), (f["return"]["class"], f["return"]["size"]), name + ": return")
+            for i, (t, p) in enumerate(zip(argtypes, f["params"])):
+                self.assertEqual(ctype_class(t), (p["class"], p["size"]), "%s: parameter %d (%s)" % (name, i, p["name"]))
+            if name not in native.missing:
+                fn = getattr(native, name)
+                self.assertEqual(fn.argtypes, argtypes, name)
+
+    def test_structs(self):
+        header = {s["name"] for s in MANIFEST["structs"]}
+        mirrors = {k for k, v in vars(native).items() if isinstance(v, type) and issubclass(v, ctypes.Structure)
+                   and k.startswith("mica_")}
+        self.assertEqual(sorted(header - mirrors), [], "structs in the header without a mirror")
+        self.assertEqual(sorted(mirrors - header), [], "mirrors of structs not in the header")
+        for s in MANIFEST["structs"]:
+            py = getattr(native, s["name"])
+            self.assertEqual(ctypes.sizeof(py), s["size"], s["name"] + ": size")
+            self.assertEqual(ctypes.alignment(py), s["align"], s["name"] + ": alignment")
+            self.assertEqual([f[0] for f in py._fields_], [f["name"] for f in s["fields"]], s["name"] + ": fields")
+            for (fname, ftype), f in zip(py._fields_, s["fields"]):
+                where = "%s.%s" % (s["name"], fname)
+                self.assertEqual(getattr(py, fname).offset, f["offset"], where + ": offset")
+                self.assertEqual(getattr(py, fname).size, f["size"], where + ": size")
+                self.assertEqual(ctype_class(ftype)[0], f["class"], where + ": type")
+
+    def test_typedefs_and_callbacks(self):
+        for t in MANIFEST["typedefs"]:
+            self.assertEqual(ctype_class(getattr(native, t["name"])), (t["class"], t["size"]), t["name"])
+        for c in MANIFEST["callbacks"]:
+            self.assertEqual(len(getattr(native, c["name"])._argtypes_), c["param_count"], c["name"])
+
+    def test_constants(self):
+        header = {c["name"]: c["value"] for c in MANIFEST["constants"]}
+        mine = {k: v for k, v in vars(native).items() if k.startswith("MICA_")}
+        self.assertEqual(sorted(set(header) - set(mine)), [], "constants in the header, not in the binding")
+        self.assertEqual(sorted(set(mine) - set(header)), [], "constants in the binding, not in the header")
+        for name, value in header.items():
+            self.assertEqual(mine[name], value, name)
+        self.assertEqual(mica.version() // 10000, mica.MICA_VERSION_MAJOR, "the loaded library's major version")
+
+
+def read_reference():
+    rows = []
+    with open(os.environ["MICA_REFERENCE"]) as f:
+        for line in f:
+            k, fx, fy, fz, contacts = line.strip().split(",")
+            rows.append((int(k), (float(fx), float(fy), float(fz)), int(contacts)))
+    return rows
+
+
+def sphere_indent(steps):
+    """examples_c/sphere_indent.c through the Pythonic layer: the force and contacts per step."""
+    L, E, nu, rho, dt = 0.1, 1e4, 0.4, 1000.0, 0.01
+    R, margin, start_gap, max_depth = 0.02, 0.0015, 0.005, 0.015
+    cells = 12
+    out = []
+    with mica.World(gravity=(0, 0, 0), solver=mica.MICA_SOLVER_MICA, max_iterations=2000, tolerance=1e-6) as world:
+        cube = world.create_box((-L / 2, 0, -L / 2), (L / 2, L, L / 2), (cells, cells, cells), 5,
+                                youngs_modulus=E, poisson_ratio=nu, density=rho,
+                                rayleigh_alpha=2.0, rayleigh_beta=0.005)
+        bottom = cube.select_nodes_by_plane((0, 0, 0), (0, 1, 0), 1e-9, use_rest=True)
+        cube.add_lpc(bottom, kind=mica.MICA_LPC_FIXED)
+        y_start = L + R + start_gap
+        sphere = world.create_tool(shape=mica.MICA_TOOL_SPHERE, radius=R, margin=margin, position=(0, y_start, 0))
+        n_load, n_hold, n_unload = steps // 3, steps // 6, steps // 3
+        travel = start_gap + max_depth
+        speed = travel / (n_load * dt)
+        for k in range(1, steps + 1):
+            # The same floating-point operations as the C program, in the same order.
+            if k <= n_load:
+                y = y_start - speed * k * dt
+            elif k <= n_load + n_hold:
+                y = y_start - travel
+            elif k <= n_load + n_hold + n_unload:
+                y = y_start - travel + speed * (k - n_load - n_hold) * dt
+            else:
+                y = y_start
+            sphere.set_pose((0, y, 0), (1, 0, 0, 0))
+            world.step(dt)
+            force, _, contacts = sphere.force()
+            out.append((k, tuple(force), contacts))
+    return out
+
+
+class Scene(unittest.TestCase):
+    def test_sphere_indent_matches_c(self):
+        ref = read_reference()
+        got = sphere_indent(len(ref))
+        peak = 0.0
+        for (k, fr, cr), (_, fp, cp) in zip(ref, got):
+            scale = max(np.linalg.norm(fr), np.linalg.norm(fp))
+            peak = max(peak, fr[1])
+            self.assertEqual(cp, cr, "step %d: contacts" % k)
+            for i in range(3):
+                # Relative to the force's magnitude: the same operations agree to round-off.
+                self.assertLessEqual(abs(fp[i] - fr[i]), 1e-9 * scale, "step %d: force[%d] %r vs C %r" % (k, i, fp[i], fr[i]))
+        self.assertGreater(peak, 0.1, "the scene indents at all")
+        worst = max((abs(fp[i] - fr[i]) / max(np.linalg.norm(fr), np.linalg.norm(fp))
+                     for (_, fr, _), (_, fp, _) in zip(ref, got) if max(np.linalg.norm(fr), np.linalg.norm(fp)) > 0
+                     for i in range(3)), default=0.0)
+        print("(%d steps, largest deviation from C %.3g of the force) " % (len(ref), worst), end="", file=sys.stderr)
+
+
+class Behaviour(unittest.TestCase):
+    def test_defaults_come_from_the_library(self):
+        d = mica.world_def()
+        self.assertEqual(d.struct_size, ctypes.sizeof(native.mica_world_def))
+        self.assertEqual(d.header_version, mica.MICA_VERSION_NUMBER)
+        self.assertEqual(list(d.gravity), [0, -9.81, 0])
+        self.assertEqual(mica.body_def().youngs_modulus, 1e4)
+        self.assertEqual(mica.tool_def().orientation[:], [1, 0, 0, 0])
+        with self.assertRaises(TypeError):
+            mica.world_def(no_such_field=1)
+
+    def test_errors_raise_with_the_message(self):
+        with mica.World() as world:
+            with self.assertRaises(mica.MicaError) as e:
+                world.create_box((0, 0, 0), (-1, 1, 1), (1, 1, 1))
+            self.assertEqual(e.exception.status, mica.MICA_ERR_INVALID_ARGUMENT)
+            self.assertIn("hi[0]", e.exception.message)
+            body = world.create_box((0, 0, 0), (1, 1, 1), (1, 1, 1))
+            body.destroy()
+            with self.assertRaises(mica.MicaError) as e:
+                body.counts()
+            self.assertEqual(e.exception.status, mica.MICA_ERR_STALE_ID)
+        with self.assertRaises(mica.MicaError) as e:
+            world.step(0.01)  # closed
+        self.assertEqual(e.exception.status, mica.MICA_ERR_WRONG_STATE)
+        with self.assertRaises(mica.MicaError) as e:
+            mica.World(header_version=(mica.MICA_VERSION_MAJOR + 1) * 10000)
+        self.assertEqual(e.exception.status, mica.MICA_ERR_VERSION_MISMATCH)
+
+    def test_warning_when_not_converged(self):
+        with mica.World(solver=mica.MICA_SOLVER_PCG, max_iterations=1, tolerance=1e-14) as world:
+            world.create_box((0, 0, 0), (1, 1, 1), (2, 2, 2), youngs_modulus=1e5)
+            with warnings.catch_warnings(record=True) as caught:
+                warnings.simplefilter("always")
+                converged = world.step(0.01)
+            self.assertFalse(converged)
+            self.assertEqual([w.message.status for w in caught], [mica.MICA_WARN_NOT_CONVERGED])
+            self.assertEqual(world.stats().converged, 0)
+
+    def test_positions_view_is_zero_copy_and_keeps_the_world(self):
+        def make():
+            world = mica.World()
+            body = world.create_box((0, 0, 0), (1, 1, 1), (2, 2, 2))
+            return body.positions, body
+
+        view, body = make()
+        gc.collect()
+        self.assertFalse(view.flags.writeable)
+        self.assertFalse(view.flags.owndata)
+        np.testing.assert_array_equal(view, body.get_positions())
+        self.assertIs(view.base.world, body.world)
+        view2 = body.positions
+        self.assertEqual(view.__array_interface__["data"][0], view2.__array_interface__["data"][0])
+        body.world.step(0.01)  # the documented rule: fetch the view again after a step
+        np.testing.assert_array_equal(body.positions, body.get_positions())
+        self.assertLess(body.positions[:, 1].min(), 0)
+        body.world.close()
+
+    def test_constraints_and_grab(self):
+        with mica.World(gravity=(0, 0, 0)) as world:
+            body = world.create_box((0, 0, 0), (1, 1, 1), (2, 2, 2))
+            bottom = body.select_nodes_by_plane((0, 0, 0), (0, 1, 0))
+            lpc = body.add_lpc(bottom)
+            np.testing.assert_array_equal(np.sort(lpc.nodes()), np.sort(bottom))
+            grab = body.grab((0.5, 1, 0.5), 0.3)
+            grab.set_handle_pose((0.5, 1.1, 0.5))
+            world.step(0.01)
+            self.assertLess(grab.reaction()[1], 0, "pulling up: the hand feels a downward force")
+            grab.remove()
+            self.assertEqual(len(body.surface()), body.counts()[2])
+            tool = world.create_tool(position=(1, 2, 3))
+            position, orientation = tool.pose()
+            self.assertEqual(list(position), [1, 2, 3])
+            self.assertEqual(list(orientation), [1, 0, 0, 0])
+
+    def test_library_found_next_to_the_build_tree(self):
+        # The package copied into <build>/bindings/python finds <build>/libmica without help.
+        pkg = os.path.join(os.environ["MICA_BINDINGS_BUILD_DIR"], "python")
+        env = {k: v for k, v in os.environ.items() if k not in ("MICA_LIBRARY", "LD_LIBRARY_PATH")}
+        env["PYTHONPATH"] = pkg
+        r = subprocess.run([sys.executable, "-c", "import mica; print(mica.native.path)"], env=env,
+                           capture_output=True, text=True)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        build = os.path.dirname(os.environ["MICA_BINDINGS_BUILD_DIR"])
+        self.assertEqual(os.path.realpath(r.stdout.strip()), os.path.realpath(os.path.join(build, "libmica.so.0")))
+
+
+class Recorder(mica.DeviceBackend):
+    """A device implemented in Python: a stylus held at `position`, recording the forces."""
+
+    def __init__(self, position):
+        self.position = position
+        self.opened = self.closed = 0
+        self.reads = 0
+        self.forces = []
+
+    def open(self):
+        self.opened += 1
+
+    def close(self):
+        self.closed += 1
+
+    def info(self, out):
+        out.name = b"python stylus"
+        out.max_force = 5.0
+
+    def read_state(self, state):
+        self.reads += 1
+        state.position[:] = self.position
+        state.orientation[:] = (1, 0, 0, 0)
+        state.timestamp = self.reads * 0.001
+
+    def write_force(self, force, torque):
+        self.forces.append(force)
+
+
+@unittest.skipIf("mica_device_create" in native.missing, "the loaded libmica has no device functions yet")
+class Devices(unittest.TestCase):
+    def test_python_backend(self):
+        with mica.World(gravity=(0, 0, 0), solver=mica.MICA_SOLVER_MICA) as world:
+            world.create_box((-0.05, 0, -0.05), (0.05, 0.1, 0.05), (4, 4, 4))
+            tool = world.create_tool(radius=0.02, position=(0, 0.2, 0))
+            backend = Recorder((0, 0.115, 0))
+            device = world.create_device(backend=backend, tool=tool)
+            self.assertEqual(backend.opened, 1)
+            self.assertEqual(device.info().name, b"python stylus")
+            state, force = device.poll()
+            self.assertEqual(state.position[:], [0, 0.115, 0])
+            self.assertEqual(backend.forces[-1], tuple(force))
+            world.step(0.01)
+            for _ in range(5):
+                state, force = device.poll()
+            self.assertGreaterEqual(backend.reads, 6, "a read per poll")
+            self.assertEqual(backend.forces[-1], tuple(force))
+            self.assertTrue(np.all(np.isfinite(force)))
+            self.assertEqual(device.stats().polls, 6)
+            device.destroy()
+            self.assertEqual(backend.closed, 1)
+            self.assertIsNone(backend.error)
+
+    def test_failing_backend_sends_zero(self):
+        class Broken(Recorder):
+            def read_state(self, state):
+                raise IOError("unplugged")
+
+        with mica.World() as world:
+            tool = world.create_tool()
+            backend = Broken((0, 0, 0))
+            device = world.create_device(backend=backend, tool=tool)
+            with self.assertRaises(mica.MicaError) as e:
+                device.poll()
+            self.assertEqual(e.exception.status, mica.MICA_ERR_DEVICE)
+            self.assertIsInstance(backend.error, IOError)
+
+
+if __name__ == "__main__":
+    sys.stdout.reconfigure(line_buffering=True)
+    result = unittest.main(verbosity=2, exit=False).result
+    sys.exit(0 if result.wasSuccessful() else 1)
