@@ -136,7 +136,9 @@ MicaReport MicaSolver::solve(std::vector<MicaBody>& bodies, const ContactRows& r
       MicaBody& body = bodies[bi];
       Vec3List& v = *body.v;
       for (int32_t i = 0; i < body.pattern->rows; ++i) {
-        const Vec3 next = node_update(body, inv_diag_[bi][i], i, (*body.b)[i] + body.contact_impulse[i]);
+        const Vec3 gs = node_update(body, inv_diag_[bi][i], i, (*body.b)[i] + body.contact_impulse[i]);
+        // Over-relaxation keeps (I - S) v = z: both v_i and the Gauss-Seidel value satisfy it.
+        const Vec3 next = v[i] + settings.relaxation * (gs - v[i]);
         dv2 += (next - v[i]).squaredNorm();
         v[i] = next;
         v2 += next.squaredNorm();

@@ -25,6 +25,7 @@ struct MicaSettings {
   int32_t max_iterations = 200;
   int32_t pgs_sweeps = 1;           // PGS sweeps over the contact rows per iteration
   bool paper_norm = false;          // stop on the 2-norm of the change of (v, lambda) instead
+  double relaxation = 1.0;          // MBGS over-relaxation omega in (0, 2); 1 is the paper's Gauss-Seidel
 };
 
 // One body's system as the solver sees it. v holds the warm start and receives the result.
