@@ -188,7 +188,10 @@ MICA_API mica_status mica_device_get_stats(const mica_world* world, mica_device_
   r.failures = s.failures.load(std::memory_order_relaxed);
   r.clamped = s.clamped.load(std::memory_order_relaxed);
   r.rate_hz = s.rate_hz.load(std::memory_order_relaxed);
-  for (int k = 0; k < 3; ++k) r.last_force[k] = s.last_force[k].load(std::memory_order_relaxed);
+  for (int k = 0; k < 3; ++k) {
+    r.last_force[k] = s.last_force[k].load(std::memory_order_relaxed);
+    r.last_raw_force[k] = s.last_raw_force[k].load(std::memory_order_relaxed);
+  }
   std::memcpy(static_cast<void*>(out), &r, out->struct_size);
   return MICA_OK;
 }

@@ -157,6 +157,7 @@ typedef struct mica_device_stats {
   int64_t clamped;          /**< polls whose force was clamped or rate-limited */
   double rate_hz;           /**< servo rate measured over the last second */
   double last_force[3];     /**< N, the last force sent (device frame) */
+  double last_raw_force[3]; /**< N, the last force of the model before filtering and limits (device frame) */
 } mica_device_stats;
 
 /** Copies the servo statistics, writing at most out->struct_size bytes. Any thread. */

@@ -73,6 +73,7 @@ DeviceResult DeviceLink::poll(DeviceState* out_state, Vec3* out_force) noexcept 
     }
     // Scene -> device frame: virtual work gives F_device = s R^T F_scene.
     const Vec3 device_force = s * (R.inverse() * scene_force);
+    for (int k = 0; k < 3; ++k) stats_.last_raw_force[k].store(device_force[k], std::memory_order_relaxed);
     SafetyFlags flags;
     force = safety_.apply(filter_.filter(device_force, model.in_contact), t, model.published_at, dt, flags);
     if (flags.clamped || flags.rate_limited) stats_.clamped.fetch_add(1, std::memory_order_relaxed);

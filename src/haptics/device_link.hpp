@@ -40,6 +40,7 @@ struct ServoStats {
   std::atomic<int32_t> last_code{0};
   std::atomic<double> rate_hz{0};
   std::atomic<double> last_force[3] = {0, 0, 0};
+  std::atomic<double> last_raw_force[3] = {0, 0, 0};  // before the filter and the limits
 };
 
 class DeviceLink {

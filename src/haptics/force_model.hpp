@@ -28,6 +28,8 @@ struct ForceModel {
 
   // The force at tool position x: f0 + H (x - x0) for LocalModel, f0 for Hold. Coupling is not a
   // function of the position alone (see coupling_force()); any mode but LocalModel holds f0.
+  // LocalModel: f0 + H (x - x0), or zero once that turns against f0 (contact opens: tissue only
+  // pushes); Hold and Coupling: f0.
   Vec3 evaluate(const Vec3& x, ForceMode mode) const noexcept;
 };
 

@@ -37,7 +37,9 @@ static void test_default_model_is_zero(void**) {
 static void test_local_model_is_linear(void**) {
   std::mt19937 rng(9);
   for (int trial = 0; trial < 100; ++trial) {
-    const ForceModel m = random_model(rng);
+    // The linear regime: |f0| > |H d| for the displacements below, so the contact stays closed.
+    ForceModel m = random_model(rng);
+    m.f0 = m.f0.normalized() * (1 + m.H.norm());
     // At x0 it is f0 exactly.
     assert_true(m.evaluate(m.x0, ForceMode::LocalModel) == m.f0);
     // Anywhere: f0 + H (x - x0), computed component by component.
@@ -106,8 +108,21 @@ static void test_passivity_bound(void**) {
   }
 }
 
+// Pulling the tool out past the model's reach opens the contact: zero, never a pull.
+static void test_local_model_never_pulls(void**) {
+  ForceModel m;
+  m.f0 = Vec3(0, 1, 0);
+  m.H = -100 * Mat3::Identity();
+  m.x0 = Vec3::Zero();
+  assert_near(m.evaluate(Vec3(0, 0.005, 0), ForceMode::LocalModel).y(), 0.5, 1e-12);
+  assert_true(m.evaluate(Vec3(0, 0.02, 0), ForceMode::LocalModel).isZero(0));  // would be -1 N
+  ForceModel none;  // no contact: nothing to extrapolate
+  assert_true(none.evaluate(Vec3(1, 2, 3), ForceMode::LocalModel).isZero(0));
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_local_model_never_pulls),
       cmocka_unit_test(test_default_model_is_zero),
       cmocka_unit_test(test_local_model_is_linear),
       cmocka_unit_test(test_hold_ignores_the_position),

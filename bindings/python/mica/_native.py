@@ -11,7 +11,7 @@ from ctypes import (CFUNCTYPE, POINTER, Structure, c_char, c_char_p, c_double, c
 
 # --- Constants (mica.h)
 MICA_VERSION_MAJOR = 0
-MICA_VERSION_MINOR = 1
+MICA_VERSION_MINOR = 2
 MICA_VERSION_PATCH = 0
 MICA_VERSION_NUMBER = MICA_VERSION_MAJOR * 10000 + MICA_VERSION_MINOR * 100 + MICA_VERSION_PATCH
 
@@ -270,6 +270,7 @@ class mica_device_stats(Structure):
         ("clamped", c_int64),
         ("rate_hz", c_double),
         ("last_force", c_double * 3),
+        ("last_raw_force", c_double * 3),
     ]
 
 

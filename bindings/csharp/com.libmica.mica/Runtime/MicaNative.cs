@@ -14,7 +14,7 @@ namespace LibMica
 
         // --- Constants (mica.h)
         public const int MICA_VERSION_MAJOR = 0;
-        public const int MICA_VERSION_MINOR = 1;
+        public const int MICA_VERSION_MINOR = 2;
         public const int MICA_VERSION_PATCH = 0;
         public const int MICA_VERSION_NUMBER = MICA_VERSION_MAJOR * 10000 + MICA_VERSION_MINOR * 100 + MICA_VERSION_PATCH;
 
@@ -284,6 +284,7 @@ namespace LibMica
             public long clamped;
             public double rate_hz;
             public fixed double last_force[3];
+            public fixed double last_raw_force[3];
         }
 
         // --- Functions (mica.h). mica_world* is a WorldHandle (a SafeHandle), except where NULL

@@ -1,0 +1,177 @@
+/* A haptic loop as an engine would run it: a simulation thread stepping at 60 Hz and a servo
+ * thread polling the device at 1 kHz, concurrently. The device is the Geomagic Touch when
+ * OpenHaptics' libHD is present (MICA_HD_LIBRARY), else a simulated stylus that presses into
+ * a soft block for a second and lets go. Prints the rates and forces and writes
+ * haptic_loop.csv (servo samples: time, raw and filtered force) for the paper's Figure 1 b/c.
+ *
+ * usage: haptic_loop [output-folder] [seconds]
+ */
+#include <math.h>
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <time.h>
+
+#include <mica/mica.h>
+#include <mica/mica_device.h>
+
+#define SERVO_HZ 1000
+#define MAX_SAMPLES 200000
+
+typedef struct {
+  mica_world* world;
+  mica_device_id device;
+  atomic_int running;
+  double seconds;
+  /* servo samples, written by the servo thread only */
+  int samples;
+  double t[MAX_SAMPLES], raw[MAX_SAMPLES], filtered[MAX_SAMPLES];
+  long failures;
+} loop;
+
+static double now_s(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static void sleep_until(double deadline) {
+  const double wait = deadline - now_s();
+  if (wait <= 0) return;
+  struct timespec ts = {(time_t)wait, (long)((wait - floor(wait)) * 1e9)};
+  nanosleep(&ts, NULL);
+}
+
+/* The stylus goes 1.5 cm down into the block over 0.5 s, holds 0.5 s, and lifts off. */
+static void press(double t, double p[3], void* user) {
+  (void)user;
+  const double depth = t < 0.5 ? 0.015 * t / 0.5 : t < 1.0 ? 0.015 : t < 1.5 ? 0.015 * (1.5 - t) / 0.5 : 0;
+  p[0] = 0.002;
+  p[1] = 0.021 - depth; /* the sphere (radius 2 cm) touches the top face y = 0 at p_y = 0.02 */
+  p[2] = 0.001;
+}
+
+static void* servo_thread(void* arg) {
+  loop* L = arg;
+  const double start = now_s();
+  double deadline = start;
+  while (atomic_load(&L->running)) {
+    double force[3];
+    if (mica_device_poll(L->world, L->device, NULL, force) < 0) L->failures++;
+    mica_device_stats st = {sizeof st};
+    mica_device_get_stats(L->world, L->device, &st);
+    if (L->samples < MAX_SAMPLES) {
+      L->t[L->samples] = now_s() - start;
+      L->raw[L->samples] = st.last_raw_force[1];
+      L->filtered[L->samples] = force[1];
+      L->samples++;
+    }
+    deadline += 1.0 / SERVO_HZ;
+    sleep_until(deadline);
+  }
+  return NULL;
+}
+
+#define CHECK(call)                                                                                   \
+  do {                                                                                                \
+    mica_status s_ = (call);                                                                          \
+    if (s_ < 0) {                                                                                     \
+      fprintf(stderr, "%s: %s\n  %s\n", #call, mica_status_string(s_), mica_world_last_error(world)); \
+      return 1;                                                                                       \
+    }                                                                                                 \
+  } while (0)
+
+int main(int argc, char** argv) {
+  const char* out_dir = argc > 1 ? argv[1] : ".";
+  static loop L;
+  L.seconds = argc > 2 ? atof(argv[2]) : 2.0;
+  mica_world* world = NULL;
+  mica_world_def wd = mica_world_def_default();
+  wd.gravity[1] = 0;
+  wd.solver = MICA_SOLVER_MICA;
+  wd.tolerance = 1e-5;
+  wd.max_iterations = 2000;
+  if (mica_world_create(&wd, &world) != MICA_OK) {
+    fprintf(stderr, "%s\n", mica_world_last_error(NULL));
+    return 1;
+  }
+  mica_body_def bd = mica_body_def_default();
+  bd.youngs_modulus = 8e3;
+  bd.poisson_ratio = 0.4;
+  bd.rayleigh_alpha = 2;
+  const double lo[3] = {-0.05, -0.1, -0.05}, hi[3] = {0.05, 0, 0.05};
+  const int32_t cells[3] = {8, 8, 8};
+  mica_body_id body;
+  CHECK(mica_body_create_box(world, &bd, lo, hi, cells, 6, &body));
+  int32_t base[128], n = 0;
+  const double o[3] = {0, -0.1, 0}, up[3] = {0, 1, 0};
+  CHECK(mica_body_select_nodes_by_plane(world, body, o, up, 1e-9, 1, base, 128, &n));
+  mica_lpc_def fixed = mica_lpc_def_default();
+  mica_lpc_id lpc;
+  CHECK(mica_add_lpc(world, body, base, n, &fixed, &lpc));
+  mica_tool_def td = mica_tool_def_default();
+  td.radius = 0.02;
+  td.position[1] = 0.05;
+  mica_tool_id tool;
+  CHECK(mica_tool_create(world, &td, &tool));
+
+  /* The Touch if OpenHaptics is there, else the simulated stylus. */
+  mica_device_def dd = mica_device_def_default();
+  dd.tool = tool;
+  dd.backend = MICA_DEVICE_TOUCH;
+  if (mica_device_create(world, &dd, &L.device) != MICA_OK) {
+    printf("no Touch (%s): using the simulated stylus\n", mica_world_last_error(world));
+    dd.backend = MICA_DEVICE_SIMULATED;
+    dd.trajectory = press;
+    CHECK(mica_device_create(world, &dd, &L.device));
+  }
+  mica_device_info info = {sizeof info};
+  CHECK(mica_device_get_info(world, L.device, &info));
+  printf("device: %s, max force %.2f N\n", info.name, info.max_force);
+
+  L.world = world;
+  atomic_store(&L.running, 1);
+  pthread_t servo;
+  pthread_create(&servo, NULL, servo_thread, &L);
+  /* The simulation thread: 60 Hz in real time. */
+  const double start = now_s();
+  int steps = 0;
+  double deadline = start, worst_step_ms = 0;
+  while (now_s() - start < L.seconds) {
+    const double t0 = now_s();
+    CHECK(mica_step(world, 1.0 / 60.0));
+    const double ms = 1e3 * (now_s() - t0);
+    if (ms > worst_step_ms) worst_step_ms = ms;
+    ++steps;
+    if (steps % 15 == 0) {
+      double f[3];
+      mica_tool_get_force(world, tool, f, NULL, NULL);
+      printf("t %.2f s  tool force %.3f N\n", now_s() - start, f[1]);
+    }
+    deadline += 1.0 / 60.0;
+    sleep_until(deadline);
+  }
+  atomic_store(&L.running, 0);
+  pthread_join(servo, NULL);
+  const double elapsed = now_s() - start;
+  mica_device_stats st = {sizeof st};
+  CHECK(mica_device_get_stats(world, L.device, &st));
+  printf("simulation %.1f Hz (worst step %.1f ms), servo %.0f Hz, %ld device failures, %lld limited polls\n",
+         steps / elapsed, worst_step_ms, L.samples / elapsed, L.failures, (long long)st.clamped);
+
+  char path[1024];
+  snprintf(path, sizeof path, "%s/haptic_loop.csv", out_dir);
+  FILE* csv = fopen(path, "w");
+  if (!csv) {
+    fprintf(stderr, "cannot write %s\n", path);
+    return 1;
+  }
+  fprintf(csv, "t_s,raw_force_y_N,filtered_force_y_N\n");
+  for (int k = 0; k < L.samples; ++k) fprintf(csv, "%.6f,%.9g,%.9g\n", L.t[k], L.raw[k], L.filtered[k]);
+  fclose(csv);
+  printf("servo samples written to %s\n", path);
+  CHECK(mica_device_destroy(world, L.device));
+  mica_world_destroy(world);
+  return 0;
+}
