@@ -17,6 +17,11 @@ mkdir -p "$out"
 "$root/build/examples_c/cantilever_sag" "$out" 300
 /usr/bin/python3 "$root/scripts/plot_cantilever.py" "$out/cantilever.csv" "$out/cantilever.png"
 
+# 3. haptic_loop: a 60 Hz simulation thread and a 1 kHz servo thread (simulated stylus unless a Touch is there).
+"$root/build/examples_c/haptic_loop" "$out" 2
+/usr/bin/python3 "$root/scripts/plot_haptic_loop.py" "$out/haptic_loop.csv" "$out/haptic_loop.png"
+
 echo "demo: pictures in $out"
 echo "  sphere_indent.png  (tool force over time and against depth; sphere_indent_*.vtk open in ParaView)"
 echo "  cantilever.png     (tip deflection against Euler-Bernoulli; cantilever_*.vtk open in ParaView)"
+echo "  haptic_loop.png    (raw and rendered device force at 1 kHz over a press and release)"

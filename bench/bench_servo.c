@@ -1,0 +1,126 @@
+/* What one servo cycle costs, and how steady the 1 kHz period is, while the simulation thread
+ * steps a large scene as fast as it can (the worst case for the servo thread's core).
+ *
+ * usage: bench_servo [seconds] [cells-per-side]   (default 10 s, 12^3 x 6 = 10368 tets)
+ */
+#include <math.h>
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <time.h>
+
+#include <mica/mica.h>
+#include <mica/mica_device.h>
+
+static double now_s(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static int cmp(const void* a, const void* b) {
+  const double x = *(const double*)a, y = *(const double*)b;
+  return (x > y) - (x < y);
+}
+
+static void press(double t, double p[3], void* user) {
+  (void)user;
+  p[0] = 0.003;
+  p[1] = 0.019 - 0.008 * (0.5 - 0.5 * cos(t)); /* slowly in and out, up to 8 mm deep */
+  p[2] = 0.002;
+}
+
+typedef struct {
+  mica_world* world;
+  atomic_int running;
+  long steps;
+} sim;
+
+static void* simulate(void* arg) {
+  sim* s = arg;
+  while (atomic_load(&s->running)) {
+    mica_step(s->world, 0.01);
+    s->steps++;
+  }
+  return NULL;
+}
+
+int main(int argc, char** argv) {
+  const double seconds = argc > 1 ? atof(argv[1]) : 10.0;
+  const int32_t cells = argc > 2 ? atoi(argv[2]) : 12;
+  mica_world_def wd = mica_world_def_default();
+  wd.gravity[1] = 0;
+  wd.solver = MICA_SOLVER_MICA;
+  wd.tolerance = 1e-4;
+  wd.max_iterations = 500;
+  mica_world* world;
+  if (mica_world_create(&wd, &world) != MICA_OK) return 1;
+  mica_body_def bd = mica_body_def_default();
+  bd.youngs_modulus = 1e4;
+  const double lo[3] = {-0.05, -0.1, -0.05}, hi[3] = {0.05, 0, 0.05};
+  const int32_t c[3] = {cells, cells, cells};
+  mica_body_id body;
+  if (mica_body_create_box(world, &bd, lo, hi, c, 6, &body) != MICA_OK) return 1;
+  int32_t n = 0, tets = 0;
+  mica_body_get_counts(world, body, &n, &tets, NULL);
+  int32_t* base = malloc(sizeof(int32_t) * (size_t)n);
+  int32_t nb = 0;
+  const double o[3] = {0, -0.1, 0}, up[3] = {0, 1, 0};
+  mica_body_select_nodes_by_plane(world, body, o, up, 1e-9, 1, base, n, &nb);
+  mica_lpc_def fixed = mica_lpc_def_default();
+  mica_lpc_id lpc;
+  mica_add_lpc(world, body, base, nb, &fixed, &lpc);
+  free(base);
+  mica_tool_def td = mica_tool_def_default();
+  td.radius = 0.02;
+  mica_tool_id tool;
+  mica_tool_create(world, &td, &tool);
+  mica_device_def dd = mica_device_def_default();
+  dd.backend = MICA_DEVICE_SIMULATED;
+  dd.trajectory = press;
+  dd.tool = tool;
+  mica_device_id device;
+  if (mica_device_create(world, &dd, &device) != MICA_OK) return 1;
+
+  sim s = {world, 1, 0};
+  pthread_t thread;
+  pthread_create(&thread, NULL, simulate, &s);
+  /* The servo loop on this thread: absolute 1 ms deadlines. */
+  const long cycles = (long)(seconds * 1000);
+  double* cost = malloc(sizeof(double) * (size_t)cycles);
+  double* period = malloc(sizeof(double) * (size_t)cycles);
+  double deadline = now_s(), last = deadline;
+  for (long k = 0; k < cycles; ++k) {
+    const double t0 = now_s();
+    mica_device_poll(world, device, NULL, NULL);
+    const double t1 = now_s();
+    cost[k] = 1e6 * (t1 - t0);
+    period[k] = 1e3 * (t0 - last);
+    last = t0;
+    deadline += 1e-3;
+    const double wait = deadline - now_s();
+    if (wait > 0) {
+      struct timespec ts = {0, (long)(wait * 1e9)};
+      nanosleep(&ts, NULL);
+    }
+  }
+  atomic_store(&s.running, 0);
+  pthread_join(thread, NULL);
+  for (long k = 0; k < cycles; ++k) period[k] = fabs(period[k] - 1.0);
+  qsort(cost, (size_t)cycles, sizeof(double), cmp);
+  qsort(period + 1, (size_t)cycles - 1, sizeof(double), cmp);
+  const long m = cycles - 1;
+  printf("# bench_servo: %.0f s, %ld servo cycles, simulation of %d tets stepping alongside (%.1f steps/s)\n",
+         seconds, cycles, tets, (double)s.steps / seconds);
+  printf("# command: build/bench/bench_servo %g %d\n", seconds, cells);
+  printf("poll cost (us):       median %.2f  p99 %.2f  p99.9 %.2f  max %.2f\n", cost[cycles / 2],
+         cost[(long)(cycles * 0.99)], cost[(long)(cycles * 0.999)], cost[cycles - 1]);
+  printf("period jitter (ms):   median %.3f  p99 %.3f  p99.9 %.3f  max %.3f   (|period - 1 ms|)\n", period[1 + m / 2],
+         period[1 + (long)(m * 0.99)], period[1 + (long)(m * 0.999)], period[cycles - 1]);
+  free(cost);
+  free(period);
+  mica_device_destroy(world, device);
+  mica_world_destroy(world);
+  return 0;
+}
