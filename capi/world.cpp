@@ -25,6 +25,7 @@ mica_world_def world_defaults() {
   d.max_recovery_speed = 1.0;
   d.body_contact = 1;
   d.body_margin = 0.001;
+  d.warm_start = 1;
   return d;
 }
 
@@ -48,6 +49,8 @@ mica::WorldSettings translate(const mica_world_def& d) {
   s.body_contact = d.body_contact == 1;
   s.body_margin = d.body_margin;
   s.body_friction = d.body_friction;
+  if (d.warm_start != 0 && d.warm_start != 1) refuse(MICA_ERR_INVALID_ARGUMENT, "def->warm_start must be 0 or 1");
+  s.warm_start = d.warm_start == 1;
   s.max_iterations = d.max_iterations;
   s.tolerance = d.tolerance;
   s.plan_all_stages = d.plan_all_stages != 0;

@@ -137,6 +137,9 @@ typedef struct mica_world_def {
   int32_t reserved1;       /**< zero */
   double body_margin;      /**< m: contacts between bodies are made for gaps below this; default 0.001 */
   double body_friction;    /**< Coulomb coefficient between bodies, >= 0; default 0 */
+  int32_t warm_start;      /**< MICA: 1 starts each step's iteration from the last step's velocities
+                                and impulses (matched by persistent contact keys); 0 from zero; default 1 */
+  int32_t reserved2;       /**< zero */
 } mica_world_def;
 
 /** Fills `def` with defaults, writing only its first `struct_size` bytes, and records

@@ -231,7 +231,10 @@ void World::solve_mica(const std::vector<Body*>& dynamic, double h) {
   for (size_t k = 0; k < dynamic.size(); ++k) {
     Body& b = *dynamic[k];
     form_rhs(b, h);
-    b.v_next = b.v;  // warm start from the last velocity
+    // The warm start: the last step's velocities (MICA's iterate carries its information in v:
+    // one PGS sweep makes an isolated row's impulse a function of v alone).
+    if (settings_.warm_start) b.v_next = b.v;
+    else for (Vec3& v : b.v_next) v.setZero();
     mica_bodies_[k].pattern = &b.fem.pattern;
     mica_bodies_[k].A = &b.A;
     mica_bodies_[k].b = &b.b;
@@ -241,7 +244,7 @@ void World::solve_mica(const std::vector<Body*>& dynamic, double h) {
   // Warm start the impulses of contact rows that persist from the last step.
   rows_.build(contacts_, h, settings_.max_recovery_speed);
   lambda_.assign(rows_.size(), 0.0);
-  for (size_t r = 0; r < rows_.size(); ++r) {
+  for (size_t r = 0; settings_.warm_start && r < rows_.size(); ++r) {
     const auto it = warm_start_.find(rows_.key[r]);
     if (it != warm_start_.end()) lambda_[r] = it->second;
   }

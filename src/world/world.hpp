@@ -31,6 +31,7 @@ struct WorldSettings {
   double max_recovery_speed = 1.0; // m/s, clamps gap / h for penetrating contacts
   bool paper_norm = false;         // MICA: stop on the paper's 2-norm of the change
   double relaxation = 1.0;         // MICA: MBGS over-relaxation omega in (0, 2)
+  bool warm_start = true;          // MICA: start from the last step's velocities and impulses (else zero)
   bool body_contact = true;        // contact between bodies (and with static bodies)
   double body_margin = 1e-3;       // m, contacts between bodies are made for gaps below this
   double body_friction = 0;        // Coulomb coefficient between bodies

@@ -270,6 +270,38 @@ static void test_degenerate_contacts_stay_bounded(void**) {
   }
 }
 
+// Warm starting the impulses from the last step changes the work, not the answer.
+static void test_warm_start_saves_iterations(void**) {
+  WorldSettings warm = settings(SolverKind::Mica, 1e-10), cold = warm;
+  cold.warm_start = false;
+  Scene a{World(warm)}, b{World(cold)};
+  SceneSpec spec;
+  spec.tool = true;
+  build(a, spec);
+  build(b, spec);
+  int iterations_warm = 0, iterations_cold = 0;
+  double diff = 0, vmax = 0;
+  for (int k = 0; k < 10; ++k) {
+    for (Scene* s : {&a, &b}) {
+      const Vec3 p = s->world.tool(s->tool).position + Vec3(0, -0.001, 0);
+      s->world.set_tool_pose(s->tool, p, Eigen::Quaterniond::Identity());
+      s->world.step(0.01);
+    }
+    iterations_warm += a.world.stats().solver_iterations;
+    iterations_cold += b.world.stats().solver_iterations;
+    const Vec3List& va = a.world.body(a.body).v;
+    const Vec3List& vb = b.world.body(b.body).v;
+    for (size_t i = 0; i < va.size(); ++i) {
+      diff = std::max(diff, (va[i] - vb[i]).norm());
+      vmax = std::max(vmax, vb[i].norm());
+    }
+  }
+  print_message("iterations over 10 steps: %d warm, %d cold; velocities agree to %.2g relative\n", iterations_warm,
+                iterations_cold, diff / vmax);
+  assert_true(iterations_warm < iterations_cold);
+  assert_le(diff, 1e-7 * vmax);
+}
+
 // The paper's Figure 2: Gauss-Seidel needs more iterations as the body stiffens (the count
 // grows ~ E h^2 / (rho dx^2) until it saturates at the mesh's own scale).
 static void test_iterations_grow_with_stiffness(void**) {
@@ -307,6 +339,7 @@ int main(void) {
       cmocka_unit_test(test_lifting_a_grasp_pulls_down),
       cmocka_unit_test(test_degenerate_contacts_stay_bounded),
       cmocka_unit_test(test_iterations_grow_with_stiffness),
+      cmocka_unit_test(test_warm_start_saves_iterations),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

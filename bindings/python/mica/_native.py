@@ -118,6 +118,8 @@ class mica_world_def(Structure):
         ("reserved1", c_int32),
         ("body_margin", c_double),
         ("body_friction", c_double),
+        ("warm_start", c_int32),
+        ("reserved2", c_int32),
     ]
 
 

@@ -132,6 +132,8 @@ namespace LibMica
             public int reserved1;
             public double body_margin;
             public double body_friction;
+            public int warm_start;
+            public int reserved2;
         }
 
         [StructLayout(LayoutKind.Sequential)]
