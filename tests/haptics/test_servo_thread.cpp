@@ -25,7 +25,10 @@ void count_tick(void* context) {
 
 }  // namespace
 
-static void test_runs_at_about_one_kilohertz(void**) {
+// Timing-independent: every 1 ms deadline over the run is either ticked or skipped (never
+// burst), and the reported rate agrees with the counted ticks. How many ticks a loaded machine
+// manages is a benchmark's business (bench/bench_servo.c), not a unit test's.
+static void test_accounts_for_every_deadline(void**) {
   Counter counter;
   ServoThread servo;
   assert_false(servo.running());
@@ -40,11 +43,12 @@ static void test_runs_at_about_one_kilohertz(void**) {
   const int64_t ticks = counter.ticks.load();
   printf("# %lld ticks in %.3f s, measured rate %.1f Hz, %lld deadlines skipped\n", (long long)ticks, elapsed,
          servo.measured_rate(), (long long)servo.skipped());
-  assert_in_range(ticks, 200, 400);
+  assert_true(ticks > 0);
   assert_int_equal(servo.ticks(), ticks);
+  const double deadlines = double(ticks + servo.skipped());
+  assert_le(deadlines, 1e3 * elapsed + 2);
+  assert_le(1e3 * elapsed - 0.1 * 1e3 * elapsed - 5, deadlines);  // stop() may end a sleep early
   // The measured rate agrees with the count (loosely: the count spans start to stop).
-  assert_le(600, servo.measured_rate());
-  assert_le(servo.measured_rate(), 1500);
   assert_near(servo.measured_rate(), double(ticks) / elapsed, 0.25 * double(ticks) / elapsed);
   // No more ticks after stop().
   std::this_thread::sleep_for(std::chrono::milliseconds(5));
@@ -122,7 +126,7 @@ static void test_destructor_stops(void**) {
 
 int main(void) {
   const struct CMUnitTest tests[] = {
-      cmocka_unit_test(test_runs_at_about_one_kilohertz),
+      cmocka_unit_test(test_accounts_for_every_deadline),
       cmocka_unit_test(test_overrun_skips_instead_of_bursting),
       cmocka_unit_test(test_start_stop_bookkeeping),
       cmocka_unit_test(test_destructor_stops),
