@@ -58,6 +58,20 @@ static void reach(double t, double p[3], void* user) {
   p[2] = 0;
 }
 
+/* A virtual hand following `reach`, driving the scene's tool. */
+static mica_device_id add_hand(scene* s, mica_device_def* dd, mica_device_info* info) {
+  *dd = mica_device_def_default();
+  dd->backend = MICA_DEVICE_SIMULATED;
+  dd->simulated_kind = MICA_SIMULATED_HAND;
+  dd->trajectory = reach;
+  dd->tool = s->tool;
+  mica_device_id device;
+  assert_int_equal(mica_device_create(s->world, dd, &device), MICA_OK);
+  info->struct_size = sizeof *info;
+  assert_int_equal(mica_device_get_info(s->world, device, info), MICA_OK);
+  return device;
+}
+
 static void sleep_ms(double ms) {
   struct timespec ts = {0, (long)(ms * 1e6)};
   nanosleep(&ts, NULL);
@@ -67,15 +81,9 @@ static void sleep_ms(double ms) {
  * read) per 16 ms step, so the run is the same on any machine. */
 static void closed_loop(double youngs_modulus) {
   scene s = make_scene(youngs_modulus);
-  mica_device_def dd = mica_device_def_default();
-  dd.backend = MICA_DEVICE_SIMULATED;
-  dd.simulated_kind = MICA_SIMULATED_HAND;
-  dd.trajectory = reach;
-  dd.tool = s.tool;
-  mica_device_id device;
-  assert_int_equal(mica_device_create(s.world, &dd, &device), MICA_OK);
-  mica_device_info info = {sizeof info};
-  assert_int_equal(mica_device_get_info(s.world, device, &info), MICA_OK);
+  mica_device_def dd;
+  mica_device_info info;
+  const mica_device_id device = add_hand(&s, &dd, &info);
   double max_force = 0, last_y[3] = {0, 0, 0}, tool[3] = {0, 0, 0};
   for (int k = 0; k < 150; ++k) { /* 2.4 s */
     for (int p = 0; p < 16; ++p) {
@@ -131,15 +139,9 @@ static void test_closed_loop_stiff(void** state) {
 static void test_servo_thread_beside_simulation(void** state) {
   (void)state;
   scene s = make_scene(5e3);
-  mica_device_def dd = mica_device_def_default();
-  dd.backend = MICA_DEVICE_SIMULATED;
-  dd.simulated_kind = MICA_SIMULATED_HAND;
-  dd.trajectory = reach;
-  dd.tool = s.tool;
-  mica_device_id device;
-  assert_int_equal(mica_device_create(s.world, &dd, &device), MICA_OK);
-  mica_device_info info = {sizeof info};
-  assert_int_equal(mica_device_get_info(s.world, device, &info), MICA_OK);
+  mica_device_def dd;
+  mica_device_info info;
+  const mica_device_id device = add_hand(&s, &dd, &info);
   assert_int_equal(mica_device_start(s.world, device), MICA_OK);
   for (int k = 0; k < 60; ++k) {
     assert_true(mica_step(s.world, 1.0 / 60.0) >= 0);
