@@ -18,4 +18,5 @@ cmake --build "$build" -j "$(nproc 2>/dev/null || echo 2)"
 # Leaks count as failures; UBSan stops at the first report (the build sets -fno-sanitize-recover).
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1 TSAN_OPTIONS=halt_on_error=1
 export LSAN_OPTIONS="suppressions=$root/tests/lsan.supp"
-ctest --test-dir "$build" --output-on-failure -j "$(nproc 2>/dev/null || echo 2)" "${select[@]}" -LE packaging
+# The examples (demos at full size, already run by the main suite) would take minutes under ASan.
+ctest --test-dir "$build" --output-on-failure -j "$(nproc 2>/dev/null || echo 2)" "${select[@]}" -LE "packaging|examples"
