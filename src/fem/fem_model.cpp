@@ -27,7 +27,16 @@ FemModel build_fem_model(const TetMesh& mesh, const Material& material, MassKind
   m.lame = lame_parameters(material);
   m.mass_kind = mass_kind;
   m.elements.reserve(mesh.tets.size());
-  for (const Tet& t : mesh.tets) m.elements.push_back(make_tet_element(m.rest, t));
+  for (size_t e = 0; e < mesh.tets.size(); ++e) {
+    m.elements.push_back(make_tet_element(m.rest, mesh.tets[e]));
+    // The quality check is scale-free; double precision is not: a tet of edge 1e-104 m has a
+    // subnormal determinant (its inverse overflows) and one of 1e102 m overflows its mass.
+    const TetElement& el = m.elements.back();
+    if (!el.dm_inv.allFinite() || !std::isfinite(material.density * el.volume) ||
+        !std::isfinite(material.youngs_modulus * el.volume))
+      fail(Errc::BadMesh, source + ": tet " + std::to_string(e) + " (volume " + std::to_string(el.volume) +
+                              " m^3) is too small or too large to model in double precision");
+  }
   m.pattern = build_block_pattern(m.node_count(), mesh.tets);
   m.slots = element_block_slots(m.pattern, mesh.tets);
 

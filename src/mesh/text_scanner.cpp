@@ -39,9 +39,11 @@ bool underflows(std::string_view s) {
     std::string_view digits = s.substr(e + 1);
     if (!digits.empty() && digits.front() == '+') digits.remove_prefix(1);
     const auto ec = std::from_chars(digits.data(), digits.data() + digits.size(), exponent).ec;
-    if (ec == std::errc::result_out_of_range) {
-      exponent = digits.front() == '-' ? -(std::int64_t{1} << 40) : std::int64_t{1} << 40;
-    }
+    // Far beyond any double's range, and small enough that adding a digit count cannot overflow
+    // (an exponent of 2^63 - 1 itself parses, and wrapped the sum below).
+    constexpr std::int64_t kBound = std::int64_t{1} << 40;
+    if (ec == std::errc::result_out_of_range) exponent = digits.front() == '-' ? -kBound : kBound;
+    exponent = std::clamp(exponent, -kBound, kBound);
   }
   // Power of ten of the leading nonzero digit (the mantissa has one, or it would be in range).
   const auto point = static_cast<std::int64_t>(std::min(mantissa.find('.'), mantissa.size()));
