@@ -15,13 +15,14 @@
 # Installs nothing. Needs the Debian 12 packages clang-14, libclang-rt-14-dev and
 # libeigen3-dev (llvm-14 too for symbolized stack traces).
 # Environment: FUZZ_SECONDS, FUZZ_TARGETS, FUZZ_BUILD_DIR (default build-fuzz/), FUZZ_CXX (the
-# clang++ to use), FUZZ_JOBS (build parallelism, default nproc).
+# clang++ to use), FUZZ_JOBS (build parallelism, default nproc), FUZZ_CRASH_DIR (default
+# fuzz/crashes/).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 seconds=${FUZZ_SECONDS:-60}
 targets=${FUZZ_TARGETS:-fuzz_gmsh fuzz_tetgen fuzz_mesh_build}
 build=${FUZZ_BUILD_DIR:-$root/build-fuzz}
-crashes="$root/fuzz/crashes"
+crashes=${FUZZ_CRASH_DIR:-$root/fuzz/crashes}
 packages="clang-14 libclang-rt-14-dev libeigen3-dev (and llvm-14 for symbolized traces)"
 
 if [[ -n "${FUZZ_CXX:-}" ]]; then
