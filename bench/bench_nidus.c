@@ -1,0 +1,338 @@
+/* The nidus-scale scene of Arikatla et al. 2016: a lesion-like blob of about 9.7k tets and
+ * 2.7k nodes (8.2k DOF, data/nidus/nidus.msh, made by data/nidus/make_nidus.py), touched by a
+ * forceps tip, timed per step on one core. The paper ran this scale at about 100 ms per step
+ * on a 2016 core; the target here is 5 ms.
+ *
+ * Scene: the blob (E = 1e4 Pa, nu = 0.4, rho = 1000, Rayleigh alpha = 2 1/s, co-rotational,
+ * consistent mass, no gravity: the tissue around a lesion carries it) held by its lowest fifth
+ * (fixed nodes, as if attached to the surrounding tissue). A 2 mm sphere (the forceps tip)
+ * starts 0.5 mm above the top of the blob over its centre, presses 2 mm into it at 10 mm/s,
+ * then moves between 1 and 3 mm deep once a second (every timed step has a moving tool in
+ * contact). MICA at tolerance 1e-6 (cap 100000), dt = 10 ms. The first `warm-up` steps
+ * (approach and first contact) are not timed; then `steps` steps are, with mica_step's
+ * wall-clock time taken around the call.
+ *
+ * Memory: VmRSS (/proc/self/status) before and after mica_body_create_from_file, and after the
+ * first step (when the solver's buffers exist), divided by the tets.
+ *
+ * usage: bench_nidus [mesh] [tolerance] [steps] [warm-up] [E] [dt]
+ *          defaults: data/nidus/nidus.msh 1e-6 200 40 1e4 0.01
+ *        bench_nidus --scaling <out.csv> [max-tets]
+ *          time per step against tets on box grids: a 0.1 m cube of n^3 cubes x 6 tets
+ *          (E = 2e4 Pa, alpha = 2, gravity, base fixed), a 2 cm sphere 6 mm deep +- 3 mm at
+ *          1 Hz, MICA tol 1e-6; 9 warm-up steps, then 20 timed (10 above 40k tets); 1k to 100k
+ *          tets, with the memory per tet of each box.
+ * Run it pinned to one core, with CHOLMOD's BLAS kept to one thread (OpenBLAS starts a worker
+ * thread at load even though MICA never calls it):
+ *   OPENBLAS_NUM_THREADS=1 taskset -c 1 build/bench/bench_nidus
+ */
+#define _GNU_SOURCE
+#include <math.h>
+#include <sched.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include <mica/mica.h>
+
+static double now_ms(void) {
+  struct timespec t;
+  clock_gettime(CLOCK_MONOTONIC, &t);
+  return 1e3 * (double)t.tv_sec + 1e-6 * (double)t.tv_nsec;
+}
+
+static int cmp(const void* a, const void* b) {
+  const double x = *(const double*)a, y = *(const double*)b;
+  return (x > y) - (x < y);
+}
+
+static double quantile(double* v, int n, double q) {
+  qsort(v, (size_t)n, sizeof v[0], cmp);
+  int k = (int)ceil(q * n) - 1;
+  return v[k < 0 ? 0 : k >= n ? n - 1 : k];
+}
+
+static long status_kb(const char* key) {
+  FILE* f = fopen("/proc/self/status", "r");
+  if (!f) return -1;
+  char line[256];
+  long v = -1;
+  const size_t n = strlen(key);
+  while (fgets(line, sizeof line, f))
+    if (strncmp(line, key, n) == 0) {
+      v = strtol(line + n, NULL, 10);
+      break;
+    }
+  fclose(f);
+  return v;
+}
+
+static void machine(char* buf, size_t size) {
+  char model[160] = "unknown CPU";
+  FILE* f = fopen("/proc/cpuinfo", "r");
+  if (f) {
+    char line[256];
+    while (fgets(line, sizeof line, f))
+      if (strncmp(line, "model name", 10) == 0) {
+        const char* c = strchr(line, ':');
+        if (c) snprintf(model, sizeof model, "%s", c + 2);
+        model[strcspn(model, "\n")] = 0;
+        break;
+      }
+    fclose(f);
+  }
+  double load = -1;
+  f = fopen("/proc/loadavg", "r");
+  if (f) {
+    if (fscanf(f, "%lf", &load) != 1) load = -1;
+    fclose(f);
+  }
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  const int cpus = sched_getaffinity(0, sizeof set, &set) == 0 ? CPU_COUNT(&set) : -1;
+  snprintf(buf, size, "%s; this process may run on %d CPU(s); load average %.2f", model, cpus, load);
+}
+
+#define CHECK(call)                                                                                   \
+  do {                                                                                                \
+    const mica_status s_ = (call);                                                                    \
+    if (s_ < 0) {                                                                                     \
+      fprintf(stderr, "%s: %s\n  %s\n", #call, mica_status_string(s_), mica_world_last_error(world)); \
+      return 1;                                                                                       \
+    }                                                                                                 \
+  } while (0)
+
+typedef struct {
+  double median, p95, mean, iterations, mem_create_b_per_tet, mem_step_b_per_tet, force;
+  int32_t nodes, tets, capped, contacts;
+} figures;
+
+/* Steps a world with a sphere pressing from `y0` down by `depth` at `speed`, then moving up
+ * and down by `wobble` around there once a second (so every timed step has a moving tool in
+ * contact, as under a hand); times the steps after the warm-up. */
+static int press(mica_world* world, mica_tool_id tool, const double c[3], double y0, double depth, double speed,
+                 double wobble, double dt, int warmup, int steps, figures* out) {
+  double* ms = malloc(sizeof(double) * (size_t)steps);
+  long iterations = 0;
+  out->capped = 0;
+  for (int k = 0; k < warmup + steps; ++k) {
+    const double t = (k + 1) * dt, t_in = depth / speed;
+    const double travel = t < t_in ? speed * t : depth + wobble * sin(2 * M_PI * (t - t_in));
+    const double p[3] = {c[0], y0 - travel, c[2]}, q[4] = {1, 0, 0, 0};
+    CHECK(mica_tool_set_pose(world, tool, p, q));
+    const double t0 = now_ms();
+    const mica_status s = mica_step(world, dt);
+    const double elapsed = now_ms() - t0;
+    CHECK(s);
+    if (k < warmup) continue;
+    mica_world_stats st;
+    memset(&st, 0, sizeof st);
+    st.struct_size = sizeof st;
+    CHECK(mica_world_get_stats(world, &st));
+    ms[k - warmup] = elapsed;
+    iterations += st.solver_iterations;
+    if (!st.converged) ++out->capped;
+  }
+  double f[3];
+  CHECK(mica_tool_get_force(world, tool, f, NULL, &out->contacts));
+  out->force = sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
+  double sum = 0;
+  for (int k = 0; k < steps; ++k) sum += ms[k];
+  out->mean = sum / steps;
+  out->median = quantile(ms, steps, 0.5);
+  out->p95 = quantile(ms, steps, 0.95);
+  out->iterations = (double)iterations / steps;
+  free(ms);
+  return 0;
+}
+
+static int nidus(const char* path, double tol, int steps, int warmup, double E, double dt) {
+  mica_world* world = NULL;
+  mica_world_def wd = mica_world_def_default();
+  wd.gravity[1] = 0; /* the lesion is carried by the tissue around it */
+  wd.solver = MICA_SOLVER_MICA;
+  wd.tolerance = tol;
+  wd.max_iterations = 100000;
+  if (mica_world_create(&wd, &world) != MICA_OK) {
+    fprintf(stderr, "%s\n", mica_world_last_error(NULL));
+    return 1;
+  }
+  mica_body_def bd = mica_body_def_default();
+  bd.youngs_modulus = E;
+  bd.poisson_ratio = 0.4;
+  bd.density = 1000;
+  bd.rayleigh_alpha = 2;
+  figures fig;
+  memset(&fig, 0, sizeof fig);
+  const long rss0 = status_kb("VmRSS:");
+  mica_body_id body;
+  CHECK(mica_body_create_from_file(world, &bd, path, &body));
+  const long rss1 = status_kb("VmRSS:");
+  CHECK(mica_body_get_counts(world, body, &fig.nodes, &fig.tets, NULL));
+  double* x = malloc(sizeof(double) * 3 * (size_t)fig.nodes);
+  CHECK(mica_body_get_rest_positions(world, body, x, fig.nodes, NULL));
+  double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL}, c[3] = {0, 0, 0};
+  for (int32_t i = 0; i < fig.nodes; ++i)
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = fmin(lo[a], x[3 * i + a]);
+      hi[a] = fmax(hi[a], x[3 * i + a]);
+      c[a] += x[3 * i + a] / fig.nodes;
+    }
+  /* The top of the blob over its centre: the highest crossing of the vertical line through the
+   * centroid with a surface triangle. */
+  double top = -HUGE_VAL;
+  int32_t ntri = 0;
+  CHECK(mica_body_get_surface(world, body, NULL, 0, &ntri));
+  int32_t* tri = malloc(sizeof(int32_t) * 3 * (size_t)ntri);
+  CHECK(mica_body_get_surface(world, body, tri, ntri, &ntri));
+  for (int32_t t = 0; t < ntri; ++t) {
+    const double* a = x + 3 * tri[3 * t];
+    const double* b = x + 3 * tri[3 * t + 1];
+    const double* d = x + 3 * tri[3 * t + 2];
+    const double det = (b[0] - a[0]) * (d[2] - a[2]) - (d[0] - a[0]) * (b[2] - a[2]);
+    if (fabs(det) < 1e-18) continue;
+    const double u = ((c[0] - a[0]) * (d[2] - a[2]) - (d[0] - a[0]) * (c[2] - a[2])) / det;
+    const double v = ((b[0] - a[0]) * (c[2] - a[2]) - (c[0] - a[0]) * (b[2] - a[2])) / det;
+    if (u < 0 || v < 0 || u + v > 1) continue;
+    top = fmax(top, a[1] + u * (b[1] - a[1]) + v * (d[1] - a[1]));
+  }
+  free(tri);
+  free(x);
+  /* Held by its lowest fifth. */
+  const double cut[3] = {0, lo[1] + 0.2 * (hi[1] - lo[1]), 0}, up[3] = {0, 1, 0};
+  int32_t n = 0;
+  CHECK(mica_body_select_nodes_by_plane(world, body, cut, up, 0, 1, NULL, 0, &n));
+  int32_t* held = malloc(sizeof(int32_t) * (size_t)n);
+  CHECK(mica_body_select_nodes_by_plane(world, body, cut, up, 0, 1, held, n, &n));
+  mica_lpc_def fixed = mica_lpc_def_default();
+  mica_lpc_id base;
+  CHECK(mica_add_lpc(world, body, held, n, &fixed, &base));
+  free(held);
+  const double R = 0.002, y0 = top + R + 0.0005;
+  mica_tool_def td = mica_tool_def_default();
+  td.radius = R;
+  td.margin = 0.0005;
+  td.position[0] = c[0];
+  td.position[1] = y0;
+  td.position[2] = c[2];
+  mica_tool_id tool;
+  CHECK(mica_tool_create(world, &td, &tool));
+  CHECK(mica_step(world, dt) < 0 ? -1 : MICA_OK); /* the first step allocates the solver's buffers */
+  const long rss2 = status_kb("VmRSS:");
+  if (press(world, tool, c, y0, 0.0025, 0.01, 0.001, dt, warmup - 1, steps, &fig)) return 1;
+  fig.mem_create_b_per_tet = 1024.0 * (double)(rss1 - rss0) / fig.tets;
+  fig.mem_step_b_per_tet = 1024.0 * (double)(rss2 - rss0) / fig.tets;
+  char m[300];
+  machine(m, sizeof m);
+  const long threads = status_kb("Threads:");
+  printf("# bench_nidus: %s\n", m);
+  printf("# mesh %s: %d nodes (%d DOF), %d tets, %.1f x %.1f x %.1f mm; held by %d nodes (lowest fifth)\n", path,
+         fig.nodes, 3 * fig.nodes, fig.tets, 1e3 * (hi[0] - lo[0]), 1e3 * (hi[1] - lo[1]), 1e3 * (hi[2] - lo[2]), n);
+  printf("# E = %.3g Pa, nu = 0.4, rho = 1000, alpha = 2; forceps tip: sphere R = %.1f mm, 2 mm deep +- 1 mm at 1 Hz; "
+         "MICA tol %.0e, dt = %g ms; %d warm-up steps, %d timed; %ld thread(s) in the process\n",
+         E, 1e3 * R, tol, 1e3 * dt, warmup, steps, threads);
+  printf("# command: OPENBLAS_NUM_THREADS=1 taskset -c 1 build/bench/bench_nidus %s %g %d %d %g %g\n", path, tol,
+         steps, warmup, E, dt);
+  printf("median ms/step        %.3f\n", fig.median);
+  printf("p95 ms/step           %.3f\n", fig.p95);
+  printf("mean ms/step          %.3f\n", fig.mean);
+  printf("iterations/step       %.1f (mean over timed steps; %d stopped at the cap)\n", fig.iterations, fig.capped);
+  printf("tool force            %.4f N, %d contacts at the end\n", fig.force, fig.contacts);
+  printf("memory, body creation %.0f B/tet (VmRSS %ld -> %ld kB)\n", fig.mem_create_b_per_tet, rss0, rss1);
+  printf("memory, after 1 step  %.0f B/tet (VmRSS %ld kB)\n", fig.mem_step_b_per_tet, rss2);
+  mica_world_destroy(world);
+  return 0;
+}
+
+static int scaling(const char* csv_path, int max_tets) {
+  FILE* csv = fopen(csv_path, "w");
+  if (!csv) {
+    fprintf(stderr, "cannot write %s\n", csv_path);
+    return 1;
+  }
+  char m[300];
+  machine(m, sizeof m);
+  fprintf(csv, "# bench_nidus --scaling: %s\n", m);
+  fprintf(csv, "cells,nodes,tets,ms_median,ms_p95,iterations,ms_per_iteration,mem_B_per_tet,force_N\n");
+  printf("# bench_nidus --scaling: %s\n", m);
+  printf("# command: OPENBLAS_NUM_THREADS=1 taskset -c 1 build/bench/bench_nidus --scaling %s %d\n", csv_path, max_tets);
+  printf("%6s %8s %8s %10s %10s %10s %12s %10s\n", "cells", "nodes", "tets", "median ms", "p95 ms", "iters",
+         "ms/iter", "B/tet");
+  const int sizes[] = {6, 8, 11, 14, 18, 22, 26, 30};
+  for (int s = 0; s < 8; ++s) {
+    const int n = sizes[s];
+    if (6L * n * n * n > max_tets) break;
+    mica_world* world = NULL;
+    mica_world_def wd = mica_world_def_default();
+    wd.solver = MICA_SOLVER_MICA;
+    wd.tolerance = 1e-6;
+    wd.max_iterations = 100000;
+    if (mica_world_create(&wd, &world) != MICA_OK) return 1;
+    mica_body_def bd = mica_body_def_default();
+    bd.youngs_modulus = 2e4;
+    bd.rayleigh_alpha = 2;
+    const double lo[3] = {0, 0, 0}, hi[3] = {0.1, 0.1, 0.1};
+    const int32_t cells[3] = {n, n, n};
+    figures fig;
+    memset(&fig, 0, sizeof fig);
+    const long rss0 = status_kb("VmRSS:");
+    mica_body_id body;
+    CHECK(mica_body_create_box(world, &bd, lo, hi, cells, 6, &body));
+    CHECK(mica_body_get_counts(world, body, &fig.nodes, &fig.tets, NULL));
+    int32_t count = 0;
+    const double o[3] = {0, 0, 0}, up[3] = {0, 1, 0};
+    CHECK(mica_body_select_nodes_by_plane(world, body, o, up, 1e-9, 1, NULL, 0, &count));
+    int32_t* sel = malloc(sizeof(int32_t) * (size_t)count);
+    CHECK(mica_body_select_nodes_by_plane(world, body, o, up, 1e-9, 1, sel, count, &count));
+    mica_lpc_def fixed = mica_lpc_def_default();
+    mica_lpc_id base;
+    CHECK(mica_add_lpc(world, body, sel, count, &fixed, &base));
+    free(sel);
+    mica_tool_def td = mica_tool_def_default();
+    td.radius = 0.02;
+    td.margin = 0.002;
+    const double c[3] = {0.05, 0, 0.05}, y0 = 0.1 + 0.02 + 0.001;
+    td.position[0] = c[0];
+    td.position[1] = y0;
+    td.position[2] = c[2];
+    mica_tool_id tool;
+    CHECK(mica_tool_create(world, &td, &tool));
+    CHECK(mica_step(world, 0.01) < 0 ? -1 : MICA_OK);
+    const long rss1 = status_kb("VmRSS:");
+    const int steps = fig.tets > 40000 ? 10 : 20;
+    if (press(world, tool, c, y0, 0.007, 0.1, 0.003, 0.01, 9, steps, &fig)) return 1;
+    fig.mem_step_b_per_tet = 1024.0 * (double)(rss1 - rss0) / fig.tets;
+    fprintf(csv, "%d,%d,%d,%.4f,%.4f,%.1f,%.5f,%.0f,%.5g\n", n, fig.nodes, fig.tets, fig.median, fig.p95,
+            fig.iterations, fig.iterations > 0 ? fig.median / fig.iterations : NAN, fig.mem_step_b_per_tet, fig.force);
+    fflush(csv);
+    printf("%6d %8d %8d %10.3f %10.3f %10.1f %12.5f %10.0f\n", n, fig.nodes, fig.tets, fig.median, fig.p95,
+           fig.iterations, fig.iterations > 0 ? fig.median / fig.iterations : NAN, fig.mem_step_b_per_tet);
+    fflush(stdout);
+    fprintf(stderr, "progress %d %d\n", s + 1, 8);
+    mica_world_destroy(world);
+  }
+  fclose(csv);
+  return 0;
+}
+
+int main(int argc, char** argv) {
+  if (argc > 1 && strcmp(argv[1], "--scaling") == 0) {
+    if (argc < 3) {
+      fprintf(stderr, "usage: bench_nidus --scaling <out.csv> [max-tets]\n");
+      return 2;
+    }
+    return scaling(argv[2], argc > 3 ? atoi(argv[3]) : 110000);
+  }
+  const char* path = argc > 1 ? argv[1] : "data/nidus/nidus.msh";
+  const double tol = argc > 2 ? atof(argv[2]) : 1e-6;
+  const int steps = argc > 3 ? atoi(argv[3]) : 200;
+  const int warmup = argc > 4 ? atoi(argv[4]) : 40;
+  const double E = argc > 5 ? atof(argv[5]) : 1e4;
+  const double dt = argc > 6 ? atof(argv[6]) : 0.01;
+  if (!(tol > 0) || steps < 1 || warmup < 2 || !(E > 0) || !(dt > 0)) {
+    fprintf(stderr, "usage: bench_nidus [mesh] [tolerance] [steps] [warm-up >= 2] [E] [dt]\n");
+    return 2;
+  }
+  return nidus(path, tol, steps, warmup, E, dt);
+}

@@ -1,0 +1,320 @@
+/* Analytic anchors: mesh convergence toward Hertz (a sphere indenting a deep block) and toward
+ * Euler-Bernoulli (a cantilever under its own weight). Both are static, small-strain linear
+ * elasticity problems, so both bodies use MICA_MODEL_LINEAR and the exact solver
+ * (MICA_SOLVER_DIRECT), stepped with h = 1 s: the mass term M / h^2 is then some 1e-8 of the
+ * stiffness, and each step is a Newton step of the static problem (a linear body's matrix is
+ * factored once). What is measured is the discretisation error, not the solver's.
+ *
+ * Hertz: a quarter of a block [0, W] x [-D, 0] x [0, W] (W = D = 0.1 m = 45 contact radii),
+ * symmetry planes x = 0 and z = 0 (sliding projection constraints), the base fixed, sides free;
+ * E = 1e4 Pa, nu = 0.3. A sphere of R = 1 cm centred on the axis is pushed to d = 0.5 mm
+ * (d / R = 0.05, contact radius a = sqrt(R d) = 2.24 mm) in 4 increments of 2 steps, then 3
+ * more steps. The mesh is a tensor grid graded alike along each axis, x_i = W sinh(4 i / n) /
+ * sinh(4) for i = 0 ... n (nearly uniform near the contact, growing by e^(4/n) per cell
+ * outward, so raising n refines every cell alike), each cell cut into 5 tets (the cut
+ * alternating with the cell parity); n = 8, 12, 16, 20, 24 (2560 ... 69120 tets). The element
+ * size reported is the cell size at the contact edge x = a. F_FEM = 4 x the tool's force
+ * against F_Hertz = 4/3 E/(1 - nu^2) sqrt(R) d^1.5; the mean of the last 3 steps, since the
+ * contact set still flickers between steps on the coarser meshes (the spread is reported).
+ *
+ * Euler-Bernoulli: a beam L = 0.2 m, square section H = 0.02 m, E = 1e7 Pa, nu = 0.3,
+ * rho = 1000, clamped (all nodes of x = 0 fixed), under gravity; the tip deflection (mean over
+ * the nodes of the end face) against w = q L^4 / (8 E I), q = rho g H^2 (Timoshenko's shear
+ * term, q L^2 / (2 k G A) with k = 5/6, is printed beside it: about +1%). Box meshes of
+ * 10 n x n x n cubes x 6 tets, n = 1 ... 8.
+ *
+ * usage: study_anchors <out-dir> [quick]
+ * Writes <out-dir>/anchors.csv (one row per mesh) and <out-dir>/hertz_curve.csv (F against d
+ * on every Hertz level).
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <mica/mica.h>
+
+#include "study_common.h"
+
+#define HERTZ_R 0.01
+#define HERTZ_D 0.0005
+#define HERTZ_E 1e4
+#define HERTZ_NU 0.3
+#define HERTZ_W 0.1
+
+/* A 1D graded coordinate list from 0 to `length` in n cells: x_i = length sinh(k i / n) / sinh(k),
+ * nearly uniform near 0 and growing geometrically (by e^(k/n) per cell) further out, so that
+ * raising n refines every cell alike. Returns the count of points, n + 1. */
+static int graded(int n, double k, double length, double* out) {
+  for (int i = 0; i <= n; ++i) out[i] = length * sinh(k * i / n) / sinh(k);
+  return n + 1;
+}
+
+/* 5-tet cuts of a cube, corner index = x + 2 y + 4 z. */
+static const int cut_even[5][4] = {{0, 3, 5, 6}, {1, 0, 3, 5}, {2, 0, 6, 3}, {4, 0, 5, 6}, {7, 3, 6, 5}};
+static const int cut_odd[5][4] = {{1, 2, 4, 7}, {0, 1, 4, 2}, {3, 1, 2, 7}, {5, 1, 7, 4}, {6, 2, 4, 7}};
+
+static double det3(const double* a, const double* b, const double* c, const double* d) {
+  const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+  const double v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+  const double w[3] = {d[0] - a[0], d[1] - a[1], d[2] - a[2]};
+  return u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) + u[2] * (v[0] * w[1] - v[1] * w[0]);
+}
+
+typedef struct {
+  double h, value, theory, timoshenko, ms, spread;
+  int32_t nodes, tets;
+  int ok;
+} level_result;
+
+static double g_kappa = 4.0, g_W = HERTZ_W;
+static int g_trace = 0;
+
+static level_result hertz_level(int cells, FILE* curve) {
+  level_result r;
+  memset(&r, 0, sizeof r);
+  const double a = sqrt(HERTZ_R * HERTZ_D);
+  double gx[256] = {0}, gy[256] = {0};
+  const int nx = graded(cells, g_kappa, g_W, gx);
+  const double h0 = gx[1];
+  const int ny = nx; /* the same sequence downward */
+  memcpy(gy, gx, sizeof(double) * (size_t)nx);
+  const int cx = nx - 1, cy = ny - 1, cz = nx - 1;
+  const int32_t nodes = nx * ny * nx;
+  double* p = malloc(sizeof(double) * 3 * (size_t)nodes);
+  int32_t* t = malloc(sizeof(int32_t) * 4 * 5 * (size_t)cx * cy * cz);
+  for (int k = 0; k < nx; ++k)
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i) {
+        double* q = p + 3 * ((size_t)(k * ny + j) * nx + i);
+        q[0] = gx[i];
+        q[1] = -gy[ny - 1 - j]; /* y from -D up to 0: fine near the top */
+        q[2] = gx[k];
+      }
+  int32_t ntet = 0;
+  for (int k = 0; k < cz; ++k)
+    for (int j = 0; j < cy; ++j)
+      for (int i = 0; i < cx; ++i) {
+        int32_t c[8];
+        for (int m = 0; m < 8; ++m)
+          c[m] = ((k + ((m >> 2) & 1)) * ny + (j + ((m >> 1) & 1))) * nx + (i + (m & 1));
+        const int(*cut)[4] = ((i + j + k) % 2 == 0) ? cut_even : cut_odd;
+        for (int e = 0; e < 5; ++e) {
+          int32_t* o = t + 4 * (size_t)ntet++;
+          for (int v = 0; v < 4; ++v) o[v] = c[cut[e][v]];
+          if (det3(p + 3 * o[0], p + 3 * o[1], p + 3 * o[2], p + 3 * o[3]) < 0) {
+            const int32_t s = o[2];
+            o[2] = o[3];
+            o[3] = s;
+          }
+        }
+      }
+  mica_world_def wd = mica_world_def_default();
+  wd.gravity[0] = wd.gravity[1] = wd.gravity[2] = 0;
+  wd.solver = MICA_SOLVER_DIRECT;
+  mica_world* w = NULL;
+  mica_world_create(&wd, &w);
+  mica_body_def bd = mica_body_def_default();
+  bd.youngs_modulus = HERTZ_E;
+  bd.poisson_ratio = HERTZ_NU;
+  bd.model = MICA_MODEL_LINEAR;
+  mica_body_id body;
+  const double t0 = study_now_ms();
+  if (mica_body_create(w, &bd, p, nodes, t, ntet, &body) != MICA_OK) {
+    fprintf(stderr, "hertz: %s\n", mica_world_last_error(w));
+    mica_world_destroy(w);
+    free(p);
+    free(t);
+    return r;
+  }
+  /* Symmetry: x = 0 slides in its plane, z = 0 too; the base is fixed. */
+  mica_lpc_id lx, lz, base;
+  const double o[3] = {0, 0, 0}, nxp[3] = {1, 0, 0}, nzp[3] = {0, 0, 1}, bottom[3] = {0, -HERTZ_W, 0},
+               up[3] = {0, 1, 0};
+  int32_t n = 0;
+  int32_t* sel = study_select_plane(w, body, o, nxp, 1e-9, &n);
+  mica_lpc_def plane = mica_lpc_def_default();
+  plane.kind = MICA_LPC_PLANE;
+  plane.direction[0][0] = 1;
+  mica_add_lpc(w, body, sel, n, &plane, &lx);
+  free(sel);
+  sel = study_select_plane(w, body, o, nzp, 1e-9, &n);
+  plane.direction[0][0] = 0;
+  plane.direction[0][2] = 1;
+  mica_add_lpc(w, body, sel, n, &plane, &lz);
+  free(sel);
+  study_fix_plane(w, body, bottom, up, 1e-9, &base);
+  mica_tool_def td = mica_tool_def_default();
+  td.radius = HERTZ_R;
+  td.margin = 1e-4;
+  td.position[1] = HERTZ_R + 1e-4;
+  mica_tool_id tool;
+  mica_tool_create(w, &td, &tool);
+  const double q[4] = {1, 0, 0, 0};
+  const int increments = 4, settle = 2, final_settle = 3;
+  double f[3] = {0, 0, 0}, last3[3] = {0, 0, 0};
+  r.ok = 1;
+  for (int inc = 1; inc <= increments && r.ok; ++inc) {
+    const double d = HERTZ_D * inc / increments;
+    const double pos[3] = {0, HERTZ_R - d, 0};
+    mica_tool_set_pose(w, tool, pos, q);
+    const int steps = inc == increments ? settle + final_settle : settle;
+    for (int s = 0; s < steps; ++s)
+      if (mica_step(w, 1.0) < 0) {
+        fprintf(stderr, "hertz h0 %.3g: %s\n", h0, mica_world_last_error(w));
+        r.ok = 0;
+        break;
+      } else {
+        mica_tool_get_force(w, tool, f, NULL, NULL);
+        if (inc == increments && s >= steps - 3) last3[s - (steps - 3)] = 4 * f[1];
+        if (g_trace) printf("  d %.4g step %d F %.6g (%.0f ms)\n", d, s, 4 * f[1], study_now_ms() - t0);
+      }
+    int32_t contacts = 0;
+    mica_tool_get_force(w, tool, f, NULL, &contacts);
+    const double hertz = 4.0 / 3.0 * HERTZ_E / (1 - HERTZ_NU * HERTZ_NU) * sqrt(HERTZ_R) * pow(d, 1.5);
+    fprintf(curve, "%.6g,%.6g,%.9g,%.9g,%d\n", h0, d, 4 * f[1], hertz, contacts);
+  }
+  r.ms = study_now_ms() - t0;
+  r.h = h0;
+  for (int i = 0; i + 1 < nx; ++i)
+    if (gx[i] <= a && a < gx[i + 1]) r.h = gx[i + 1] - gx[i]; /* the cell size at the contact edge */
+  /* The contact set still flickers between steps on coarse meshes (nodes and triangle points
+   * entering and leaving): the force is the mean of the last 3 steps, its spread reported. */
+  r.value = (last3[0] + last3[1] + last3[2]) / 3;
+  r.spread = (fmax(last3[0], fmax(last3[1], last3[2])) - fmin(last3[0], fmin(last3[1], last3[2]))) / r.value;
+  r.theory = 4.0 / 3.0 * HERTZ_E / (1 - HERTZ_NU * HERTZ_NU) * sqrt(HERTZ_R) * pow(HERTZ_D, 1.5);
+  r.timoshenko = NAN;
+  r.nodes = nodes;
+  r.tets = ntet;
+  mica_world_destroy(w);
+  free(p);
+  free(t);
+  return r;
+}
+
+static level_result beam_level(int n, int model) {
+  level_result r;
+  memset(&r, 0, sizeof r);
+  const double L = 0.2, H = 0.02, E = 1e7, nu = 0.3, rho = 1000, g = 9.81;
+  mica_world_def wd = mica_world_def_default();
+  wd.gravity[0] = wd.gravity[1] = 0;
+  wd.gravity[2] = -g;
+  wd.solver = MICA_SOLVER_DIRECT;
+  mica_world* w = NULL;
+  mica_world_create(&wd, &w);
+  mica_body_def bd = mica_body_def_default();
+  bd.youngs_modulus = E;
+  bd.poisson_ratio = nu;
+  bd.density = rho;
+  bd.model = model;
+  const double lo[3] = {0, 0, 0}, hi[3] = {L, H, H};
+  const int32_t cells[3] = {10 * n, n, n};
+  mica_body_id body;
+  const double t0 = study_now_ms();
+  mica_body_create_box(w, &bd, lo, hi, cells, 6, &body);
+  mica_body_get_counts(w, body, &r.nodes, &r.tets, NULL);
+  mica_lpc_id clamp;
+  const double o[3] = {0, 0, 0}, nx[3] = {1, 0, 0}, tip_p[3] = {L, 0, 0}, tip_n[3] = {-1, 0, 0};
+  study_fix_plane(w, body, o, nx, 1e-9, &clamp);
+  int32_t ntip = 0;
+  int32_t* tip = study_select_plane(w, body, tip_p, tip_n, 1e-9, &ntip);
+  double* x = malloc(sizeof(double) * 3 * (size_t)r.nodes);
+  double* x0 = malloc(sizeof(double) * 3 * (size_t)r.nodes);
+  mica_body_get_rest_positions(w, body, x0, r.nodes, NULL);
+  double wtip = 0, last = -1;
+  r.ok = 1;
+  for (int s = 0; s < 30; ++s) {
+    if (mica_step(w, 1.0) < 0) {
+      r.ok = 0;
+      break;
+    }
+    mica_body_get_positions(w, body, x, r.nodes, NULL);
+    wtip = 0;
+    for (int32_t k = 0; k < ntip; ++k) wtip += x0[3 * tip[k] + 2] - x[3 * tip[k] + 2];
+    wtip /= ntip;
+    if (s >= 2 && fabs(wtip - last) <= 1e-10 * fabs(wtip)) break;
+    last = wtip;
+  }
+  r.ms = study_now_ms() - t0;
+  const double I = H * H * H * H / 12.0, q = rho * g * H * H, G = E / (2 * (1 + nu));
+  r.h = H / n;
+  r.value = wtip;
+  r.theory = q * L * L * L * L / (8 * E * I);
+  r.timoshenko = r.theory + q * L * L / (2 * (5.0 / 6.0) * G * H * H);
+  free(x);
+  free(x0);
+  free(tip);
+  mica_world_destroy(w);
+  return r;
+}
+
+int main(int argc, char** argv) {
+  if (argc < 2) {
+    fprintf(stderr, "usage: study_anchors <out-dir> [quick]\n");
+    return 2;
+  }
+  const int quick = argc > 2 && strcmp(argv[2], "quick") == 0;
+  if (argc > 5 && strcmp(argv[2], "hertz") == 0) { /* experiments: hertz <cells> <kappa> <W> */
+    g_kappa = atof(argv[4]);
+    g_W = atof(argv[5]);
+    g_trace = 1;
+    const level_result r = hertz_level(atoi(argv[3]), stdout);
+    printf("h0 %.4g: %d nodes %d tets F %.6g Hertz %.6g ratio %.4f, %.0f ms\n", r.h, r.nodes, r.tets, r.value,
+           r.theory, r.value / r.theory, r.ms);
+    return 0;
+  }
+  char path[1024], machine[256];
+  study_machine(machine, sizeof machine);
+  snprintf(path, sizeof path, "%s/anchors.csv", argv[1]);
+  FILE* csv = fopen(path, "w");
+  snprintf(path, sizeof path, "%s/hertz_curve.csv", argv[1]);
+  FILE* curve = fopen(path, "w");
+  if (!csv || !curve) {
+    fprintf(stderr, "cannot write into %s\n", argv[1]);
+    return 1;
+  }
+  fprintf(csv, "# study_anchors: %s; libmica %d\n", machine, mica_version());
+  fprintf(csv, "test,model,h_m,nodes,tets,fem,theory,rel_error,timoshenko,rel_error_timoshenko,ms,spread\n");
+  fprintf(curve, "h0_m,depth_m,force_N,hertz_N,contacts\n");
+  const double a = sqrt(HERTZ_R * HERTZ_D);
+  const int divisors[] = {8, 12, 16, 20, 24};
+  const int beams[] = {1, 2, 3, 4, 6, 8};
+  const int nh = quick ? 2 : 5, nbm = quick ? 3 : 6;
+  /* progress weights: roughly the cost of each level */
+  double total = 0, done = 0;
+  for (int k = 0; k < nh; ++k) total += pow(divisors[k] / 8.0, 4);
+  for (int k = 0; k < nbm; ++k) total += 2 * 0.2 * pow(beams[k], 3);
+  printf("# Hertz: sphere R = %.3f m to d = %.4f m (a = %.4f m) on a graded quarter block; E = %.0f Pa, nu = %.2f\n",
+         HERTZ_R, HERTZ_D, a, HERTZ_E, HERTZ_NU);
+  printf("%-6s %-12s %10s %8s %8s %12s %12s %10s %9s\n", "test", "model", "h (m)", "nodes", "tets", "FEM", "theory",
+         "rel err", "ms");
+  for (int k = 0; k < nh; ++k) {
+    const level_result r = hertz_level(divisors[k], curve);
+    fflush(curve);
+    const double err = (r.value - r.theory) / r.theory;
+    fprintf(csv, "hertz,linear,%.6g,%d,%d,%.9g,%.9g,%.6g,,,%.1f,%.4g\n", r.h, r.nodes, r.tets, r.value, r.theory,
+            r.ok ? err : NAN, r.ms, r.spread);
+    printf("%-6s %-12s %10.3e %8d %8d %12.5g %12.5g %10.4f %9.0f  (last 3 steps spread %.1f%%)\n", "hertz", "linear",
+           r.h, r.nodes, r.tets, r.value, r.theory, err, r.ms, 100 * r.spread);
+    fflush(stdout);
+    done += pow(divisors[k] / 8.0, 4);
+    study_progress(done, total);
+  }
+  for (int m = 0; m < 2; ++m)
+    for (int k = 0; k < nbm; ++k) {
+      const int model = m == 0 ? MICA_MODEL_LINEAR : MICA_MODEL_COROTATIONAL;
+      const level_result r = beam_level(beams[k], model);
+      const double err = (r.value - r.theory) / r.theory, errt = (r.value - r.timoshenko) / r.timoshenko;
+      fprintf(csv, "cantilever,%s,%.6g,%d,%d,%.9g,%.9g,%.6g,%.9g,%.6g,%.1f,\n", m == 0 ? "linear" : "corotational",
+              r.h, r.nodes, r.tets, r.value, r.theory, r.ok ? err : NAN, r.timoshenko, r.ok ? errt : NAN, r.ms);
+      printf("%-6s %-12s %10.3e %8d %8d %12.5g %12.5g %10.4f %9.0f  (Timoshenko %.5g: %+.4f)\n", "beam",
+             m == 0 ? "linear" : "corotational", r.h, r.nodes, r.tets, r.value, r.theory, err, r.ms, r.timoshenko,
+             errt);
+      fflush(stdout);
+      done += 0.2 * pow(beams[k], 3);
+      study_progress(done, total);
+    }
+  fclose(csv);
+  fclose(curve);
+  return 0;
+}

@@ -1,0 +1,131 @@
+#!/usr/bin/env bash
+# What accuracy costs in time: builds what is missing, runs the whole study and draws it.
+# Output: out/study/*.csv, out/study/*.png, out/study/tables.md, out/study/logs/*.log.
+# See docs/accuracy-vs-time.md and docs/performance.md.
+#
+#   scripts/study.sh            the full study: about 11 minutes on a 2-core machine shared
+#                               with other work (a third to a half of a core for the study)
+#   scripts/study.sh quick      a smoke test: a few configurations of each part
+#
+# Environment: MICA_STUDY_BUILD (default ./build-study) is the CMake build folder;
+# MICA_STUDY_OUT (default ./out/study) the output folder.
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+mode=${1:-full}
+build=${MICA_STUDY_BUILD:-$root/build-study}
+out=${MICA_STUDY_OUT:-$root/out/study}
+mkdir -p "$out/logs"
+rm -f "$out/logs/times.txt.new"
+export OPENBLAS_NUM_THREADS=1 # CHOLMOD's BLAS: one thread, like the library's own step
+start=$SECONDS
+
+# ---- build (libmica, bench_nidus, the study programs) when missing or out of date
+echo "study: building in $build (log: $out/logs/build.log)"
+{
+  cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release -DMICA_BUILD_DOCS=OFF -DMICA_BUILD_TESTS=OFF \
+    -DMICA_BUILD_EXAMPLES=OFF -DMICA_BUILD_BENCH=ON
+  cmake --build "$build" -j 2 --target mica bench_nidus
+} >"$out/logs/build.log" 2>&1 || { tail -20 "$out/logs/build.log"; exit 1; }
+bin="$build/study-bin"
+mkdir -p "$bin"
+study_programs=(study_sweep study_anchors study_filter)
+if cmake --build "$build" --target help 2>/dev/null | grep -q study_sweep; then
+  # bench/CMakeLists.txt has add_subdirectory(study): the targets exist.
+  cmake --build "$build" -j 2 --target "${study_programs[@]}" >>"$out/logs/build.log" 2>&1
+  for p in "${study_programs[@]}"; do cp "$build/bench/study/$p" "$bin/$p"; done
+else
+  # Not hooked into CMake yet: compile the plain C programs against the built libmica.
+  cc=${CC:-cc}
+  defs=()
+  grep -q 'warm_start' "$root/include/mica/mica.h" && defs+=(-DMICA_STUDY_HAVE_WARM_START)
+  for p in "${study_programs[@]}"; do
+    src="$root/bench/study/$p.c"
+    if [[ ! -x "$bin/$p" || "$src" -nt "$bin/$p" || "$root/bench/study/study_common.h" -nt "$bin/$p" ||
+          "$build/libmica.so" -nt "$bin/$p" || "$root/include/mica/mica.h" -nt "$bin/$p" ]]; then
+      "$cc" -O2 -std=c99 -D_POSIX_C_SOURCE=200809L "${defs[@]}" -I"$root/include" "$src" -o "$bin/$p" \
+        -L"$build" -lmica -lm -lpthread -Wl,-rpath,"$build" >>"$out/logs/build.log" 2>&1 ||
+        { tail -20 "$out/logs/build.log"; exit 1; }
+    fi
+  done
+fi
+nidus_bin="$build/bench/bench_nidus"
+pin=""
+command -v taskset >/dev/null && pin="taskset -c 1" # the benchmark's "one core"
+echo "study: built in $((SECONDS - start)) s"
+
+# ---- the stages: name, weight (expected CPU seconds, for the bar), command
+quick=()
+[[ $mode == quick ]] && quick=(quick)
+nidus_steps=(30 30)
+scaling_max=110000
+if [[ $mode == quick ]]; then
+  nidus_steps=(5 30)
+  scaling_max=20000
+fi
+stages=(
+  "sweep|250|$bin/study_sweep $out ${quick[*]:-}"
+  "anchors|90|$bin/study_anchors $out ${quick[*]:-}"
+  "filter|35|$bin/study_filter $out"
+  "nidus|45|$pin $nidus_bin $root/data/nidus/nidus.msh 1e-6 ${nidus_steps[0]} ${nidus_steps[1]} 1e4 0.01"
+  "scaling|215|$pin $nidus_bin --scaling $out/scaling.csv $scaling_max"
+  "plots|6|/usr/bin/python3 $root/scripts/study_plots.py $out"
+)
+total=0
+for s in "${stages[@]}"; do total=$((total + $(cut -d'|' -f2 <<<"$s"))); done
+cols=40
+draw() { # draw <fraction 0..1> <label>
+  awk -v f="$1" -v label="$2" -v cols=$cols -v el=$((SECONDS - start)) 'BEGIN {
+    if (f < 0) f = 0; if (f > 1) f = 1
+    n = int(f * cols + 0.5); bar = ""
+    for (i = 0; i < cols; ++i) bar = bar (i < n ? "#" : ".")
+    printf "\r[%s] %3d%%  %-8s %4d s ", bar, int(100 * f + 0.5), label, el
+  }' >&2
+}
+has_tty=0
+[[ -t 2 ]] && has_tty=1 # the bar on a terminal; one line per stage in a log
+done_weight=0
+for s in "${stages[@]}"; do
+  name=$(cut -d'|' -f1 <<<"$s")
+  weight=$(cut -d'|' -f2 <<<"$s")
+  cmd=$(cut -d'|' -f3- <<<"$s")
+  log="$out/logs/$name.log"
+  t0=$SECONDS
+  if [[ $has_tty == 1 ]]; then
+    draw "$(awk -v a=$done_weight -v t=$total 'BEGIN{print a/t}')" "$name"
+  else
+    echo "study: $name ..."
+  fi
+  # stdout to the log; stderr's "progress d t" lines move the bar, anything else goes to the log.
+  set +e
+  $cmd 2>&1 >"$log" | while IFS= read -r line; do
+    if [[ $line == progress\ * ]]; then
+      read -r _ d t <<<"$line"
+      [[ $has_tty == 1 ]] && draw "$(awk -v a=$done_weight -v w=$weight -v d="$d" -v t="$t" -v T=$total \
+        'BEGIN{print (a + w * d / t) / T}')" "$name"
+    else
+      echo "$line" >>"$log"
+    fi
+  done
+  status=${PIPESTATUS[0]}
+  set -e
+  if [[ $status != 0 ]]; then
+    echo
+    echo "study: $name failed (exit $status); the end of $log:"
+    tail -20 "$log"
+    exit 1
+  fi
+  done_weight=$((done_weight + weight))
+  if [[ $has_tty == 1 ]]; then
+    draw "$(awk -v a=$done_weight -v t=$total 'BEGIN{print a/t}')" "$name"
+  else
+    echo "study: $name done in $((SECONDS - t0)) s ($((100 * done_weight / total))%)"
+  fi
+  echo "$name $((SECONDS - t0)) s" >>"$out/logs/times.txt.new"
+done
+[[ $has_tty == 1 ]] && echo
+mv "$out/logs/times.txt.new" "$out/logs/times.txt"
+cp "$out/logs/nidus.log" "$out/nidus.txt"
+echo "study: done in $((SECONDS - start)) s; stage times in $out/logs/times.txt"
+echo "  CSV: $(cd "$out" && ls *.csv | tr '\n' ' ')"
+echo "  PNG: $(cd "$out" && ls *.png | tr '\n' ' ')"
+echo "  tables for the docs: $out/tables.md; the nidus benchmark: $out/nidus.txt"

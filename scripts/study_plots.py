@@ -1,0 +1,517 @@
+#!/usr/bin/env python3
+"""Draws the accuracy-against-time study (scripts/study.sh) from the CSVs in its folder, and
+writes tables.md (the tables of docs/accuracy-vs-time.md and docs/performance.md).
+
+  error_vs_time.png          position and tool-force error against ms per step, one front per
+                             solver and mode (fixed tolerance, fixed iterations), exact as a line
+  iterations_vs_tolerance.png iterations and ms per step against the tolerance
+  figure2_stiffness.png      MICA iterations per step for E = 1e3 ... 1e7 Pa (nu = 0.3, tol 1e-8),
+                             and iterations and ms against E for all three solvers
+  figure1_force.png          force during compression and release at the device (1 kHz): raw,
+                             filtered with N = 20 and the post-contact correction, and without it;
+                             delay and ripple against N
+  knobs.png                  the other knobs: time step, mesh, model, mass, PGS sweeps, warm start,
+                             stopping norm: error against ms per step
+  anchors.png                Hertz and Euler-Bernoulli: error against element size (log-log), and
+                             the Hertz force against depth
+  scaling.png                ms per step, iterations and ms per iteration against tets
+
+usage: study_plots.py <study-folder>
+"""
+import csv
+import math
+import os
+import sys
+from collections import OrderedDict, defaultdict
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+
+def read(path):
+    if not os.path.exists(path):
+        return [], ""
+    with open(path, newline="") as f:
+        lines = f.readlines()
+    comment = "".join(l[1:].strip() for l in lines if l.startswith("#"))
+    rows = list(csv.DictReader(l for l in lines if not l.startswith("#")))
+    return rows, comment
+
+
+def num(v):
+    try:
+        return float(v)
+    except (TypeError, ValueError):
+        return math.nan
+
+
+def fin(v):
+    return not math.isnan(v) and not math.isinf(v)
+
+
+COLOURS = {"MICA": "tab:blue", "PCG": "tab:orange", "exact": "k"}
+
+
+def error_vs_time(rows, out):
+    fig, axes = plt.subplots(1, 2, figsize=(13, 5), dpi=110)
+    floor = {"disp_rms_err_m": 1e-15, "force_err_N": 1e-13}
+    for ax, key, label in ((axes[0], "disp_rms_err_m", "position error, RMS over nodes, worst step (m)"),
+                           (axes[1], "force_err_N", "tool force error, worst step (N)")):
+        for solver in ("MICA", "PCG"):
+            for group, ls, marker, mode in (("tolerance", "-", "o", "fixed tolerance"),
+                                            ("iterations", "--", "s", "fixed iterations")):
+                pts = [(num(r["ms_median"]), num(r[key]), r) for r in rows
+                       if r["group"] == group and r["solver"] == solver and r["status"] in ("ok", "capped")]
+                pts = [(x, max(y, floor[key]), r) for x, y, r in pts if fin(x) and fin(y)]
+                if not pts:
+                    continue
+                pts.sort(key=lambda p: p[0])
+                ax.loglog([p[0] for p in pts], [p[1] for p in pts], ls=ls, marker=marker, ms=4,
+                          color=COLOURS[solver], label=f"{solver}, {mode}")
+                for x, y, r in pts:
+                    tag = f"{num(r['tol']):.0e}" if group == "tolerance" else r["cap"]
+                    ax.annotate(tag, (x, y), fontsize=6, color=COLOURS[solver], xytext=(3, 2),
+                                textcoords="offset points")
+        exact = [num(r["ms_median"]) for r in rows if r["group"] == "tolerance" and r["solver"] == "exact"]
+        if exact:
+            ax.axvline(exact[0], color="k", ls=":", lw=1.2, label=f"exact (DIRECT): {exact[0]:.1f} ms")
+        ax.set_xlabel("median ms per step (in-process, after warm-up)")
+        ax.set_ylabel(label)
+        ax.grid(alpha=0.3, which="both")
+        ax.legend(fontsize=7)
+    axes[0].set_title("Position error against cost (labels: tolerance or iteration cap)")
+    axes[1].set_title("Tool force error against cost")
+    fig.suptitle("Error against the exact solver on the same scene: 3072-tet cube, sphere press + grasp drag, "
+                 "dt = 10 ms, 100 steps")
+    fig.tight_layout()
+    fig.savefig(os.path.join(out, "error_vs_time.png"))
+    plt.close(fig)
+
+
+def iterations_vs_tolerance(rows, out):
+    fig, (ax_i, ax_t) = plt.subplots(1, 2, figsize=(12, 4.5), dpi=110)
+    for solver in ("MICA", "PCG"):
+        pts = sorted((num(r["tol"]), num(r["iters_mean"]), num(r["iters_max"]), num(r["ms_median"]),
+                      num(r["ms_p95"])) for r in rows if r["group"] == "tolerance" and r["solver"] == solver)
+        if not pts:
+            continue
+        ax_i.loglog([p[0] for p in pts], [p[1] for p in pts], "o-", color=COLOURS[solver],
+                    label=f"{solver}: mean per step")
+        ax_i.loglog([p[0] for p in pts], [p[2] for p in pts], "^:", color=COLOURS[solver], ms=4,
+                    label=f"{solver}: worst step")
+        ax_t.loglog([p[0] for p in pts], [p[3] for p in pts], "o-", color=COLOURS[solver], label=f"{solver}: median")
+        ax_t.loglog([p[0] for p in pts], [p[4] for p in pts], "^:", color=COLOURS[solver], ms=4,
+                    label=f"{solver}: p95")
+    exact = [num(r["ms_median"]) for r in rows if r["group"] == "tolerance" and r["solver"] == "exact"]
+    if exact:
+        ax_t.axhline(exact[0], color="k", ls=":", label="exact (DIRECT) median")
+    for ax in (ax_i, ax_t):
+        ax.invert_xaxis()
+        ax.set_xlabel("tolerance (relative change of v and lambda)")
+        ax.grid(alpha=0.3, which="both")
+        ax.legend(fontsize=7)
+    ax_i.set_ylabel("iterations per step (PCG: summed over its solves, one per contact row + 1)")
+    ax_t.set_ylabel("ms per step")
+    ax_i.set_title("Iterations against tolerance")
+    ax_t.set_title("Time against tolerance")
+    fig.tight_layout()
+    fig.savefig(os.path.join(out, "iterations_vs_tolerance.png"))
+    plt.close(fig)
+
+
+def figure2(rows, steps, out):
+    fig, (ax_s, ax_e, ax_t) = plt.subplots(1, 3, figsize=(16, 4.5), dpi=110)
+    runs = OrderedDict()
+    for r in steps:
+        if r["solver"] == "MICA":
+            runs.setdefault(num(r["E_Pa"]), []).append((int(r["step"]), int(r["iterations"]), int(r["converged"])))
+    colours = plt.cm.viridis([i / max(1, len(runs) - 1) for i in range(len(runs))])
+    for (E, rs), c in zip(runs.items(), colours):
+        ax_s.plot([s for s, _, _ in rs], [i for _, i, _ in rs], marker="o", ms=2.5, lw=1, color=c,
+                  label=f"E = {E:.0e} Pa")
+        capped = [(s, i) for s, i, ok in rs if not ok]
+        if capped:
+            ax_s.plot(*zip(*capped), "x", color="r")
+    ax_s.set_yscale("log")
+    ax_s.set_xlabel("step (dt = 10 ms)")
+    ax_s.set_ylabel("MICA iterations to tolerance 1e-8")
+    ax_s.set_title("Figure 2: iterations per step (nu = 0.3)")
+    ax_s.grid(alpha=0.3, which="both")
+    ax_s.legend(fontsize=7)
+    for solver in ("MICA", "PCG", "exact"):
+        pts = sorted((num(r["E_Pa"]), num(r["iters_mean"]), num(r["ms_median"])) for r in rows
+                     if r["group"] == "stiffness" and r["solver"] == solver)
+        if not pts:
+            continue
+        if solver != "exact":
+            ax_e.loglog([p[0] for p in pts], [p[1] for p in pts], "o-", color=COLOURS[solver], label=solver)
+        ax_t.loglog([p[0] for p in pts], [p[2] for p in pts], "o-", color=COLOURS[solver], label=solver)
+    Es = sorted({num(r["E_Pa"]) for r in rows if r["group"] == "stiffness"})
+    if Es:
+        dx = 0.1 / 8
+        ax_e.set_title("Mean iterations per step against E\n(top axis: E h^2 / (rho dx^2))")
+        sec = ax_e.secondary_xaxis("top", functions=(lambda E: E * 1e-4 / (1000 * dx * dx),
+                                                     lambda r: r * 1000 * dx * dx / 1e-4))
+        sec.tick_params(labelsize=7)
+    ax_e.set_xlabel("Young's modulus E (Pa)")
+    ax_e.set_ylabel("iterations per step (mean after warm-up)")
+    ax_t.set_xlabel("Young's modulus E (Pa)")
+    ax_t.set_ylabel("median ms per step")
+    ax_t.set_title("Time against E (tol 1e-8; exact for reference)")
+    for ax in (ax_e, ax_t):
+        ax.grid(alpha=0.3, which="both")
+        ax.legend(fontsize=7)
+    fig.suptitle("Stiffness: 3072-tet cube, sphere press + grasp drag, 50 steps of 10 ms")
+    fig.tight_layout()
+    fig.savefig(os.path.join(out, "figure2_stiffness.png"))
+    plt.close(fig)
+
+
+def moving_average_uncorrected(raw, n):
+    out, acc = [], 0.0
+    for k, v in enumerate(raw):
+        acc += v
+        if k >= n:
+            acc -= raw[k - n]
+        out.append(acc / min(n, k + 1))
+    return out
+
+
+def figure1(samples, filt, out):
+    if not samples:
+        return
+    fig = plt.figure(figsize=(15, 8), dpi=110)
+    gs = fig.add_gridspec(2, 3)
+    ax = fig.add_subplot(gs[0, :2])
+    ax_z = fig.add_subplot(gs[0, 2])
+    ax_d = fig.add_subplot(gs[1, 0])
+    ax_r = fig.add_subplot(gs[1, 1])
+    ax_h = fig.add_subplot(gs[1, 2])
+    by = defaultdict(list)
+    for r in samples:
+        by[(r["mode"], int(r["N"]))].append(r)
+    local1 = by.get(("local", 1), [])
+    local20 = by.get(("local", 20), [])
+    if local1 and local20:
+        t = [num(r["t_s"]) for r in local20]
+        raw = [num(r["raw_force_y_N"]) for r in local20]
+        ax.plot(t, [num(r["step_force_y_N"]) for r in local20], color="0.6", lw=1, drawstyle="steps-post",
+                label="simulation step force (62.5 Hz)")
+        ax.plot(t, raw, color="tab:orange", lw=0.8, label="raw: local model at 1 kHz")
+        ax.plot(t, [num(r["filtered_force_y_N"]) for r in local20], color="tab:blue", lw=1.5,
+                label="rendered: moving average N = 20 with the post-contact correction")
+        ax.plot(t, moving_average_uncorrected(raw, 20), color="tab:green", lw=1, ls="--",
+                label="N = 20 without the correction (computed from the raw samples)")
+        ax.set_xlabel("time (s)")
+        ax.set_ylabel("force on the stylus, y (N)")
+        ax.set_title("Figure 1: compression and release, simulated stylus, lockstep 16 polls per 16 ms step")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7)
+        # zoom on the contact onset
+        onset = next((i for i, v in enumerate(raw) if v > 0), 0)
+        lo, hi = max(0, onset - 15), min(len(t), onset + 80)
+        ax_z.plot(t[lo:hi], raw[lo:hi], color="tab:orange", lw=1, marker=".", ms=3, label="raw")
+        ax_z.plot(t[lo:hi], [num(r["filtered_force_y_N"]) for r in local20][lo:hi], color="tab:blue", lw=1.5,
+                  label="N = 20, corrected")
+        ax_z.plot(t[lo:hi], moving_average_uncorrected(raw, 20)[lo:hi], color="tab:green", ls="--",
+                  label="N = 20, uncorrected")
+        ax_z.set_title("Contact onset (zoom)")
+        ax_z.set_xlabel("time (s)")
+        ax_z.grid(alpha=0.3)
+        ax_z.legend(fontsize=7)
+    for mode, colour in (("local", "tab:blue"), ("hold", "tab:red")):
+        pts = sorted((int(r["N"]), num(r["delay_ms"]), num(r["ripple_rms_N_per_ms"]), num(r["max_jump_N"]))
+                     for r in filt if r["mode"] == mode)
+        if not pts:
+            continue
+        name = "local model" if mode == "local" else "zero-order hold"
+        ax_d.plot([p[0] for p in pts], [p[1] for p in pts], "o-", color=colour, label=f"{name}: measured")
+        ax_r.loglog([p[0] for p in pts], [p[2] for p in pts], "o-", color=colour, label=f"{name}: RMS change per ms")
+        ax_r.loglog([p[0] for p in pts], [p[3] for p in pts], "s:", color=colour, ms=4,
+                    label=f"{name}: largest jump per ms")
+    Ns = sorted({int(r["N"]) for r in filt})
+    ax_d.plot(Ns, [(n - 1) / 2 for n in Ns], "k:", label="(N - 1) / 2")
+    ax_d.set_xlabel("filter window N (servo samples of 1 ms)")
+    ax_d.set_ylabel("delay of the rendered force (ms)")
+    ax_d.set_title("Delay against N")
+    ax_r.set_xlabel("filter window N")
+    ax_r.set_ylabel("N per servo sample while in contact")
+    ax_r.set_title("Smoothness against N")
+    for a in (ax_d, ax_r):
+        a.grid(alpha=0.3, which="both")
+        a.legend(fontsize=7)
+    hold20 = by.get(("hold", 20), [])
+    hold1 = by.get(("hold", 1), [])
+    if hold1 and hold20:
+        t = [num(r["t_s"]) for r in hold20]
+        ax_h.plot(t, [num(r["filtered_force_y_N"]) for r in hold1], color="tab:red", lw=0.8, label="hold, N = 1")
+        ax_h.plot(t, [num(r["filtered_force_y_N"]) for r in hold20], color="tab:blue", lw=1.5, label="hold, N = 20")
+        ax_h.set_xlim(0.3, 0.5)
+        ys = [num(r["filtered_force_y_N"]) for r in hold1 if 0.3 <= num(r["t_s"]) <= 0.5]
+        if ys:
+            ax_h.set_ylim(min(ys) * 0.95, max(ys) * 1.05)
+        ax_h.set_title("Zero-order hold, loading (zoom)")
+        ax_h.set_xlabel("time (s)")
+        ax_h.grid(alpha=0.3)
+        ax_h.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(os.path.join(out, "figure1_force.png"))
+    plt.close(fig)
+
+
+def knobs(rows, out):
+    panels = [("dt", "time step", lambda r: f"{1e3 * num(r['dt_s']):g} ms"),
+              ("mesh", "mesh (cells per side)", lambda r: f"{r['cells']}^3"),
+              ("model", "model", lambda r: r["model"][:6]),
+              ("mass", "mass", lambda r: r["mass"]),
+              ("pgs", "PGS sweeps (tol 1e-6)", lambda r: f"{r['pgs_sweeps']} sweeps"),
+              ("warmstart", "warm start", lambda r: f"{'on' if r['warm_start'] == '1' else 'off'} {num(r['tol']):.0e}"),
+              ("norm", "paper's 2-norm stop", lambda r: f"{num(r['tol']):.0e}")]
+    fig, axes = plt.subplots(2, 4, figsize=(18, 8), dpi=100)
+    axes = axes.ravel()
+    base = [r for r in rows if r["group"] == "tolerance" and r["solver"] == "MICA"]
+    for ax, (group, title, tag) in zip(axes, panels):
+        rs = [r for r in rows if r["group"] == group]
+        if not rs:
+            ax.set_title(f"{title}: not in this run")
+            ax.axis("off")
+            continue
+        for r in rs:
+            x = num(r["ms_median"])
+            y = num(r["model_disp_rms_err_m"]) if group in ("dt", "model", "mass") else num(r["disp_rms_err_m"])
+            if group == "mesh":
+                y = num(r["model_force_err_N"])
+            if not fin(x) or not fin(y):
+                continue
+            y = max(y, 1e-12)
+            ax.loglog(x, y, "o" if r["solver"] == "MICA" else "s" if r["solver"] == "PCG" else "D",
+                      color=COLOURS[r["solver"]], ms=6)
+            ax.annotate(f"{r['solver']} {tag(r)}", (x, y), fontsize=6, xytext=(3, 3), textcoords="offset points")
+        if group in ("pgs", "norm", "warmstart") and base:
+            pts = sorted((num(r["ms_median"]), num(r["disp_rms_err_m"])) for r in base)
+            ax.loglog([p[0] for p in pts], [max(p[1], 1e-12) for p in pts], "-", color="0.7", lw=1,
+                      label="MICA tolerance front")
+            ax.legend(fontsize=6)
+        what = {"dt": "position error vs exact at dt = 5 ms (m)", "mesh": "tool force error vs exact 10^3 (N)",
+                "model": "position error vs exact co-rotational (m)",
+                "mass": "position error vs exact consistent (m)"}.get(group, "position error vs exact (m)")
+        ax.set_ylabel(what, fontsize=8)
+        ax.set_xlabel("median ms per step", fontsize=8)
+        ax.set_title(title)
+        ax.grid(alpha=0.3, which="both")
+    drift = [r for r in rows if r["group"] == "drift"]
+    ax = axes[7]
+    if drift:
+        labels = [f"{r['solver']} {num(r['tol']):.0e}" if r["solver"] != "exact" else "exact" for r in drift]
+        vals = [num(r["energy_ratio_end"]) for r in drift]
+        ax.bar(range(len(vals)), vals, color=[COLOURS[r["solver"]] for r in drift])
+        ax.set_xticks(range(len(vals)))
+        ax.set_xticklabels(labels, rotation=45, fontsize=7, ha="right")
+        ax.set_ylabel("energy after 1 s / energy after the push")
+        ax.set_title("Energy drift: undamped free vibration")
+        lo = min(v for v in vals if fin(v))
+        ax.set_ylim(min(lo * 0.98, 0.9), max(vals) * 1.02)
+        ax.grid(alpha=0.3, axis="y")
+    fig.suptitle("The other knobs (MICA tol 1e-6 unless marked): error against cost")
+    fig.tight_layout()
+    fig.savefig(os.path.join(out, "knobs.png"))
+    plt.close(fig)
+
+
+def anchors(rows, curve, out):
+    if not rows:
+        return
+    fig, (ax_c, ax_f) = plt.subplots(1, 2, figsize=(13, 5), dpi=110)
+    for test, model, colour, marker in (("hertz", "linear", "tab:red", "o"),
+                                        ("cantilever", "linear", "tab:blue", "s"),
+                                        ("cantilever", "corotational", "tab:cyan", "^")):
+        pts = sorted((num(r["h_m"]), abs(num(r["rel_error"])), num(r["rel_error"])) for r in rows
+                     if r["test"] == test and r["model"] == model)
+        pts = [p for p in pts if fin(p[1])]
+        if not pts:
+            continue
+        label = ("Hertz force, h = cell size at the contact edge" if test == "hertz"
+                 else f"cantilever tip ({model}), h = H / n")
+        ax_c.loglog([p[0] for p in pts], [p[1] for p in pts], marker=marker, color=colour, label=label)
+        for h, e, s in pts:
+            ax_c.annotate(f"{s:+.1%}", (h, e), fontsize=6, xytext=(3, 3), textcoords="offset points")
+        if len(pts) >= 2:
+            (h1, e1, _), (h2, e2, _) = pts[0], pts[1]
+            if e1 > 0 and e2 > 0 and h2 != h1:
+                rate = math.log(e2 / e1) / math.log(h2 / h1)
+                ax_c.annotate(f"slope {rate:.2f} (finest two)", (h1, e1), fontsize=7, color=colour,
+                              xytext=(-10, -14), textcoords="offset points")
+    ax_c.set_xlabel("element size h (m)")
+    ax_c.set_ylabel("|FEM - theory| / theory")
+    ax_c.set_title("Mesh convergence toward Hertz and Euler-Bernoulli (exact solver, static)")
+    ax_c.grid(alpha=0.3, which="both")
+    ax_c.legend(fontsize=7)
+    by = OrderedDict()
+    for r in curve:
+        by.setdefault(num(r["h0_m"]), []).append((num(r["depth_m"]), num(r["force_N"]), num(r["hertz_N"])))
+    colours = plt.cm.plasma([i / max(1, len(by)) for i in range(len(by))])
+    for (h, pts), c in zip(by.items(), colours):
+        ax_f.loglog([1e3 * p[0] for p in pts], [p[1] for p in pts], "o-", color=c, ms=4,
+                    label=f"FEM, h0 = {1e3 * h:.2f} mm")
+    if by:
+        pts = list(by.values())[0]
+        ax_f.loglog([1e3 * p[0] for p in pts], [p[2] for p in pts], "k--", lw=2,
+                    label="Hertz 4/3 E/(1-nu^2) sqrt(R) d^1.5")
+    ax_f.set_xlabel("indentation d (mm)")
+    ax_f.set_ylabel("force (N)")
+    ax_f.set_title("Sphere R = 1 cm on a deep block (E = 10 kPa, nu = 0.3)")
+    ax_f.grid(alpha=0.3, which="both")
+    ax_f.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(os.path.join(out, "anchors.png"))
+    plt.close(fig)
+
+
+def scaling(rows, out):
+    if not rows:
+        return
+    fig, (ax_t, ax_i) = plt.subplots(1, 2, figsize=(12, 4.5), dpi=110)
+    tets = [num(r["tets"]) for r in rows]
+    ax_t.loglog(tets, [num(r["ms_median"]) for r in rows], "o-", label="median ms per step")
+    ax_t.loglog(tets, [num(r["ms_p95"]) for r in rows], "^:", label="p95")
+    t0, m0 = tets[0], num(rows[0]["ms_median"])
+    ax_t.loglog(tets, [m0 * t / t0 for t in tets], "k:", lw=1, label="proportional to tets")
+    ax_t.set_xlabel("tets")
+    ax_t.set_ylabel("ms per step (MICA, tol 1e-6, one core)")
+    ax_t.set_title("Time per step against mesh size (0.1 m cube refined)")
+    ax_i.loglog(tets, [num(r["iterations"]) for r in rows], "o-", color="tab:orange", label="iterations per step")
+    ax_i2 = ax_i.twinx()
+    ax_i2.loglog(tets, [1e3 * num(r["ms_per_iteration"]) / num(r["tets"]) for r in rows], "s--", color="tab:green",
+                 label="microseconds per iteration per 1000 tets")
+    ax_i.set_xlabel("tets")
+    ax_i.set_ylabel("iterations per step", color="tab:orange")
+    ax_i2.set_ylabel("us per iteration per 1000 tets", color="tab:green")
+    ax_i.set_title("Where the time goes: iterations grow, each costs ~ tets")
+    for a in (ax_t, ax_i):
+        a.grid(alpha=0.3, which="both")
+    ax_t.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(os.path.join(out, "scaling.png"))
+    plt.close(fig)
+
+
+def g(v, fmt="{:.3g}"):
+    x = num(v)
+    return "-" if not fin(x) else fmt.format(x)
+
+
+def tables(rows, anchor_rows, filt, scal, comments, out):
+    lines = []
+    w = lines.append
+    w("<!-- written by scripts/study_plots.py -->")
+    for name, c in comments.items():
+        if c:
+            w(f"<!-- {name}: {c} -->")
+    head = ("| solver | tol | cap | median ms | p95 ms | iters/step (max) | pos. RMS err (m) | pos. max err (m) "
+            "| force err (N) | energy err | status |")
+    sep = "|---|---|---|---|---|---|---|---|---|---|---|"
+
+    def row(r, extra_tol=True):
+        tol = "-" if r["solver"] == "exact" else f"{num(r['tol']):.0e}"
+        cap = "-" if r["solver"] == "exact" else r["cap"]
+        return (f"| {r['solver']} | {tol} | {cap} | {g(r['ms_median'])} | {g(r['ms_p95'])} | "
+                f"{g(r['iters_mean'], '{:.1f}')} ({g(r['iters_max'], '{:.0f}')}) | {g(r['disp_rms_err_m'])} | "
+                f"{g(r['disp_max_err_m'])} | {g(r['force_err_N'])} | {g(r['energy_err_rel'])} | {r['status']} |")
+
+    for group, title in (("tolerance", "Fixed tolerance (cap 100000)"),
+                         ("iterations", "Fixed iterations (tolerance 1e-300, the cap varies)")):
+        w(f"\n### {title}\n")
+        w(head)
+        w(sep)
+        for r in rows:
+            if r["group"] == group or (group == "tolerance" and r["group"] == "tolerance" and r["solver"] == "exact"):
+                w(row(r))
+    w("\n### Other knobs\n")
+    w("| group | solver | setting | median ms | p95 ms | iters/step | pos. RMS err vs exact, same scene (m) "
+      "| model error (m or N) | force err (N) | penetration (m) | status |")
+    w("|---|---|---|---|---|---|---|---|---|---|---|")
+    for r in rows:
+        gr = r["group"]
+        if gr in ("tolerance", "iterations", "drift", "stiffness"):
+            continue
+        setting = {"dt": f"dt {1e3 * num(r['dt_s']):g} ms", "mesh": f"{r['cells']}^3 cells, {r['tets']} tets",
+                   "model": r["model"], "mass": r["mass"], "pgs": f"{r['pgs_sweeps']} PGS sweeps",
+                   "warmstart": f"warm start {'on' if r['warm_start'] == '1' else 'off'}",
+                   "norm": "paper's 2-norm"}.get(gr, "")
+        if r["solver"] != "exact":
+            setting += f", tol {num(r['tol']):.0e}"
+        model = (f"{g(r['model_force_err_N'])} N" if gr == "mesh" else
+                 f"{g(r['model_disp_rms_err_m'])} m" if gr in ("dt", "model", "mass") else "-")
+        w(f"| {gr} | {r['solver']} | {setting} | {g(r['ms_median'])} | {g(r['ms_p95'])} | "
+          f"{g(r['iters_mean'], '{:.1f}')} | {g(r['disp_rms_err_m'])} | {model} | {g(r['force_err_N'])} | "
+          f"{g(r['penetration_m'])} | {r['status']} |")
+    w("\n### Stiffness (tol 1e-8, 50 steps)\n")
+    w("| E (Pa) | solver | median ms | p95 ms | iters/step (max) | pos. RMS err (m) | force err (N) | status |")
+    w("|---|---|---|---|---|---|---|---|")
+    for r in rows:
+        if r["group"] == "stiffness":
+            w(f"| {num(r['E_Pa']):.0e} | {r['solver']} | {g(r['ms_median'])} | {g(r['ms_p95'])} | "
+              f"{g(r['iters_mean'], '{:.1f}')} ({g(r['iters_max'], '{:.0f}')}) | {g(r['disp_rms_err_m'])} | "
+              f"{g(r['force_err_N'])} | {r['status']} |")
+    w("\n### Energy drift (undamped free vibration, 1 s)\n")
+    w("| solver | tol | median ms | iters/step | energy end / start | pos. RMS err vs exact (m) |")
+    w("|---|---|---|---|---|---|")
+    for r in rows:
+        if r["group"] == "drift":
+            tol = "-" if r["solver"] == "exact" else f"{num(r['tol']):.0e}"
+            w(f"| {r['solver']} | {tol} | {g(r['ms_median'])} | {g(r['iters_mean'], '{:.1f}')} | "
+              f"{g(r['energy_ratio_end'], '{:.3g}')} | {g(r['disp_rms_err_m'])} |")
+    if anchor_rows:
+        w("\n### Analytic anchors\n")
+        w("| test | model | h (m) | nodes | tets | FEM | theory | rel. error | vs Timoshenko (beam) | ms |")
+        w("|---|---|---|---|---|---|---|---|---|---|")
+        for r in anchor_rows:
+            extra = (g(r.get("rel_error_timoshenko"), "{:+.2%}") if r["test"] == "cantilever"
+                     else f"(last 3 steps spread {g(r.get('spread'), '{:.1%}')})")
+            w(f"| {r['test']} | {r['model']} | {g(r['h_m'])} | {r['nodes']} | {r['tets']} | {g(r['fem'], '{:.5g}')} | "
+              f"{g(r['theory'], '{:.5g}')} | {g(r['rel_error'], '{:+.2%}')} | {extra} | {g(r['ms'], '{:.0f}')} |")
+    if filt:
+        w("\n### Filter window (device side)\n")
+        w("| mode | N | delay (ms) | (N-1)/2 | ripple (N/ms) | raw ripple | largest jump (N) | raw jump (N) "
+          "| peak raw (N) | peak rendered (N) |")
+        w("|---|---|---|---|---|---|---|---|---|---|")
+        for r in filt:
+            w(f"| {r['mode']} | {r['N']} | {r['delay_ms']} | {r['delay_theory_ms']} | {g(r['ripple_rms_N_per_ms'])} | "
+              f"{g(r['ripple_raw_N_per_ms'])} | {g(r['max_jump_N'])} | {g(r['max_jump_raw_N'])} | "
+              f"{g(r['peak_raw_N'], '{:.4f}')} | {g(r['peak_filtered_N'], '{:.4f}')} |")
+    if scal:
+        w("\n### Scaling (0.1 m cube, MICA tol 1e-6, one core)\n")
+        w("| cells | nodes | tets | median ms | p95 ms | iters/step | ms/iteration | memory (B/tet) |")
+        w("|---|---|---|---|---|---|---|---|")
+        for r in scal:
+            w(f"| {r['cells']}^3 | {r['nodes']} | {r['tets']} | {g(r['ms_median'])} | {g(r['ms_p95'])} | "
+              f"{g(r['iterations'], '{:.1f}')} | {g(r['ms_per_iteration'], '{:.4f}')} | {r['mem_B_per_tet']} |")
+    with open(os.path.join(out, "tables.md"), "w") as f:
+        f.write("\n".join(lines) + "\n")
+
+
+def main(folder):
+    rows, c_sweep = read(os.path.join(folder, "sweep.csv"))
+    steps, _ = read(os.path.join(folder, "stiffness_steps.csv"))
+    anchor_rows, c_anchor = read(os.path.join(folder, "anchors.csv"))
+    curve, _ = read(os.path.join(folder, "hertz_curve.csv"))
+    filt, c_filter = read(os.path.join(folder, "filter.csv"))
+    samples, _ = read(os.path.join(folder, "filter_samples.csv"))
+    scal, c_scal = read(os.path.join(folder, "scaling.csv"))
+    if rows:
+        error_vs_time(rows, folder)
+        iterations_vs_tolerance(rows, folder)
+        figure2(rows, steps, folder)
+        knobs(rows, folder)
+    figure1(samples, filt, folder)
+    anchors(anchor_rows, curve, folder)
+    scaling(scal, folder)
+    tables(rows, anchor_rows, filt, scal,
+           {"sweep": c_sweep, "anchors": c_anchor, "filter": c_filter, "scaling": c_scal}, folder)
+    print(f"plots and tables.md in {folder}")
+
+
+if __name__ == "__main__":
+    main(sys.argv[1])
