@@ -56,6 +56,10 @@ FemModel build_fem_model(const TetMesh& mesh, const Material& material, MassKind
   m.node_mass.assign(size_t(m.node_count()), 0.0);
   for (int32_t i = 0; i < m.pattern.rows; ++i)
     for (int32_t k = m.pattern.row_start[i]; k < m.pattern.row_start[i + 1]; ++k) m.node_mass[i] += m.mass[k];
+  // Each tet in range is not enough: the sums (node masses, the body's mass, gravity's m g)
+  // must be too.
+  if (!std::isfinite(m.total_mass() * 1e3))
+    fail(Errc::BadMesh, source + ": the body's mass overflows double precision (it is too large to model)");
   return m;
 }
 

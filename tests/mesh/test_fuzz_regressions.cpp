@@ -126,12 +126,12 @@ const std::string kOneTetEle = "1 4 0\n1 1 2 3 4\n";
 
 // ------------------------------------------------------------ reals with extreme exponents
 
-// text_scanner.cpp:49, underflows(): for a decimal that std::from_chars finds out of range, the
-// sum (power of ten of the leading digit) + exponent is taken in int64_t and overflows when
-// the exponent is within a few units of INT64_MAX (signed overflow: undefined behaviour,
-// UBSan: "signed integer overflow: 1 + 9223372036854775807"). Wrapped, it reads this
-// astronomically large x as 0 and the mesh loads. strtod gives HUGE_VAL / ERANGE: the token
-// must be rejected like 1e400. fuzz_tetgen found it too, minimised to the first case below.
+// text_scanner.cpp, underflows(): for a decimal that std::from_chars finds out of range, the
+// sum (power of ten of the leading digit) + exponent was taken in int64_t and overflowed when
+// the exponent was within a few units of INT64_MAX (undefined behaviour; UBSan: "signed
+// integer overflow: 1 + 9223372036854775807"). Wrapped, it read this astronomically large x
+// as 0 and the mesh loaded. strtod gives HUGE_VAL / ERANGE: the token must be rejected like
+// 1e400. Found by fuzz_tetgen, minimised to the first case below (32 bytes).
 void huge_decimal_exponent_is_not_read_as_zero(void**) {
   expect_tetgen_error("5 3 2 0\n0 10e9223372036854775807", "", Errc::Parse,
                       "fuzz.node: line 2: expected a finite x coordinate, got "
@@ -146,10 +146,10 @@ void huge_decimal_exponent_is_not_read_as_zero(void**) {
 }
 
 // The other side of the same sum: an exponent of INT64_MIN with a mantissa below 1
-// ("-1 + -9223372036854775808" under UBSan). Found by fuzz_tetgen (fuzz/crashes/
-// fuzz_tetgen-crash-05c56220...), minimised to 33 bytes: a .node whose only point has
-// x = .5e-9223372036854775808. Wrapped, this tiny value counts as too large and is
-// rejected; strtod reads it as 0 (as the reader does with 1e-400), so it must read as 0.
+// ("-1 + -9223372036854775808" under UBSan). Found by fuzz_tetgen, minimised to 33 bytes: a
+// .node whose only point has x = .5e-9223372036854775808. Wrapped, this tiny value counted
+// as too large and was rejected; strtod reads it as 0 (as the reader does with 1e-400), so
+// it must read as 0.
 void tiny_decimal_exponent_reads_as_zero(void**) {
   // The minimised crasher as fuzz_tetgen saw it (no NUL byte: the .ele text is empty): once
   // x reads as 0 the line lacks y.
@@ -168,14 +168,13 @@ void tiny_decimal_exponent_reads_as_zero(void**) {
 
 // ------------------------------------------------------------ extreme scales on the load path
 
-// tet_mesh.cpp:52, check_rest_quality() judges the volume relative to the longest edge
-// cubed, which is scale-free, so a corner tet of edge 1e-104 m passes (relative 0.059). Its
-// rest matrix has determinant 1e-312 (subnormal): in tet_element.cpp:13 make_tet_element(),
-// Eigen's dm.inverse() takes 1/det = inf, so dm_inv is inf/NaN and so are the shape-function
-// gradients, stiffness and forces of the model build_fem_model() returns. Such a mesh must be
-// rejected. fuzz_mesh_build found the same from the seed one_tet_edge_1e-100 by changing one
-// exponent (minimised, 70 bytes): edges 1e-100, 1e-110, 1e-100, det 1e-310, relative volume
-// 6e-12, kept as a sliver.
+// check_rest_quality() judges the volume relative to the longest edge cubed, which is
+// scale-free, so a corner tet of edge 1e-104 m passes (relative 0.059). Its rest matrix has
+// determinant 1e-312 (subnormal): make_tet_element()'s dm.inverse() (Eigen) takes
+// 1/det = inf, so dm_inv, the shape-function gradients, stiffness and forces of the model
+// build_fem_model() returned were inf/NaN. Such a mesh must be rejected. fuzz_mesh_build
+// found it from the seed one_tet_edge_1e-100 by changing one exponent (last case, 70 bytes
+// minimised): edges 1e-100, 1e-110, 1e-100, det 1e-310, relative volume 6e-12, a sliver.
 void tiny_scale_tet_is_rejected(void**) {
   for (const char* edge : {"1e-104", "1e-105", "3e-104"}) {
     const TetMesh mesh = must_parse_tetgen(tetgen_corner_node(edge), kOneTetEle);
@@ -186,10 +185,9 @@ void tiny_scale_tet_is_rejected(void**) {
   expect_rejected([&] { load_body(found); }, "fuzz: ");
 }
 
-// fem_model.cpp:37 build_fem_model(): a corner tet of edge 2e102 m passes the quality check
-// (volume 1.3e306 m^3, longest edge cubed 2.3e307, both finite), but rv = density * volume
-// overflows: the mass blocks, node masses and total mass are +inf. Such a mesh must be
-// rejected.
+// build_fem_model(): a corner tet of edge 2e102 m passes the quality check (volume
+// 1.3e306 m^3, longest edge cubed 2.3e307, both finite), but density * volume overflowed: the
+// mass blocks, node masses and total mass were +inf. Such a mesh must be rejected.
 void huge_scale_tet_is_rejected(void**) {
   for (const char* edge : {"2e102", "3.5e102"}) {
     const TetMesh mesh = must_parse_tetgen(tetgen_corner_node(edge), kOneTetEle);
@@ -197,12 +195,12 @@ void huge_scale_tet_is_rejected(void**) {
   }
 }
 
-// Still open after the per-tet check in build_fem_model() (fem_model.cpp:30-39): each tet of
-// these two cubes of edge 4.6e101 m is in range (rho V = 1.6e307 kg, E V = 1.6e308 finite),
-// but their sum is not: FemModel::total_mass() is +inf (12 tets x 1.6e307), and the node that
-// 12 tets share weighs 4.9e307 kg, so gravity alone (m g, step.cpp:139) overflows to inf on
-// the first step. fuzz_mesh_build's invariant (total mass finite) flags it; the whole body,
-// not only each tet, must fit in double precision.
+// Past the per-tet range check in build_fem_model(): each tet of these two cubes of edge
+// 4.6e101 m is in range (rho V = 1.6e307 kg, E V = 1.6e308, finite), their sums are not:
+// FemModel::total_mass() is +inf (12 x 1.6e307), and nodes 2 and 11, in 8 tets each, weigh
+// 3.2e307 kg, so gravity alone (node_mass * g in world/step.cpp) is inf on the first step.
+// fuzz_mesh_build's invariant (total mass finite) flags it. The whole body, not only each
+// tet, must fit in double precision.
 void huge_scale_mesh_is_rejected_as_a_whole(void**) {
   const std::string node =
       "12 3 0 0\n"
