@@ -383,7 +383,8 @@ static inline mica_tool_def mica_tool_def_default(void) {
   return def;
 }
 
-/** Creates a tool. Contact with tools needs MICA_SOLVER_MICA. The world's thread. */
+/** Creates a tool. Every solver handles its contacts (MICA; DIRECT and PCG through the Delassus
+ *  matrix). The world's thread. */
 MICA_API mica_status mica_tool_create(mica_world* world, const mica_tool_def* def, mica_tool_id* out_tool);
 /** Destroys a tool. The world's thread. */
 MICA_API mica_status mica_tool_destroy(mica_world* world, mica_tool_id tool);
