@@ -64,7 +64,10 @@ void World::advance(double h) {
   follow_devices();
   StageRunner stage(stats_);
   stage.run(Stage::Collide, plan.collide, [&] { collide(dynamic, h); });
-  if (!plan.collide) contacts_.clear();
+  if (!plan.collide) {  // nothing to collide: drop last step's contacts and tool pointers (a tool may be gone)
+    contacts_.clear();
+    step_tools_.clear();
+  }
   rows_.clear();
   lambda_.clear();
   stage.run(Stage::Loads, plan.loads, [&] {
@@ -331,6 +334,7 @@ void World::solve_velocities(Body& b, double h) {
   form_rhs(b, h);
 
   b.v_next = b.v;  // the warm start of an iterative solve
+  for (Vec3& f : b.contact_impulse) f.setZero();  // no contact rows this step: no stale impulse in the reactions
   record(linear_solver(b).solve(ProjectedSystem{b.fem.pattern, b.A, b.projection}, b.b, b.v_next));
 }
 

@@ -1,7 +1,8 @@
 // The stress matrix: hard cases (mica-method.md section 6) across Young's modulus 1e2..1e9 Pa,
 // Poisson ratio 0..0.499 and time steps 1e-4..5e-2 s, each run checked by stress::Monitor for
-// finite results, energy growth beyond the work of the drivers, penetration, inverted elements
-// after a release, and with non-converged steps counted (never failed).
+// finite results, energy growth beyond the work of the drivers, penetration, tunnelling, false
+// body contacts, stale contact impulses, inverted elements after a release, and convergence:
+// non-converged steps are counted (never failed), steps reported converged must be solved.
 //
 //   stress_test_stress                  the representative slice (ctest labels unit;stress)
 //   stress_test_stress --full           the whole matrix (label stress-full)
@@ -24,8 +25,10 @@ namespace {
 
 constexpr double kRho = 1000;  // kg/m^3
 // Energy: the growth beyond the driving work and the recovery allowance, as a fraction of the
-// run's energy scale (see Monitor). Backward Euler dissipates; what is left to absorb is
-// round-off, the solver's residual and the co-rotational linearisation over one step.
+// run's energy scale (see Monitor). Backward Euler dissipates; 2 % absorbs round-off and the
+// solver's tolerance with a wide margin (over the whole matrix the frozen-rotation balance of
+// solved steps grew at most 9e-4 of the scale). Growth from the co-rotational rotation update
+// beyond it is a failure (K1).
 constexpr double kEnergyLimit = 0.02;
 // Penetration: no node deeper than this fraction of the scene's reference length (the tool's
 // radius, the slab's thickness, the element size) once contact has been made.
@@ -474,9 +477,6 @@ const KnownIssue kKnownIssues[] = {
      "MICA stops when consecutive iterates differ by less than the tolerance; when Gauss-Seidel stagnates (stiff "
      "bodies, long steps: E h^2 / (rho dx^2) large) that happens far from the solution, and the step is reported "
      "converged with a residual of percents"},
-    {"K4", "gi", "a stale value",
-     "with the Direct (and Pcg) solver a step without contacts leaves Body::contact_impulse at the last contact step's "
-     "value, and World::compute_forces subtracts it in every LPC reaction"},
 };
 
 bool strict_mode() {

@@ -111,12 +111,59 @@ static void test_linear_body_factors_once_corotational_every_step(void**) {
   }
 }
 
+// Removing the only tool drops the Collide stage; what the tool left behind must go with it: no
+// step may touch the removed tool (a use-after-free under AddressSanitizer), and no solver may keep
+// subtracting the last contact impulse in a constraint's reaction. The three solvers agree while
+// the tool presses (tight tolerance, frictionless), so they must agree after it is gone too.
+static void test_removed_tool_leaves_nothing_behind(void**) {
+  std::vector<Vec3> during, after;
+  for (SolverKind solver : {SolverKind::Direct, SolverKind::Mica, SolverKind::Pcg}) {
+    WorldSettings ws;
+    ws.gravity = Vec3::Zero();
+    ws.solver = solver;
+    ws.tolerance = 1e-12;
+    ws.max_iterations = 100000;
+    World w(ws);
+    BodySettings bs;
+    bs.material = {2e4, 0.3, 1000};
+    const Id b = w.add_body(make_box_grid(Vec3(0, 0, 0), Vec3(0.1, 0.1, 0.1), {4, 4, 4}, 6), bs, Vec3::Zero(),
+                            Vec3::Zero());
+    std::vector<int32_t> bottom, top;
+    for (int32_t i = 0; i < w.body(b).fem.node_count(); ++i) {
+      const double y = w.body(b).fem.rest[i].y();
+      if (y < 1e-9) bottom.push_back(i);
+      if (y > 0.1 - 1e-9) top.push_back(i);
+    }
+    w.add_lpc(b, bottom, LpcSpec{});
+    LpcSpec slide;
+    slide.kind = LpcKind::Plane;
+    slide.directions[0] = Vec3(1, 1, 0).normalized();  // held along a tilted direction: contact rows stay servable
+    const Id top_lpc = w.add_lpc(b, top, slide);
+    Tool t;
+    t.radius = 0.03;
+    t.margin = 2e-3;
+    t.position = Vec3(0.05, 0.126, 0.05);
+    const Id tool = w.add_tool(t);
+    for (int k = 0; k < 5; ++k) w.step(0.01);
+    during.push_back(w.lpc(top_lpc).reaction);
+    w.remove_tool(tool);
+    for (int k = 0; k < 3; ++k) w.step(0.01);
+    after.push_back(w.lpc(top_lpc).reaction);
+  }
+  assert_true(during[0].norm() > 0.1);  // the sphere did load the held face
+  for (size_t k = 1; k < during.size(); ++k) {
+    assert_true((during[k] - during[0]).norm() < 1e-6 * during[0].norm());
+    assert_true((after[k] - after[0]).norm() < 1e-6 * during[0].norm());
+  }
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_absent_effects_are_not_run_and_change_nothing),
       cmocka_unit_test(test_present_effects_enter_the_plan),
       cmocka_unit_test(test_static_bodies_are_not_integrated),
       cmocka_unit_test(test_linear_body_factors_once_corotational_every_step),
+      cmocka_unit_test(test_removed_tool_leaves_nothing_behind),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
