@@ -1,7 +1,9 @@
 #include "solver/mica_solver.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <limits>
 
 namespace mica {
 
@@ -44,6 +46,38 @@ void MicaSolver::project(const ContactRows& rows, size_t r, std::vector<double>&
     const double bound = rows.mu[r] * lambda[rows.normal_of[r]];
     lambda[r] = std::clamp(lambda[r], -bound, bound);
   }
+}
+
+double MicaSolver::momentum_residual(const std::vector<MicaBody>& bodies) {
+  double r2 = 0, b2 = 0, g2 = 0, av2 = 0, mv2 = 0, floor2 = 0;
+  for (const MicaBody& body : bodies) {
+    const BlockPattern& p = *body.pattern;
+    const BlockValues& A = *body.A;
+    const Vec3List& v = *body.v;
+    const bool projected = body.projection->active();
+    for (int32_t i = 0; i < p.rows; ++i) {
+      Vec3 av = Vec3::Zero();
+      for (int32_t k = p.row_start[i]; k < p.row_start[i + 1]; ++k) av += A[k] * v[p.col[k]];
+      Vec3 b = (*body.b)[i], g = body.contact_impulse[i], vi = v[i];
+      if (projected && body.projection->is_constrained[i]) {  // only the free directions must balance
+        const Mat3& S = body.projection->S[i];
+        av = S * av;
+        b = S * b;
+        g = S * g;
+        vi = S * vi;
+      }
+      r2 += (b + g - av).squaredNorm();
+      b2 += b.squaredNorm();
+      g2 += g.squaredNorm();
+      av2 += av.squaredNorm();
+      if (body.node_mass) {
+        mv2 += std::pow((*body.node_mass)[i], 2) * vi.squaredNorm();
+        floor2 += std::pow(1e-6 * (*body.node_mass)[i], 2);
+      }
+    }
+  }
+  const double scale2 = std::max({b2, g2, av2, mv2, floor2});
+  return scale2 > 0 ? std::sqrt(r2 / scale2) : 0.0;
 }
 
 MicaReport MicaSolver::solve(std::vector<MicaBody>& bodies, const ContactRows& rows, const MicaSettings& settings,
@@ -104,9 +138,18 @@ MicaReport MicaSolver::solve(std::vector<MicaBody>& bodies, const ContactRows& r
   for (size_t r = 0; r < nr; ++r)
     if (diag_[r] > 0) l_scale2 += std::pow(anticipated_velocity(bodies, rows, r) / diag_[r], 2);
 
+  using Clock = std::chrono::steady_clock;
+  const auto start = Clock::now();
   MicaReport report;
   report.converged = false;
+  report.momentum_residual = std::numeric_limits<double>::quiet_NaN();
+  int32_t next_residual_check = 0;  // the true residual costs a sweep: checked when the changes say done
   while (report.iterations < settings.max_iterations) {
+    if (settings.time_budget_ms > 0 && report.iterations > 0 &&
+        std::chrono::duration<double, std::milli>(Clock::now() - start).count() >= settings.time_budget_ms) {
+      report.out_of_time = true;
+      break;
+    }
     ++report.iterations;
     lambda_old_ = lambda;
     // Anticipate: each row's velocity from the current v, without contact.
@@ -153,12 +196,24 @@ MicaReport MicaSolver::solve(std::vector<MicaBody>& bodies, const ContactRows& r
     report.impulse_change = dl2 > 0 ? std::sqrt(dl2 / std::max(l2, l_scale2)) : 0.0;
     report.paper_change = std::sqrt(dv2 + dl2);
     report.residual = std::max(report.velocity_change, report.impulse_change);
-    const bool done = settings.paper_norm ? report.paper_change <= settings.tolerance
-                                          : report.residual <= settings.tolerance;
-    if (done) {
-      report.converged = true;
-      break;
+    if (settings.paper_norm) {
+      if (report.paper_change <= settings.tolerance) {
+        report.converged = true;
+        break;
+      }
+    } else if (report.residual <= settings.tolerance && report.iterations >= next_residual_check) {
+      report.momentum_residual = momentum_residual(bodies);
+      if (report.momentum_residual <= settings.tolerance) {
+        report.residual = std::max(report.residual, report.momentum_residual);
+        report.converged = true;
+        break;
+      }
+      next_residual_check = report.iterations + std::max(1, report.iterations / 8);
     }
+  }
+  if (!report.converged && !settings.paper_norm) {  // say how far from balance the step stopped
+    report.momentum_residual = momentum_residual(bodies);
+    report.residual = std::max(report.residual, report.momentum_residual);
   }
   return report;
 }

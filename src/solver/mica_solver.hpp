@@ -19,9 +19,13 @@ namespace mica {
 
 struct MicaSettings {
   // Stop when the change of v between iterations is below tolerance * max(|v|, |Dt^-1 b|, 1 um/s
-  // RMS per node) and the change of lambda below tolerance * max(|lambda|, the first anticipated
-  // impulse).
+  // RMS per node), the change of lambda below tolerance * max(|lambda|, the first anticipated
+  // impulse), and the true momentum residual |S (b + G^T lambda - A v)| below tolerance *
+  // max(|S b|, |S G^T lambda|, |S A v|, |S M v|): Gauss-Seidel that stagnates (stiff bodies, long
+  // steps) changes little per sweep far from the solution, so small changes alone prove nothing.
+  // (A >= M, so a residual below tol |M v| bounds the velocity error by about tol |v|.)
   double tolerance = 1e-8;
+  double time_budget_ms = 0;        // > 0: stop when the solve has used this much wall-clock time
   int32_t max_iterations = 200;
   int32_t pgs_sweeps = 1;           // PGS sweeps over the contact rows per iteration
   bool paper_norm = false;          // stop on the 2-norm of the change of (v, lambda) instead
@@ -35,6 +39,7 @@ struct MicaBody {
   const Vec3List* b;
   const Projection* projection;
   Vec3List* v;
+  const std::vector<double>* node_mass = nullptr;  // kg per node: the residual's floor (none if null)
   Vec3List contact_impulse;  // out: G^T lambda per node, N s
 };
 
@@ -42,6 +47,7 @@ struct MicaReport : SolveReport {
   double velocity_change = 0;  // last change of v, relative to its scale (see MicaSettings)
   double impulse_change = 0;   // last change of lambda, relative to its scale
   double paper_change = 0;     // last 2-norm of the change of (v, lambda), the paper's test
+  double momentum_residual = 0;  // last true residual, relative (see MicaSettings; NaN if never checked)
 };
 
 class MicaSolver {
@@ -55,6 +61,9 @@ class MicaSolver {
  private:
   double anticipated_velocity(const std::vector<MicaBody>& bodies, const ContactRows& rows, size_t r) const;
   void project(const ContactRows& rows, size_t r, std::vector<double>& lambda) const;
+  // |S (b + G^T lambda - A v)| / max(|S b|, |S G^T lambda|, |S A v|, |S M v|, 1 um/s of momentum
+  // per node), with M lumped.
+  static double momentum_residual(const std::vector<MicaBody>& bodies);
 
   std::vector<std::vector<Mat3>> inv_diag_;  // per body, per node: Dt_i^-1
   std::vector<Vec3> g_;                      // per row term: coef Dt^-1 d

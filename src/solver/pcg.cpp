@@ -52,6 +52,10 @@ SolveReport PcgSolver::iterate(const ProjectedSystem& sys, Vec3List& y) {
   }
   double rz = 0;
   while (r_norm > stop && report.iterations < max_iterations_) {
+    if (deadline_ && report.iterations > 0 && Clock::now() >= *deadline_) {
+      report.out_of_time = true;
+      break;
+    }
     for (int32_t i = 0; i < n; ++i) ws.z[i] = ws.inv_diag[i] * ws.r[i];
     const double rz_new = dot(ws.r, ws.z);
     if (report.iterations == 0) {

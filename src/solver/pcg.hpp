@@ -1,5 +1,7 @@
 // Projected (filtered) preconditioned conjugate gradient with a block-Jacobi preconditioner.
 #pragma once
+#include <chrono>
+#include <optional>
 #include "solver/projected_system.hpp"
 
 namespace mica {
@@ -10,13 +12,15 @@ struct PcgWorkspace {
   void resize(size_t n);  // allocates only when n changes
 };
 
-// Projected PCG as a LinearSolver: stops when ||P y - rhs|| <= tolerance ||rhs|| or after
-// max_iterations.
+// Projected PCG as a LinearSolver: stops when ||P y - rhs|| <= tolerance ||rhs||, after
+// max_iterations, or at the deadline (if one is set).
 class PcgSolver : public LinearSolver {
  public:
-  void configure(double tolerance, int32_t max_iterations) {
+  using Clock = std::chrono::steady_clock;
+  void configure(double tolerance, int32_t max_iterations, std::optional<Clock::time_point> deadline = {}) {
     tolerance_ = tolerance;
     max_iterations_ = max_iterations;
+    deadline_ = deadline;
   }
   SolveReport solve(const ProjectedSystem& sys, const Vec3List& b, Vec3List& v) override;
   SolveReport solve_homogeneous(const ProjectedSystem& sys, const Vec3List& f, Vec3List& y) override;
@@ -28,6 +32,7 @@ class PcgSolver : public LinearSolver {
   PcgWorkspace ws_;
   double tolerance_ = 1e-8;
   int32_t max_iterations_ = 200;
+  std::optional<Clock::time_point> deadline_;
 };
 
 }  // namespace mica

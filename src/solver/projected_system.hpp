@@ -11,6 +11,7 @@ struct SolveReport {
   int32_t iterations = 0;
   double residual = 0;  // ||P y - r|| / ||r|| of the projected system (0 when r = 0)
   bool converged = true;
+  bool out_of_time = false;  // stopped at the time budget (converged is then false)
 };
 
 struct ProjectedSystem {

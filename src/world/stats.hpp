@@ -24,6 +24,7 @@ struct WorldStats {
   int32_t solver_iterations = 0;
   double solver_residual = 0;
   bool converged = true;
+  bool out_of_time = false;  // a solve stopped at WorldSettings::time_budget_ms
   double ms_last_step = 0;
 };
 

@@ -50,7 +50,7 @@ void World::step(double h) {
 }
 
 void World::advance(double h) {
-  const auto start = std::chrono::steady_clock::now();
+  const auto start = step_start_ = std::chrono::steady_clock::now();
   const Plan plan = this->plan();
   std::vector<Body*>& dynamic = dynamic_;
   dynamic.clear();
@@ -60,6 +60,7 @@ void World::advance(double h) {
   stats_.solver_iterations = 0;
   stats_.solver_residual = 0;
   stats_.converged = true;
+  stats_.out_of_time = false;
 
   follow_devices();
   StageRunner stage(stats_);
@@ -243,6 +244,7 @@ void World::solve_mica(const std::vector<Body*>& dynamic, double h) {
     mica_bodies_[k].b = &b.b;
     mica_bodies_[k].projection = &b.projection;
     mica_bodies_[k].v = &b.v_next;
+    mica_bodies_[k].node_mass = &b.fem.node_mass;
   }
   // Warm start the impulses of contact rows that persist from the last step.
   rows_.build(contacts_, h, settings_.max_recovery_speed);
@@ -257,6 +259,10 @@ void World::solve_mica(const std::vector<Body*>& dynamic, double h) {
   ms.pgs_sweeps = settings_.pgs_sweeps;
   ms.paper_norm = settings_.paper_norm;
   ms.relaxation = settings_.relaxation;
+  if (settings_.time_budget_ms > 0)  // what the stages before the solve left of the step's budget
+    ms.time_budget_ms = std::max(1e-6, settings_.time_budget_ms - std::chrono::duration<double, std::milli>(
+                                                                       std::chrono::steady_clock::now() - step_start_)
+                                                                       .count());
   const MicaReport report = mica_.solve(mica_bodies_, rows_, ms, lambda_);
   row_diagonal_ = mica_.row_diagonal();
   for (size_t k = 0; k < dynamic.size(); ++k) std::swap(dynamic[k]->contact_impulse, mica_bodies_[k].contact_impulse);
@@ -278,7 +284,11 @@ void World::solve_delassus(const std::vector<Body*>& dynamic, double h) {
 
 LinearSolver& World::linear_solver(Body& b) {
   if (settings_.solver == SolverKind::Pcg) {
-    b.pcg.configure(settings_.tolerance, settings_.max_iterations);
+    std::optional<std::chrono::steady_clock::time_point> deadline;
+    if (settings_.time_budget_ms > 0)
+      deadline = step_start_ + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                   std::chrono::duration<double, std::milli>(settings_.time_budget_ms));
+    b.pcg.configure(settings_.tolerance, settings_.max_iterations, deadline);
     return b.pcg;
   }
   // CHOLMOD: analysed once; factored when A or the constraint set changed (a linear body with
@@ -343,6 +353,7 @@ void World::record(const SolveReport& report) {
   // A NaN residual must show, not vanish in a max.
   if (!(report.residual <= stats_.solver_residual)) stats_.solver_residual = report.residual;
   stats_.converged = stats_.converged && report.converged;
+  stats_.out_of_time = stats_.out_of_time || report.out_of_time;
 }
 
 void World::check_finite(const std::vector<Body*>& dynamic) const {

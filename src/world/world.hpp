@@ -1,6 +1,7 @@
 // The world: bodies, constraints, settings, and the step. Every mutating call validates
 // everything before it changes anything, so a call that throws leaves the world as it was.
 #pragma once
+#include <chrono>
 #include <memory>
 #include <string>
 #include <vector>
@@ -31,6 +32,7 @@ struct WorldSettings {
   double max_recovery_speed = 1.0; // m/s, clamps gap / h for penetrating contacts
   bool paper_norm = false;         // MICA: stop on the paper's 2-norm of the change
   double relaxation = 1.0;         // MICA: MBGS over-relaxation omega in (0, 2)
+  double time_budget_ms = 0;       // iterative solvers: > 0 stops the solve after this much wall-clock time
   bool warm_start = true;          // MICA: start from the last step's velocities and impulses (else zero)
   bool body_contact = true;        // contact between bodies (and with static bodies)
   double body_margin = 1e-3;       // m, contacts between bodies are made for gaps below this
@@ -155,6 +157,7 @@ class World {
   std::vector<double> row_diagonal_;                // W_rr (or B_rr) per row: the compliance a row sees
   std::vector<Body*> dynamic_;                      // this step's dynamic bodies
   std::vector<Tool*> step_tools_;
+  std::chrono::steady_clock::time_point step_start_;  // for the time budget
   std::vector<SurfaceView> views_;
   std::vector<Contact> contacts_;
   ContactRows rows_;                                // this step's rows of G

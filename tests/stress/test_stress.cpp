@@ -473,10 +473,6 @@ const KnownIssue kKnownIssues[] = {
     {"K3", "ai", "after a false body contact",
      "a consequence of K3: nodes pushed by contacts that should not exist penetrate, invert elements, make the exact "
      "solver's LCP infeasible"},
-    {"K5", "abcdefghi", "hidden non-convergence",
-     "MICA stops when consecutive iterates differ by less than the tolerance; when Gauss-Seidel stagnates (stiff "
-     "bodies, long steps: E h^2 / (rho dx^2) large) that happens far from the solution, and the step is reported "
-     "converged with a residual of percents"},
 };
 
 bool strict_mode() {
