@@ -79,6 +79,8 @@ mica::DeviceSettings translate(const mica_device_def& d) {
     default: refuse(MICA_ERR_INVALID_ARGUMENT, "def->force_mode is " + std::to_string(d.force_mode) + ", not a MICA_FORCE_* value");
   }
   s.filter_window = d.filter_window;
+  if (d.filter_plain != 0 && d.filter_plain != 1) refuse(MICA_ERR_INVALID_ARGUMENT, "def->filter_plain must be 0 or 1");
+  s.filter_restart_on_contact = d.filter_plain == 0;
   s.safety = {d.max_force, d.max_force_rate, d.stall_timeout, d.stall_ramp};
   s.coupling_stiffness = d.coupling_stiffness;
   s.coupling_damping = d.coupling_damping;

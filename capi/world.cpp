@@ -26,6 +26,8 @@ mica_world_def world_defaults() {
   d.body_contact = 1;
   d.body_margin = 0.001;
   d.warm_start = 1;
+  d.relaxation = 1.0;
+  d.mica_sweep = MICA_SWEEP_GAUSS_SEIDEL;
   return d;
 }
 
@@ -54,6 +56,17 @@ mica::WorldSettings translate(const mica_world_def& d) {
   s.max_iterations = d.max_iterations;
   s.tolerance = d.tolerance;
   s.plan_all_stages = d.plan_all_stages != 0;
+  if (!(d.relaxation > 0 && d.relaxation < 2))
+    refuse(MICA_ERR_INVALID_ARGUMENT, "def->relaxation must be in (0, 2), got " + std::to_string(d.relaxation));
+  s.relaxation = d.relaxation;
+  if (!(d.time_budget_ms >= 0) || !std::isfinite(d.time_budget_ms))
+    refuse(MICA_ERR_INVALID_ARGUMENT, "def->time_budget_ms must be finite and >= 0 (0: no budget)");
+  s.time_budget_ms = d.time_budget_ms;
+  switch (d.mica_sweep) {
+    case MICA_SWEEP_GAUSS_SEIDEL: s.mica_sweep = mica::MicaSweep::GaussSeidel; break;
+    case MICA_SWEEP_FACTORED: s.mica_sweep = mica::MicaSweep::Factored; break;
+    default: refuse(MICA_ERR_INVALID_ARGUMENT, "def->mica_sweep is " + std::to_string(d.mica_sweep) + ", not a MICA_SWEEP_* value");
+  }
   return s;
 }
 
@@ -133,6 +146,7 @@ MICA_API mica_status mica_world_get_stats(const mica_world* world, mica_world_st
     mica_world_stats r{};
     r.struct_size = out->struct_size;
     r.converged = s.converged ? 1 : 0;
+    r.out_of_time = s.out_of_time ? 1 : 0;
     r.step_count = s.step_count;
     r.solver_iterations = s.solver_iterations;
     r.solver_residual = s.solver_residual;

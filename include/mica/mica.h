@@ -41,7 +41,7 @@ extern "C" {
 /** Major version: incompatible ABI changes. */
 #define MICA_VERSION_MAJOR 0
 /** Minor version: compatible additions. */
-#define MICA_VERSION_MINOR 2
+#define MICA_VERSION_MINOR 3
 /** Patch version: fixes. */
 #define MICA_VERSION_PATCH 0
 /** major * 10000 + minor * 100 + patch */
@@ -115,6 +115,13 @@ typedef void (*mica_log_fn)(int32_t level, const char* message, void* user);
 #define MICA_SOLVER_PCG 1    /**< projected conjugate gradient, block-Jacobi preconditioner */
 #define MICA_SOLVER_MICA 2   /**< MICA: constraint anticipation, PGS on contacts, modified block Gauss-Seidel */
 
+#define MICA_SWEEP_GAUSS_SEIDEL 0 /**< MICA's velocity sweep as in the paper: modified block Gauss-Seidel */
+/** MICA with a factored anticipation: the rest system's sparse Cholesky factor, warped by node
+ *  rotations, preconditions the velocity solve (conjugate gradients) and gives the contact rows
+ *  their compliance; far fewer iterations on stiff or fine meshes, one factorization per time
+ *  step, damping and constraint set (docs/solvers.md). */
+#define MICA_SWEEP_FACTORED 1
+
 /** How to create a world: fill with mica_world_def_default(), then change fields. */
 typedef struct mica_world_def {
   uint32_t struct_size;    /**< sizeof(mica_world_def) as the caller compiled it */
@@ -140,6 +147,14 @@ typedef struct mica_world_def {
   int32_t warm_start;      /**< MICA: 1 starts each step's iteration from the last step's velocities
                                 and impulses (matched by persistent contact keys); 0 from zero; default 1 */
   int32_t reserved2;       /**< zero */
+  /* Since 0.3: */
+  double relaxation;       /**< MICA, Gauss-Seidel sweep: over-relaxation omega in (0, 2); default 1 (the paper) */
+  /** Iterative solvers: > 0 stops the solve when the step has used this many milliseconds of
+   *  wall-clock time; the step then completes with what the solver reached, mica_step returns
+   *  MICA_WARN_NOT_CONVERGED and the statistics say out_of_time and the residual. Default 0: no budget. */
+  double time_budget_ms;
+  int32_t mica_sweep;      /**< MICA_SWEEP_*; default MICA_SWEEP_GAUSS_SEIDEL */
+  int32_t reserved3;       /**< zero */
 } mica_world_def;
 
 /** Fills `def` with defaults, writing only its first `struct_size` bytes, and records
@@ -441,7 +456,7 @@ typedef struct mica_world_stats {
   int32_t converged;             /**< 1 if every solve of the last step met its tolerance */
   int64_t step_count;            /**< steps taken */
   int32_t solver_iterations;     /**< iterations of the last step (summed over bodies; 1 for direct) */
-  int32_t reserved0;             /**< zero */
+  int32_t out_of_time;           /**< 1 if a solve of the last step stopped at time_budget_ms (since 0.3) */
   double solver_residual;        /**< largest relative residual of the last step */
   double ms_last_step;           /**< wall-clock milliseconds of the last step */
   mica_stage_stats stages[MICA_STAGE_COUNT]; /**< indexed by MICA_STAGE_* */

@@ -105,7 +105,9 @@ typedef struct mica_device_def {
   double coupling_stiffness; /**< N/m, MICA_FORCE_COUPLING; default 300 */
   double coupling_damping;   /**< N s/m, MICA_FORCE_COUPLING; default 2 */
   int32_t simulated_kind;    /**< MICA_SIMULATED_*; default MICA_SIMULATED_TRAJECTORY */
-  int32_t reserved0;         /**< zero */
+  /** 1: a plain moving average that averages across contact changes; default 0: the window
+   *  restarts at every onset and release (the paper's post-contact correction). Since 0.3. */
+  int32_t filter_plain;
   mica_trajectory_fn trajectory; /**< simulated: the scripted position, or NULL (rest at the origin) */
   void* trajectory_user;     /**< passed to `trajectory` */
   double hand_mass;          /**< kg, simulated hand; default 0.1 */

@@ -28,6 +28,7 @@ DeviceLink::DeviceLink(std::unique_ptr<Device> device, const DeviceSettings& set
                              settings.safety.max_rate, settings.safety.stall_timeout, settings.safety.stall_ramp}),
       epoch_(steady_ns()) {
   settings_.safety.max_force = settings.safety.max_force > 0 ? settings.safety.max_force : info_.max_force;
+  filter_.set_restart_on_contact_change(settings.filter_restart_on_contact);
   // Nothing published yet: a model at rest, published "now", renders zero.
   model_.write_slot() = ForceModel{};
   model_.publish();

@@ -22,6 +22,7 @@ struct DeviceSettings {
   Eigen::Quaterniond rotation = Eigen::Quaterniond::Identity();
   ForceMode mode = ForceMode::LocalModel;
   int32_t filter_window = 20;
+  bool filter_restart_on_contact = true;  // the paper's post-contact correction
   SafetySettings safety{0, 1000, 0.1, 0.05};  // max_force 0: the device's own
   double coupling_stiffness = 300;  // N/m
   double coupling_damping = 2;      // N s/m

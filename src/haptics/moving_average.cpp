@@ -19,10 +19,8 @@ Vec3 MovingAverage::filter(const Vec3& raw, bool in_contact) noexcept {
     return raw;
   }
   // Onset or release: the window restarts with this sample (the post-contact correction).
-  if (in_contact != in_contact_) {
-    clear_window();
-    in_contact_ = in_contact;
-  }
+  if (in_contact != in_contact_ && restart_) clear_window();
+  in_contact_ = in_contact;
 
   const int32_t n = window();
   if (count_ == n) {

@@ -18,6 +18,10 @@ class MovingAverage {
   // Throws Error(InvalidArgument) unless window >= 1.
   explicit MovingAverage(int32_t window = 20);
 
+  // false: a plain moving average that keeps averaging across contact changes (no post-contact
+  // correction: the onset is smeared over N samples). Not on the servo path.
+  void set_restart_on_contact_change(bool restart) { restart_ = restart; }
+
   // Not on the servo path: reallocates the window and empties it.
   void set_window(int32_t window);
   int32_t window() const { return int32_t(samples_.size()); }
@@ -35,6 +39,7 @@ class MovingAverage {
   int32_t count() const { return count_; }
 
  private:
+  bool restart_ = true;
   void clear_window() noexcept;
   void resum() noexcept;
 

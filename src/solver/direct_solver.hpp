@@ -20,6 +20,9 @@ class DirectSolver : public LinearSolver {
   // Both solves use the last factorization.
   SolveReport solve(const ProjectedSystem& sys, const Vec3List& b, Vec3List& v) override;
   SolveReport solve_homogeneous(const ProjectedSystem& sys, const Vec3List& f, Vec3List& y) override;
+  // X = (S A S + I - S)^-1 B for any right-hand sides (no projection applied to B).
+  template <class Rhs>
+  void solve_raw(const Rhs& B, Eigen::MatrixXd& X) const { X = llt_.solve(B); }
   int64_t factorizations() const { return factorizations_; }
 
  private:

@@ -37,7 +37,8 @@ SolveReport PcgSolver::solve_homogeneous(const ProjectedSystem& sys, const Vec3L
 SolveReport PcgSolver::iterate(const ProjectedSystem& sys, Vec3List& y) {
   PcgWorkspace& ws = ws_;
   const int32_t n = sys.pattern.rows;
-  for (int32_t i = 0; i < n; ++i) ws.inv_diag[i] = sys.diagonal_block(i).inverse();
+  if (!preconditioner_)
+    for (int32_t i = 0; i < n; ++i) ws.inv_diag[i] = sys.diagonal_block(i).inverse();
   sys.apply(y, ws.q, ws.tmp);
   for (int32_t i = 0; i < n; ++i) ws.r[i] = ws.rhs[i] - ws.q[i];
 
@@ -56,7 +57,12 @@ SolveReport PcgSolver::iterate(const ProjectedSystem& sys, Vec3List& y) {
       report.out_of_time = true;
       break;
     }
-    for (int32_t i = 0; i < n; ++i) ws.z[i] = ws.inv_diag[i] * ws.r[i];
+    if (preconditioner_) {
+      preconditioner_->apply(ws.r, ws.z);
+      for (int32_t i : sys.projection.nodes) ws.z[i] = sys.projection.S[i] * ws.z[i];
+    } else {
+      for (int32_t i = 0; i < n; ++i) ws.z[i] = ws.inv_diag[i] * ws.r[i];
+    }
     const double rz_new = dot(ws.r, ws.z);
     if (report.iterations == 0) {
       ws.p = ws.z;

@@ -12,8 +12,17 @@ struct PcgWorkspace {
   void resize(size_t n);  // allocates only when n changes
 };
 
+// z = M^-1 r for a symmetric positive definite approximation M of the projected system; the
+// solver projects its result (z = S z) itself.
+class Preconditioner {
+ public:
+  virtual ~Preconditioner() = default;
+  virtual void apply(const Vec3List& r, Vec3List& z) = 0;
+};
+
 // Projected PCG as a LinearSolver: stops when ||P y - rhs|| <= tolerance ||rhs||, after
-// max_iterations, or at the deadline (if one is set).
+// max_iterations, or at the deadline (if one is set). Block-Jacobi preconditioned unless given
+// another preconditioner.
 class PcgSolver : public LinearSolver {
  public:
   using Clock = std::chrono::steady_clock;
@@ -22,6 +31,7 @@ class PcgSolver : public LinearSolver {
     max_iterations_ = max_iterations;
     deadline_ = deadline;
   }
+  void set_preconditioner(Preconditioner* p) { preconditioner_ = p; }  // null: block Jacobi
   SolveReport solve(const ProjectedSystem& sys, const Vec3List& b, Vec3List& v) override;
   SolveReport solve_homogeneous(const ProjectedSystem& sys, const Vec3List& f, Vec3List& y) override;
   void reserve(size_t n) { ws_.resize(n); }
@@ -33,6 +43,7 @@ class PcgSolver : public LinearSolver {
   double tolerance_ = 1e-8;
   int32_t max_iterations_ = 200;
   std::optional<Clock::time_point> deadline_;
+  Preconditioner* preconditioner_ = nullptr;
 };
 
 }  // namespace mica

@@ -8,6 +8,7 @@
 #include "fem/fem_model.hpp"
 #include "solver/direct_solver.hpp"
 #include "solver/pcg.hpp"
+#include "solver/rest_factor.hpp"
 #include "solver/projection.hpp"
 
 namespace mica {
@@ -47,6 +48,8 @@ struct Body {
   Vec3List contact_impulse;    // G^T lambda of the last step, N s
   DirectSolver direct;
   PcgSolver pcg;
+  RestFactor rest_factor;          // MICA with the factored anticipation
+  std::vector<Mat3> node_rotation;  // per node, for warping the rest factor
 
   // What A and the factorization were built for; a linear body reuses both while unchanged.
   struct MatrixKey {

@@ -263,10 +263,24 @@ void World::solve_mica(const std::vector<Body*>& dynamic, double h) {
     ms.time_budget_ms = std::max(1e-6, settings_.time_budget_ms - std::chrono::duration<double, std::milli>(
                                                                        std::chrono::steady_clock::now() - step_start_)
                                                                        .count());
-  const MicaReport report = mica_.solve(mica_bodies_, rows_, ms, lambda_);
-  row_diagonal_ = mica_.row_diagonal();
+  if (settings_.mica_sweep == MicaSweep::Factored) {
+    factored_bodies_.resize(dynamic.size());
+    for (size_t k = 0; k < dynamic.size(); ++k) {
+      Body& b = *dynamic[k];
+      const bool damped = needs_damping(b);
+      b.rest_factor.update(b.fem, {h, damped ? b.settings.rayleigh_alpha : 0.0, damped ? b.settings.rayleigh_beta : 0.0,
+                                   b.lpc_version},
+                           b.projection);
+      if (b.settings.corotational) compute_node_rotations(b.fem, b.R, b.node_rotation);
+      factored_bodies_[k] = {&b.rest_factor, b.settings.corotational ? &b.node_rotation : nullptr};
+    }
+    record(factored_mica_.solve(mica_bodies_, factored_bodies_, rows_, ms, lambda_));
+    row_diagonal_ = factored_mica_.row_diagonal();
+  } else {
+    record(mica_.solve(mica_bodies_, rows_, ms, lambda_));
+    row_diagonal_ = mica_.row_diagonal();
+  }
   for (size_t k = 0; k < dynamic.size(); ++k) std::swap(dynamic[k]->contact_impulse, mica_bodies_[k].contact_impulse);
-  record(report);
 }
 
 void World::solve_delassus(const std::vector<Body*>& dynamic, double h) {

@@ -12,6 +12,7 @@
 #include "collision/contact.hpp"
 #include "haptics/device_link.hpp"
 #include "solver/exact_contact_solver.hpp"
+#include "solver/factored_mica.hpp"
 #include "solver/mica_solver.hpp"
 #include "world/body.hpp"
 #include "world/slot_map.hpp"
@@ -20,6 +21,9 @@
 namespace mica {
 
 enum class SolverKind { Direct, Pcg, Mica };
+// How MICA anticipates and updates velocities: the paper's block Gauss-Seidel on the diagonal
+// blocks, or the factor of the rest system warped by node rotations (solver/factored_mica.hpp).
+enum class MicaSweep { GaussSeidel, Factored };
 enum class LogLevel { Error, Warning, Info };
 
 struct WorldSettings {
@@ -32,6 +36,7 @@ struct WorldSettings {
   double max_recovery_speed = 1.0; // m/s, clamps gap / h for penetrating contacts
   bool paper_norm = false;         // MICA: stop on the paper's 2-norm of the change
   double relaxation = 1.0;         // MICA: MBGS over-relaxation omega in (0, 2)
+  MicaSweep mica_sweep = MicaSweep::GaussSeidel;
   double time_budget_ms = 0;       // iterative solvers: > 0 stops the solve after this much wall-clock time
   bool warm_start = true;          // MICA: start from the last step's velocities and impulses (else zero)
   bool body_contact = true;        // contact between bodies (and with static bodies)
@@ -164,7 +169,9 @@ class World {
   std::vector<double> lambda_;                      // impulse per row, N s
   std::unordered_map<uint64_t, double> warm_start_; // last step's impulses by row key
   MicaSolver mica_;
+  FactoredMicaSolver factored_mica_;
   std::vector<MicaBody> mica_bodies_;
+  std::vector<FactoredBody> factored_bodies_;
   std::vector<ExactBody> exact_bodies_;
   WorldStats stats_;
   int64_t bodies_created_ = 0;

@@ -610,6 +610,30 @@ static void test_nonfinite_world_def(void** state) {
     EXPECT_FAIL_NO_WORLD(fx, MICA_ERR_INVALID_ARGUMENT, mica_world_create(&wd, &w), "paper_norm");
     assert_null(w);
   }
+  const double bad_relaxation[4] = {0, 2, -1, NAN};
+  for (int i = 0; i < 4; ++i) {
+    mica_world_def wd = mica_world_def_default();
+    wd.relaxation = bad_relaxation[i];
+    mica_world* w = (mica_world*)&wd;
+    EXPECT_FAIL_NO_WORLD(fx, MICA_ERR_INVALID_ARGUMENT, mica_world_create(&wd, &w), "relaxation");
+    assert_null(w);
+  }
+  const double bad_budget[3] = {-1, NAN, INFINITY};
+  for (int i = 0; i < 3; ++i) {
+    mica_world_def wd = mica_world_def_default();
+    wd.time_budget_ms = bad_budget[i];
+    mica_world* w = (mica_world*)&wd;
+    EXPECT_FAIL_NO_WORLD(fx, MICA_ERR_INVALID_ARGUMENT, mica_world_create(&wd, &w), "time_budget_ms");
+    assert_null(w);
+  }
+  const int32_t bad_sweep_kind[3] = {2, -1, INT32_MAX};
+  for (int i = 0; i < 3; ++i) {
+    mica_world_def wd = mica_world_def_default();
+    wd.mica_sweep = bad_sweep_kind[i];
+    mica_world* w = (mica_world*)&wd;
+    EXPECT_FAIL_NO_WORLD(fx, MICA_ERR_INVALID_ARGUMENT, mica_world_create(&wd, &w), "mica_sweep");
+    assert_null(w);
+  }
 }
 
 static void test_nonfinite_gravity(void** state) {

@@ -71,6 +71,26 @@ static void test_contact_onset_starts_a_new_window(void**) {
   }
 }
 
+// Without the correction the window keeps averaging across the onset: N samples after it, the
+// output is still the plain mean of the last N samples, out-of-contact ones included.
+static void test_without_correction_the_onset_is_smeared(void**) {
+  std::mt19937 rng(12);
+  const int32_t window = 20;
+  MovingAverage filter(window);
+  filter.set_restart_on_contact_change(false);
+  std::vector<Vec3> x;
+  for (size_t k = 0; k < 50; ++k) {
+    x.push_back(random_vec(rng, -0.01, 0.01));
+    filter.filter(x.back(), false);
+  }
+  for (size_t k = x.size(); k < 50 + 2 * window; ++k) {
+    x.push_back(random_vec(rng, 1, 2));
+    const Vec3 y = filter.filter(x.back(), true);
+    assert_vec_near(y, window_mean(x, 0, k, window), 1e-14, k);
+    assert_int_equal(filter.count(), window);
+  }
+}
+
 static void test_release_resets_the_window(void**) {
   const int32_t window = 20;
   MovingAverage filter(window);
@@ -197,6 +217,7 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_matches_brute_force_window),
       cmocka_unit_test(test_contact_onset_starts_a_new_window),
+      cmocka_unit_test(test_without_correction_the_onset_is_smeared),
       cmocka_unit_test(test_release_resets_the_window),
       cmocka_unit_test(test_window_of_one_is_identity),
       cmocka_unit_test(test_no_drift_over_a_million_samples),

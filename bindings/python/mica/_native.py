@@ -11,7 +11,7 @@ from ctypes import (CFUNCTYPE, POINTER, Structure, c_char, c_char_p, c_double, c
 
 # --- Constants (mica.h)
 MICA_VERSION_MAJOR = 0
-MICA_VERSION_MINOR = 2
+MICA_VERSION_MINOR = 3
 MICA_VERSION_PATCH = 0
 MICA_VERSION_NUMBER = MICA_VERSION_MAJOR * 10000 + MICA_VERSION_MINOR * 100 + MICA_VERSION_PATCH
 
@@ -44,6 +44,9 @@ MICA_LOG_INFO = 2
 MICA_SOLVER_DIRECT = 0
 MICA_SOLVER_PCG = 1
 MICA_SOLVER_MICA = 2
+
+MICA_SWEEP_GAUSS_SEIDEL = 0
+MICA_SWEEP_FACTORED = 1
 
 MICA_MODEL_COROTATIONAL = 0
 MICA_MODEL_LINEAR = 1
@@ -120,6 +123,10 @@ class mica_world_def(Structure):
         ("body_friction", c_double),
         ("warm_start", c_int32),
         ("reserved2", c_int32),
+        ("relaxation", c_double),
+        ("time_budget_ms", c_double),
+        ("mica_sweep", c_int32),
+        ("reserved3", c_int32),
     ]
 
 
@@ -182,7 +189,7 @@ class mica_world_stats(Structure):
         ("converged", c_int32),
         ("step_count", c_int64),
         ("solver_iterations", c_int32),
-        ("reserved0", c_int32),
+        ("out_of_time", c_int32),
         ("solver_residual", c_double),
         ("ms_last_step", c_double),
         ("stages", mica_stage_stats * MICA_STAGE_COUNT),
@@ -254,7 +261,7 @@ class mica_device_def(Structure):
         ("coupling_stiffness", c_double),
         ("coupling_damping", c_double),
         ("simulated_kind", c_int32),
-        ("reserved0", c_int32),
+        ("filter_plain", c_int32),
         ("trajectory", mica_trajectory_fn),
         ("trajectory_user", c_void_p),
         ("hand_mass", c_double),

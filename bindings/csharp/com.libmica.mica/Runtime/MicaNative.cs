@@ -14,7 +14,7 @@ namespace LibMica
 
         // --- Constants (mica.h)
         public const int MICA_VERSION_MAJOR = 0;
-        public const int MICA_VERSION_MINOR = 2;
+        public const int MICA_VERSION_MINOR = 3;
         public const int MICA_VERSION_PATCH = 0;
         public const int MICA_VERSION_NUMBER = MICA_VERSION_MAJOR * 10000 + MICA_VERSION_MINOR * 100 + MICA_VERSION_PATCH;
 
@@ -47,6 +47,9 @@ namespace LibMica
         public const int MICA_SOLVER_DIRECT = 0;
         public const int MICA_SOLVER_PCG = 1;
         public const int MICA_SOLVER_MICA = 2;
+
+        public const int MICA_SWEEP_GAUSS_SEIDEL = 0;
+        public const int MICA_SWEEP_FACTORED = 1;
 
         public const int MICA_MODEL_COROTATIONAL = 0;
         public const int MICA_MODEL_LINEAR = 1;
@@ -134,6 +137,10 @@ namespace LibMica
             public double body_friction;
             public int warm_start;
             public int reserved2;
+            public double relaxation;
+            public double time_budget_ms;
+            public int mica_sweep;
+            public int reserved3;
         }
 
         [StructLayout(LayoutKind.Sequential)]
@@ -196,7 +203,7 @@ namespace LibMica
             public int converged;
             public long step_count;
             public int solver_iterations;
-            public int reserved0;
+            public int out_of_time;
             public double solver_residual;
             public double ms_last_step;
             // mica_stage_stats stages[MICA_STAGE_COUNT]: fixed buffers hold primitives only, so
@@ -268,7 +275,7 @@ namespace LibMica
             public double coupling_stiffness;
             public double coupling_damping;
             public int simulated_kind;
-            public int reserved0;
+            public int filter_plain;
             public IntPtr trajectory; // mica_trajectory_fn
             public IntPtr trajectory_user;
             public double hand_mass;

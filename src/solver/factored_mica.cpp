@@ -1,0 +1,211 @@
+#include "solver/factored_mica.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+namespace mica {
+
+namespace {
+
+const Mat3& projector(const MicaBody& body, int32_t i) {
+  static const Mat3 identity = Mat3::Identity();
+  return body.projection->active() && body.projection->is_constrained[i] ? body.projection->S[i] : identity;
+}
+
+Mat3 rotation(const FactoredBody& f, int32_t i) {
+  return f.node_rotation ? (*f.node_rotation)[i] : Mat3::Identity();
+}
+
+}  // namespace
+
+void FactoredMicaSolver::project(const ContactRows& rows, size_t r, std::vector<double>& lambda) const {
+  if (rows.normal_of[r] < 0) {
+    lambda[r] = std::max(0.0, lambda[r]);
+  } else {
+    const double bound = rows.mu[r] * lambda[rows.normal_of[r]];
+    lambda[r] = std::clamp(lambda[r], -bound, bound);
+  }
+}
+
+void FactoredMicaSolver::build_compliance(const std::vector<MicaBody>& bodies,
+                                          const std::vector<FactoredBody>& factored, const ContactRows& rows) {
+  const size_t nr = rows.size(), nt = rows.terms.size();
+  term_columns_.resize(nt);
+  term_force_.resize(nt);
+  std::vector<int32_t> row_of(nt);
+  for (size_t r = 0; r < nr; ++r)
+    for (int32_t t = rows.start[r]; t < rows.start[r + 1]; ++t) {
+      const RowTerm& term = rows.terms[t];
+      term_columns_[t] = &factored[term.body].rest->columns(term.node);
+      term_force_[t] = term.coef * (rotation(factored[term.body], term.node).transpose() *
+                                    (projector(bodies[term.body], term.node) * rows.direction[r]));
+      row_of[t] = int32_t(r);
+    }
+  // W_rs = sum over term pairs on one body of f_t^T (K^-1)_{node t, node u} f_u.
+  W_.setZero(Eigen::Index(nr), Eigen::Index(nr));
+  for (size_t t = 0; t < nt; ++t)
+    for (size_t u = 0; u < nt; ++u) {
+      if (rows.terms[t].body != rows.terms[u].body) continue;
+      const Eigen::MatrixXd& X = *term_columns_[u];
+      const Mat3 block = X.block<3, 3>(3 * rows.terms[t].node, 0);
+      W_(row_of[t], row_of[u]) += term_force_[t].dot(block * term_force_[u]);
+    }
+}
+
+void FactoredMicaSolver::apply_impulse_change(std::vector<MicaBody>& bodies,
+                                              const std::vector<FactoredBody>& factored, const ContactRows& rows,
+                                              const std::vector<double>& dlambda) {
+  for (size_t bi = 0; bi < bodies.size(); ++bi) {
+    y_.setZero(3 * Eigen::Index(bodies[bi].pattern->rows));
+    bool any = false;
+    for (size_t r = 0; r < rows.size(); ++r) {
+      if (dlambda[r] == 0) continue;
+      for (int32_t t = rows.start[r]; t < rows.start[r + 1]; ++t)
+        if (rows.terms[t].body == int32_t(bi)) {
+          y_.noalias() += *term_columns_[t] * (term_force_[t] * dlambda[r]);
+          any = true;
+        }
+    }
+    if (!any) continue;
+    Vec3List& v = *bodies[bi].v;
+    for (int32_t i = 0; i < bodies[bi].pattern->rows; ++i)
+      v[i] += projector(bodies[bi], i) * (rotation(factored[bi], i) * y_.segment<3>(3 * i));
+  }
+}
+
+MicaReport FactoredMicaSolver::solve(std::vector<MicaBody>& bodies, const std::vector<FactoredBody>& factored,
+                                     const ContactRows& rows, const MicaSettings& settings,
+                                     std::vector<double>& lambda) {
+  using Clock = std::chrono::steady_clock;
+  const auto start = Clock::now();
+  std::optional<Clock::time_point> deadline;
+  if (settings.time_budget_ms > 0)
+    deadline = start + std::chrono::duration_cast<Clock::duration>(
+                           std::chrono::duration<double, std::milli>(settings.time_budget_ms));
+  const size_t nb = bodies.size(), nr = rows.size();
+  pcg_.resize(nb);
+  warp_.resize(nb);
+  rhs_.resize(nb);
+  for (size_t bi = 0; bi < nb; ++bi) {
+    warp_[bi].bind(factored[bi].rest, factored[bi].node_rotation);
+    pcg_[bi].set_preconditioner(&warp_[bi]);
+  }
+  build_compliance(bodies, factored, rows);
+  lambda.resize(nr, 0.0);
+  diag_.assign(nr, 0.0);
+  const double w_max = nr ? W_.diagonal().cwiseAbs().maxCoeff() : 0.0;
+  for (size_t r = 0; r < nr; ++r) {
+    if (W_(r, r) > 1e-12 * w_max) diag_[r] = W_(r, r);
+    else lambda[r] = 0;  // nothing can move along this row
+    project(rows, r, lambda);
+  }
+
+  MicaReport report;
+  report.converged = false;
+  report.momentum_residual = std::numeric_limits<double>::quiet_NaN();
+  double l_scale = 0;
+  int32_t outer = 0;
+  bool velocities_solved = false;
+  while (report.iterations < settings.max_iterations) {
+    if (deadline && outer > 0 && Clock::now() >= *deadline) {
+      report.out_of_time = true;
+      break;
+    }
+    ++outer;
+    // Velocities for the current impulses: A v = b + G^T lambda on the free directions. While the
+    // impulses still move, a tenth of their last change is accuracy enough (inexact Newton); the
+    // final solves aim a little below the tolerance, so the outer test is not starved.
+    const double final_tolerance = 0.3 * settings.tolerance;
+    const double inner_tolerance =
+        outer == 1 || nr == 0 ? final_tolerance : std::clamp(0.1 * report.impulse_change, final_tolerance, 1e-2);
+    for (size_t bi = 0; bi < nb; ++bi) pcg_[bi].configure(inner_tolerance, settings.max_iterations, deadline);
+    velocities_solved = true;
+    for (size_t bi = 0; bi < nb; ++bi) {
+      MicaBody& body = bodies[bi];
+      body.contact_impulse.assign(size_t(body.pattern->rows), Vec3::Zero());
+    }
+    for (size_t r = 0; r < nr; ++r)
+      for (int32_t t = rows.start[r]; t < rows.start[r + 1]; ++t)
+        bodies[rows.terms[t].body].contact_impulse[rows.terms[t].node] +=
+            rows.terms[t].coef * lambda[r] * rows.direction[r];
+    for (size_t bi = 0; bi < nb; ++bi) {
+      MicaBody& body = bodies[bi];
+      rhs_[bi] = *body.b;
+      for (size_t i = 0; i < rhs_[bi].size(); ++i) rhs_[bi][i] += body.contact_impulse[i];
+      const SolveReport s = pcg_[bi].solve(ProjectedSystem{*body.pattern, *body.A, *body.projection}, rhs_[bi], *body.v);
+      report.iterations += std::max(1, s.iterations);
+      report.velocity_change = std::max(report.velocity_change, s.residual);
+      velocities_solved = velocities_solved && s.converged && inner_tolerance == final_tolerance;
+      report.out_of_time = report.out_of_time || s.out_of_time;
+    }
+    if (report.out_of_time) break;
+    if (nr == 0) {
+      report.converged = velocities_solved;
+      break;
+    }
+    // Anticipate the row velocities and solve the small complementarity problem on W.
+    w_.assign(nr, 0.0);
+    for (size_t r = 0; r < nr; ++r) {
+      double c = rows.bias[r];
+      for (int32_t t = rows.start[r]; t < rows.start[r + 1]; ++t)
+        c += rows.terms[t].coef * rows.direction[r].dot((*bodies[rows.terms[t].body].v)[rows.terms[t].node]);
+      w_[r] = c;
+    }
+    // Two solved velocity fields a step s of the impulses apart measure the true compliance along
+    // it, y = W_true s = w - w_prev. A BFGS update takes that into W and keeps it symmetric
+    // positive definite (while s.y > 0, as for the true W), so the rotations the warped factor
+    // misses stop slowing the loop.
+    if (outer > 1) {
+      const Eigen::Map<const Eigen::VectorXd> s_(dlambda_.data(), Eigen::Index(nr));
+      const Eigen::VectorXd y = Eigen::Map<const Eigen::VectorXd>(w_.data(), Eigen::Index(nr)) -
+                                Eigen::Map<const Eigen::VectorXd>(w_prev_.data(), Eigen::Index(nr));
+      const Eigen::VectorXd Ws = W_ * s_;
+      const double sWs = s_.dot(Ws), sy = s_.dot(y);
+      if (sWs > 0 && sy > 1e-3 * sWs) {  // curvature confirmed (inexact solves blur small steps)
+        W_ += y * y.transpose() / sy - Ws * Ws.transpose() / sWs;
+        for (size_t q = 0; q < nr; ++q) diag_[q] = diag_[q] > 0 ? W_(q, q) : 0.0;
+      }
+    }
+    w_prev_ = w_;
+    lambda_next_ = lambda;
+    for (int sweep = 0; sweep < 1000; ++sweep) {
+      double change = 0, size = 0;
+      for (size_t r = 0; r < nr; ++r) {
+        if (diag_[r] == 0) continue;
+        double res = w_[r];
+        for (size_t s = 0; s < nr; ++s) res += W_(r, s) * (lambda_next_[s] - lambda[s]);
+        const double before = lambda_next_[r];
+        lambda_next_[r] -= res / W_(r, r);
+        project(rows, r, lambda_next_);
+        change = std::max(change, std::abs(lambda_next_[r] - before));
+        size = std::max(size, std::abs(lambda_next_[r]));
+      }
+      if (change <= 1e-3 * settings.tolerance * size || size == 0) break;
+    }
+    dlambda_.resize(nr);
+    double dl2 = 0, l2 = 0;
+    for (size_t r = 0; r < nr; ++r) {
+      dlambda_[r] = lambda_next_[r] - lambda[r];
+      dl2 += dlambda_[r] * dlambda_[r];
+      l2 += lambda_next_[r] * lambda_next_[r];
+    }
+    if (outer == 1) l_scale = l2;  // the first correction sets the scale when lambda starts at zero
+    report.impulse_change = dl2 > 0 ? std::sqrt(dl2 / std::max(l2, l_scale)) : 0.0;
+    if (report.impulse_change <= settings.tolerance && velocities_solved) {
+      // v balances the current impulses and the impulses no longer move: done.
+      report.momentum_residual = MicaSolver::momentum_residual(bodies);
+      report.residual = std::max({report.velocity_change, report.impulse_change, report.momentum_residual});
+      report.converged = report.momentum_residual <= settings.tolerance;
+      if (report.converged) return report;
+    }
+    apply_impulse_change(bodies, factored, rows, dlambda_);
+    lambda = lambda_next_;
+  }
+  // Stopped early: the impulses in G^T lambda are those the velocities were last solved with.
+  report.momentum_residual = MicaSolver::momentum_residual(bodies);
+  report.residual = std::max({report.velocity_change, report.impulse_change, report.momentum_residual});
+  return report;
+}
+
+}  // namespace mica
