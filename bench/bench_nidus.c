@@ -15,8 +15,9 @@
  * Memory: VmRSS (/proc/self/status) before and after mica_body_create_from_file, and after the
  * first step (when the solver's buffers exist), divided by the tets.
  *
- * usage: bench_nidus [mesh] [tolerance] [steps] [warm-up] [E] [dt]
- *          defaults: data/nidus/nidus.msh 1e-6 200 40 1e4 0.01
+ * usage: bench_nidus [mesh] [tolerance] [steps] [warm-up] [E] [dt] [gauss-seidel steps]
+ *          defaults: data/nidus/nidus.msh 1e-6 200 40 1e4 0.01 30; runs MICA with the factored
+ *          sweep, then with the paper's Gauss-Seidel sweep, and prints both and their ratio
  *        bench_nidus --scaling <out.csv> [max-tets]
  *          time per step against tets on box grids: a 0.1 m cube of n^3 cubes x 6 tets
  *          (E = 2e4 Pa, alpha = 2, gravity, base fixed), a 2 cm sphere 6 mm deep +- 3 mm at
@@ -147,13 +148,17 @@ static int press(mica_world* world, mica_tool_id tool, const double c[3], double
   return 0;
 }
 
-static int nidus(const char* path, double tol, int steps, int warmup, double E, double dt) {
+static const char* sweep_name(int32_t sweep) { return sweep == MICA_SWEEP_FACTORED ? "factored" : "gauss-seidel"; }
+
+static int nidus(const char* path, double tol, int steps, int warmup, double E, double dt, int32_t sweep,
+                 figures* result) {
   mica_world* world = NULL;
   mica_world_def wd = mica_world_def_default();
   wd.gravity[1] = 0; /* the lesion is carried by the tissue around it */
   wd.solver = MICA_SOLVER_MICA;
   wd.tolerance = tol;
   wd.max_iterations = 100000;
+  wd.mica_sweep = sweep;
   if (mica_world_create(&wd, &world) != MICA_OK) {
     fprintf(stderr, "%s\n", mica_world_last_error(NULL));
     return 1;
@@ -230,10 +235,8 @@ static int nidus(const char* path, double tol, int steps, int warmup, double E, 
   printf("# mesh %s: %d nodes (%d DOF), %d tets, %.1f x %.1f x %.1f mm; held by %d nodes (lowest fifth)\n", path,
          fig.nodes, 3 * fig.nodes, fig.tets, 1e3 * (hi[0] - lo[0]), 1e3 * (hi[1] - lo[1]), 1e3 * (hi[2] - lo[2]), n);
   printf("# E = %.3g Pa, nu = 0.4, rho = 1000, alpha = 2; forceps tip: sphere R = %.1f mm, 2 mm deep +- 1 mm at 1 Hz; "
-         "MICA tol %.0e, dt = %g ms; %d warm-up steps, %d timed; %ld thread(s) in the process\n",
-         E, 1e3 * R, tol, 1e3 * dt, warmup, steps, threads);
-  printf("# command: OPENBLAS_NUM_THREADS=1 taskset -c 1 build/bench/bench_nidus %s %g %d %d %g %g\n", path, tol,
-         steps, warmup, E, dt);
+"MICA (%s sweep) tol %.0e, dt = %g ms; %d warm-up steps, %d timed; %ld thread(s) in the process\n",
+         E, 1e3 * R, sweep_name(sweep), tol, 1e3 * dt, warmup, steps, threads);
   printf("median ms/step        %.3f\n", fig.median);
   printf("p95 ms/step           %.3f\n", fig.p95);
   printf("mean ms/step          %.3f\n", fig.mean);
@@ -242,6 +245,7 @@ static int nidus(const char* path, double tol, int steps, int warmup, double E, 
   printf("memory, body creation %.0f B/tet (VmRSS %ld -> %ld kB)\n", fig.mem_create_b_per_tet, rss0, rss1);
   printf("memory, after 1 step  %.0f B/tet (VmRSS %ld kB)\n", fig.mem_step_b_per_tet, rss2);
   mica_world_destroy(world);
+  *result = fig;
   return 0;
 }
 
@@ -330,9 +334,22 @@ int main(int argc, char** argv) {
   const int warmup = argc > 4 ? atoi(argv[4]) : 40;
   const double E = argc > 5 ? atof(argv[5]) : 1e4;
   const double dt = argc > 6 ? atof(argv[6]) : 0.01;
-  if (!(tol > 0) || steps < 1 || warmup < 2 || !(E > 0) || !(dt > 0)) {
-    fprintf(stderr, "usage: bench_nidus [mesh] [tolerance] [steps] [warm-up >= 2] [E] [dt]\n");
+  const int gs_steps = argc > 7 ? atoi(argv[7]) : 30;
+  if (!(tol > 0) || steps < 1 || warmup < 2 || !(E > 0) || !(dt > 0) || gs_steps < 0) {
+    fprintf(stderr, "usage: bench_nidus [mesh] [tolerance] [steps] [warm-up >= 2] [E] [dt] [gauss-seidel steps]\n");
     return 2;
   }
-  return nidus(path, tol, steps, warmup, E, dt);
+  printf("# command: OPENBLAS_NUM_THREADS=1 taskset -c 1 build/bench/bench_nidus %s %g %d %d %g %g %d\n", path, tol,
+         steps, warmup, E, dt, gs_steps);
+  /* Both MICA sweeps on the same scene, one after the other in this process: the factored one
+   * over `steps` timed steps, the paper's Gauss-Seidel (hundreds of times slower) over fewer. */
+  figures factored, gs;
+  printf("\n## factored sweep\n");
+  if (nidus(path, tol, steps, warmup, E, dt, MICA_SWEEP_FACTORED, &factored)) return 1;
+  if (gs_steps == 0) return 0;
+  printf("\n## gauss-seidel sweep (the paper's)\n");
+  if (nidus(path, tol, gs_steps, warmup, E, dt, MICA_SWEEP_GAUSS_SEIDEL, &gs)) return 1;
+  printf("\nmedian ms/step: factored %.2f, gauss-seidel %.2f: %.1fx faster; target 5 ms (paper: ~100 ms)\n",
+         factored.median, gs.median, gs.median / factored.median);
+  return 0;
 }
