@@ -51,7 +51,7 @@ def fin(v):
     return not math.isnan(v) and not math.isinf(v)
 
 
-COLOURS = {"MICA": "tab:blue", "PCG": "tab:orange", "exact": "k"}
+COLOURS = {"MICA": "tab:blue", "MICA-F": "tab:green", "PCG": "tab:orange", "exact": "k"}
 
 
 def error_vs_time(rows, out):
@@ -59,7 +59,7 @@ def error_vs_time(rows, out):
     floor = {"disp_rms_err_m": 1e-15, "force_err_N": 1e-13}
     for ax, key, label in ((axes[0], "disp_rms_err_m", "position error, RMS over nodes, worst step (m)"),
                            (axes[1], "force_err_N", "tool force error, worst step (N)")):
-        for solver in ("MICA", "PCG"):
+        for solver in ("MICA", "MICA-F", "PCG"):
             for group, ls, marker, mode in (("tolerance", "-", "o", "fixed tolerance"),
                                             ("iterations", "--", "s", "fixed iterations")):
                 pts = [(num(r["ms_median"]), num(r[key]), r) for r in rows
@@ -92,7 +92,7 @@ def error_vs_time(rows, out):
 
 def iterations_vs_tolerance(rows, out):
     fig, (ax_i, ax_t) = plt.subplots(1, 2, figsize=(12, 4.5), dpi=110)
-    for solver in ("MICA", "PCG"):
+    for solver in ("MICA", "MICA-F", "PCG"):
         pts = sorted((num(r["tol"]), num(r["iters_mean"]), num(r["iters_max"]), num(r["ms_median"]),
                       num(r["ms_p95"])) for r in rows if r["group"] == "tolerance" and r["solver"] == solver)
         if not pts:
@@ -140,7 +140,7 @@ def figure2(rows, steps, out):
     ax_s.set_title("Figure 2: iterations per step (nu = 0.3)")
     ax_s.grid(alpha=0.3, which="both")
     ax_s.legend(fontsize=7)
-    for solver in ("MICA", "PCG", "exact"):
+    for solver in ("MICA", "MICA-F", "PCG", "exact"):
         pts = sorted((num(r["E_Pa"]), num(r["iters_mean"]), num(r["ms_median"])) for r in rows
                      if r["group"] == "stiffness" and r["solver"] == solver)
         if not pts:

@@ -49,7 +49,11 @@
 
 #define L_CUBE 0.1
 #define R_TOOL 0.02
-#define SOLVER_NAME(s) ((s) == MICA_SOLVER_MICA ? "MICA" : (s) == MICA_SOLVER_PCG ? "PCG" : "exact")
+/* The study's own code for MICA with the factored sweep (MICA_SOLVER_MICA + MICA_SWEEP_FACTORED). */
+#define STUDY_MICA_FACTORED 100
+#define SOLVER_NAME(s)                                                                                      \
+  ((s) == MICA_SOLVER_MICA ? "MICA" : (s) == STUDY_MICA_FACTORED ? "MICA-F" : (s) == MICA_SOLVER_PCG ? "PCG" \
+                                                                                                    : "exact")
 
 typedef struct {
   const char* group;
@@ -129,7 +133,8 @@ static void run(const cfg* c, traj* rec, const traj* ref, const traj* model_ref,
   mica_world_def wd = mica_world_def_default();
   wd.gravity[0] = wd.gravity[2] = 0;
   wd.gravity[1] = c->scene == 0 ? -9.81 : 0;
-  wd.solver = c->solver;
+  wd.solver = c->solver == STUDY_MICA_FACTORED ? MICA_SOLVER_MICA : c->solver;
+  wd.mica_sweep = c->solver == STUDY_MICA_FACTORED ? MICA_SWEEP_FACTORED : MICA_SWEEP_GAUSS_SEIDEL;
   wd.tolerance = c->tol;
   wd.max_iterations = c->cap;
   wd.pgs_sweeps = c->pgs;
@@ -398,7 +403,7 @@ static int same_scene(const cfg* a, const cfg* b) {
 /* A rough cost, for the progress bar: steps x nodes x a per-solver factor. */
 static double cost(const cfg* c) {
   const double n = (c->cells + 1.0) * (c->cells + 1.0) * (c->cells + 1.0) / 729.0;
-  double f = c->solver == MICA_SOLVER_MICA ? 1.0 : c->solver == MICA_SOLVER_PCG ? 4.0 : 4.0;
+  double f = c->solver == MICA_SOLVER_MICA ? 1.0 : c->solver == MICA_SOLVER_PCG ? 4.0 : 4.0; /* MICA-F too */
   if (c->solver == MICA_SOLVER_MICA && c->E > 1e5) f *= c->E / 1e5;
   if (c->solver == MICA_SOLVER_PCG && c->E > 1e5) f *= sqrt(c->E / 1e5);
   if (c->solver == MICA_SOLVER_DIRECT) f *= n; /* factorisation grows faster than linearly */
@@ -411,12 +416,12 @@ static void make_plan(int quick) {
   cfg c = base_cfg();
   c.solver = MICA_SOLVER_DIRECT;
   add(c); /* the exact reference of the base scene, first */
-  for (int s = 0; s < 2; ++s)
+  for (int s = 0; s < 3; ++s)
     for (int k = 0; k < 10; ++k) {
       if (quick && k % 3) continue;
-      if (s == 1 && (k == 2 || k == 4 || k == 6 || k == 8)) continue; /* PCG: every other decade */
+      if (s >= 1 && (k == 2 || k == 4 || k == 6 || k == 8)) continue; /* PCG, MICA-F: every other decade */
       c = base_cfg();
-      c.solver = s == 0 ? MICA_SOLVER_MICA : MICA_SOLVER_PCG;
+      c.solver = s == 0 ? MICA_SOLVER_MICA : s == 1 ? MICA_SOLVER_PCG : STUDY_MICA_FACTORED;
       c.tol = tols[k];
       add(c);
     }
@@ -494,13 +499,13 @@ static void make_plan(int quick) {
     }
   const double Es[] = {1e3, 1e4, 1e5, 1e6, 1e7};
   for (int k = 0; k < 5; ++k)
-    for (int s = 0; s < 3; ++s) {
+    for (int s = 0; s < 4; ++s) {
       c = base_cfg();
       c.group = "stiffness";
       c.E = Es[k];
       c.T = 0.5;
       c.tol = 1e-8;
-      c.solver = s == 0 ? MICA_SOLVER_DIRECT : s == 1 ? MICA_SOLVER_MICA : MICA_SOLVER_PCG;
+      c.solver = s == 0 ? MICA_SOLVER_DIRECT : s == 1 ? MICA_SOLVER_MICA : s == 2 ? MICA_SOLVER_PCG : STUDY_MICA_FACTORED;
       add(c);
     }
   const double dtols[] = {1e-2, 1e-4, 1e-6, 1e-8};
