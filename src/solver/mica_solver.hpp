@@ -12,6 +12,8 @@
 #pragma once
 #include <vector>
 
+#include "core/colouring.hpp"
+#include "core/thread_pool.hpp"
 #include "solver/contact_rows.hpp"
 #include "solver/projected_system.hpp"
 
@@ -26,6 +28,9 @@ struct MicaSettings {
   int32_t pgs_sweeps = 1;           // PGS sweeps over the contact rows per iteration
   bool paper_norm = false;          // stop on the 2-norm of the change of (v, lambda) instead
   double relaxation = 1.0;          // MBGS over-relaxation omega in (0, 2); 1 is the paper's Gauss-Seidel
+  // Not null (and every body coloured): the MBGS sweep runs colour by colour, a colour's nodes on
+  // the pool's threads. Null: the paper's sweep in node order.
+  ThreadPool* pool = nullptr;
 };
 
 // One body's system as the solver sees it. v holds the warm start and receives the result.
@@ -36,6 +41,7 @@ struct MicaBody {
   const Projection* projection;
   Vec3List* v;
   Vec3List contact_impulse;  // out: G^T lambda per node, N s
+  const Colouring* colours = nullptr;  // nodes coupled by no block of A share a colour (see node_colouring.hpp)
 };
 
 struct MicaReport : SolveReport {
@@ -55,12 +61,17 @@ class MicaSolver {
  private:
   double anticipated_velocity(const std::vector<MicaBody>& bodies, const ContactRows& rows, size_t r) const;
   void project(const ContactRows& rows, size_t r, std::vector<double>& lambda) const;
+  void coloured_sweep(std::vector<MicaBody>& bodies, double relaxation, ThreadPool& pool, double& dv2, double& v2);
 
   std::vector<std::vector<Mat3>> inv_diag_;  // per body, per node: Dt_i^-1
   std::vector<Vec3> g_;                      // per row term: coef Dt^-1 d
   std::vector<double> diag_, c_;             // per row: B_rr, anticipated velocity
   std::vector<std::vector<Vec3>> u_;         // per body, per node: Dt^-1 G^T lambda
   std::vector<double> lambda_old_;
+  struct alignas(64) Partial {
+    double dv2 = 0, v2 = 0;
+  };
+  std::vector<Partial> partial_;             // per thread of the coloured sweep
 };
 
 }  // namespace mica

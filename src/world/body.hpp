@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "collision/bvh.hpp"
+#include "core/colouring.hpp"
 #include "fem/fem_model.hpp"
 #include "solver/direct_solver.hpp"
 #include "solver/pcg.hpp"
@@ -47,6 +48,10 @@ struct Body {
   Vec3List contact_impulse;    // G^T lambda of the last step, N s
   DirectSolver direct;
   PcgSolver pcg;
+
+  // For a world with threads > 1 (empty otherwise): tets that share no node (parallel
+  // assembly) and nodes that share no block of A (the colour-ordered MBGS sweep).
+  Colouring element_colours, node_colours;
 
   // What A and the factorization were built for; a linear body reuses both while unchanged.
   struct MatrixKey {

@@ -76,7 +76,10 @@ void World::advance(double h) {
   });
   stage.run(Stage::Rotations, plan.rotations, [&] {
     for (Body* b : dynamic)
-      if (b->settings.corotational) compute_rotations(b->fem, b->x, b->R);
+      if (b->settings.corotational) {
+        if (pool_) compute_rotations(b->fem, b->x, b->R, *pool_);
+        else compute_rotations(b->fem, b->x, b->R);
+      }
   });
   stage.run(Stage::Elements, plan.elements, [&] {
     for (Body* b : dynamic) assemble_elements(*b, h, needs_damping(*b));
@@ -149,8 +152,13 @@ void World::assemble_elements(Body& b, double h, bool damping) const {
   // A linear body keeps A while h and the damping stay: only its forces are recomputed.
   const bool rebuild = b.settings.corotational || !b.matrix_current || !(key == b.matrix_key);
   const std::vector<Mat3>* R = b.settings.corotational ? &b.R : nullptr;
-  if (rebuild) set_scaled_mass(b.fem, 1.0, b.A);
-  assemble_elastic(b.fem, b.x, R, h * h + h * beta, rebuild ? &b.A : nullptr, b.f_int);
+  if (pool_ && !b.element_colours.empty()) {
+    if (rebuild) set_scaled_mass(b.fem, 1.0, b.A, *pool_);
+    assemble_elastic(b.fem, b.x, R, h * h + h * beta, rebuild ? &b.A : nullptr, b.f_int, b.element_colours, *pool_);
+  } else {
+    if (rebuild) set_scaled_mass(b.fem, 1.0, b.A);
+    assemble_elastic(b.fem, b.x, R, h * h + h * beta, rebuild ? &b.A : nullptr, b.f_int);
+  }
   if (rebuild) {
     b.matrix_key = key;
     b.matrix_current = !b.settings.corotational;
@@ -243,6 +251,7 @@ void World::solve_mica(const std::vector<Body*>& dynamic, double h) {
     mica_bodies_[k].b = &b.b;
     mica_bodies_[k].projection = &b.projection;
     mica_bodies_[k].v = &b.v_next;
+    mica_bodies_[k].colours = pool_ && !b.node_colours.empty() ? &b.node_colours : nullptr;
   }
   // Warm start the impulses of contact rows that persist from the last step.
   rows_.build(contacts_, h, settings_.max_recovery_speed);
@@ -257,6 +266,7 @@ void World::solve_mica(const std::vector<Body*>& dynamic, double h) {
   ms.pgs_sweeps = settings_.pgs_sweeps;
   ms.paper_norm = settings_.paper_norm;
   ms.relaxation = settings_.relaxation;
+  ms.pool = pool_.get();
   const MicaReport report = mica_.solve(mica_bodies_, rows_, ms, lambda_);
   row_diagonal_ = mica_.row_diagonal();
   for (size_t k = 0; k < dynamic.size(); ++k) std::swap(dynamic[k]->contact_impulse, mica_bodies_[k].contact_impulse);
