@@ -166,41 +166,36 @@ MicaReport MicaSolver::solve(std::vector<MicaBody>& bodies, const ContactRows& r
   return report;
 }
 
-// The MBGS sweep colour by colour: a colour's nodes share no block of A, so updating them at
-// once is the Gauss-Seidel sweep in colour order, whatever the thread count. Each thread takes
-// a fixed share of each colour (and a barrier between colours); the sums of the stopping test
-// add up per thread, then in thread order.
+// The MBGS sweep colour by colour: blocks of one colour share no block of A, so updating them
+// at once is the Gauss-Seidel sweep in the colouring's order (each block in node order),
+// whichever thread takes which block. The sums of the stopping test add up per block, then in
+// the colouring's order: the result does not depend on the thread count either.
 void MicaSolver::coloured_sweep(std::vector<MicaBody>& bodies, double relaxation, ThreadPool& pool, double& dv2,
                                 double& v2) {
-  const int32_t threads = pool.size();
-  partial_.resize(size_t(threads));  // allocates on the first solve only
-  auto task = [&](int32_t t) {
-    double d = 0, s = 0;
-    for (size_t bi = 0; bi < bodies.size(); ++bi) {
-      MicaBody& body = bodies[bi];
-      const Colouring& c = *body.colours;
-      const std::vector<Mat3>& inv_diag = inv_diag_[bi];
-      Vec3List& v = *body.v;
-      for (int32_t colour = 0; colour < c.colours(); ++colour) {
-        const auto range = ThreadPool::share(c.start[colour], c.start[colour + 1], t, threads);
-        for (int64_t n = range.first; n < range.second; ++n) {
-          const int32_t i = c.order[n];
+  for (size_t bi = 0; bi < bodies.size(); ++bi) {
+    MicaBody& body = bodies[bi];
+    const Colouring& c = *body.colours;
+    const std::vector<Mat3>& inv_diag = inv_diag_[bi];
+    Vec3List& v = *body.v;
+    if (block_sums_.size() < size_t(c.blocks())) block_sums_.resize(size_t(c.blocks()));  // the first solve only
+    auto blocks = [&](int32_t, int32_t first, int32_t last, int32_t) {
+      for (int32_t n = first; n < last; ++n) {
+        double d = 0, s = 0;
+        for (int32_t i = c.block_start[c.order[n]]; i < c.block_start[c.order[n] + 1]; ++i) {
           const Vec3 gs = node_update(body, inv_diag[i], i, (*body.b)[i] + body.contact_impulse[i]);
           const Vec3 next = v[i] + relaxation * (gs - v[i]);
           d += (next - v[i]).squaredNorm();
           v[i] = next;
           s += next.squaredNorm();
         }
-        if (colour + 1 < c.colours() || bi + 1 < bodies.size()) pool.barrier();
+        block_sums_[n] = {d, s};
       }
+    };
+    pool.phased_for(c.start.data(), c.colours(), 1, blocks);
+    for (int32_t n = 0; n < c.blocks(); ++n) {
+      dv2 += block_sums_[n][0];
+      v2 += block_sums_[n][1];
     }
-    partial_[t].dv2 = d;
-    partial_[t].v2 = s;
-  };
-  pool.run(task);
-  for (const Partial& p : partial_) {
-    dv2 += p.dv2;
-    v2 += p.v2;
   }
 }
 

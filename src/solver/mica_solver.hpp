@@ -41,7 +41,7 @@ struct MicaBody {
   const Projection* projection;
   Vec3List* v;
   Vec3List contact_impulse;  // out: G^T lambda per node, N s
-  const Colouring* colours = nullptr;  // nodes coupled by no block of A share a colour (see node_colouring.hpp)
+  const Colouring* colours = nullptr;  // node blocks coupled by no block of A share a colour (node_colouring.hpp)
 };
 
 struct MicaReport : SolveReport {
@@ -68,10 +68,7 @@ class MicaSolver {
   std::vector<double> diag_, c_;             // per row: B_rr, anticipated velocity
   std::vector<std::vector<Vec3>> u_;         // per body, per node: Dt^-1 G^T lambda
   std::vector<double> lambda_old_;
-  struct alignas(64) Partial {
-    double dv2 = 0, v2 = 0;
-  };
-  std::vector<Partial> partial_;             // per thread of the coloured sweep
+  std::vector<std::array<double, 2>> block_sums_;  // coloured sweep: |dv|^2 and |v|^2 per block, in sweep order
 };
 
 }  // namespace mica

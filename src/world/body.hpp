@@ -49,8 +49,8 @@ struct Body {
   DirectSolver direct;
   PcgSolver pcg;
 
-  // For a world with threads > 1 (empty otherwise): tets that share no node (parallel
-  // assembly) and nodes that share no block of A (the colour-ordered MBGS sweep).
+  // For a world with threads > 1 (empty otherwise): blocks of tets that share no node (parallel
+  // assembly) and blocks of nodes that share no block of A (the colour-ordered MBGS sweep).
   Colouring element_colours, node_colours;
 
   // What A and the factorization were built for; a linear body reuses both while unchanged.

@@ -52,8 +52,9 @@ Id World::add_body(const TetMesh& mesh, const BodySettings& settings, const Vec3
   if (!settings.is_static)
     for (Vec3& u : body->v) u = velocity;
   if (pool_ && !settings.is_static) {
-    body->element_colours = colour_elements(body->tets, body->fem.node_count());
-    body->node_colours = colour_nodes(body->fem.pattern);
+    body->element_colours = colour_elements(body->tets, body->fem.node_count(),
+                                            block_size_for(int32_t(body->tets.size()), 16, 1024));
+    body->node_colours = colour_nodes(body->fem.pattern, block_size_for(body->fem.node_count(), 8, 512));
   }
   const Id id = bodies_.insert(std::move(body));
   ++bodies_created_;

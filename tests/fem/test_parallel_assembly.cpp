@@ -1,9 +1,13 @@
 // The step's parallel loops against the serial ones: the pool itself (every thread runs, the
 // barrier orders), rotations bit for bit, assembly by element colours equal up to round-off
-// (the sums run in colour order) and the same for every thread count above one.
+// (the sums run in colour order) and the same for every thread count above one; none of it
+// allocates once warm.
 #include "core/thread_pool.hpp"
 #include "fem/element_colouring.hpp"
 #include "fem/fem_model.hpp"
+#include "haptics/alloc_counter.hpp"
+#include "solver/mica_solver.hpp"
+#include "solver/node_colouring.hpp"
 #include "test_util.hpp"
 
 using namespace mica;
@@ -38,28 +42,40 @@ double max_diff(const Vec3List& a, const Vec3List& b) {
 
 }  // namespace
 
-static void test_pool_runs_every_thread_and_barrier_orders(void**) {
+// Phases in order: every item of phase p reads all of phase p - 1, which must be complete.
+static void test_pool_phases_run_in_order(void**) {
   for (int32_t threads : {1, 2, 3, 4}) {
     ThreadPool pool(threads);
     assert_int_equal(pool.size(), threads);
-    std::vector<int64_t> slot(size_t(threads) * 8, 0);
-    for (int round = 0; round < 200; ++round) {
-      // Phase 1: each thread writes its slot; phase 2 (after the barrier): each reads its
-      // neighbour's, which must be this round's.
-      std::vector<int64_t> seen(size_t(threads), -1);
-      auto task = [&](int32_t t) {
-        slot[size_t(t) * 8] = round;
-        pool.barrier();
-        seen[t] = slot[size_t((t + 1) % threads) * 8];
-        pool.barrier();
-      };
-      pool.run(task);
-      for (int64_t s : seen) assert_int_equal(s, round);
+    const int32_t phases = 6, width = 37;  // uneven: the last chunk of a phase is short
+    std::vector<int32_t> start;
+    for (int32_t p = 0; p <= phases; ++p) start.push_back(p * width);
+    for (int32_t grain : {1, 5, 16, 100}) {
+      for (int round = 0; round < 50; ++round) {
+        std::vector<int64_t> value(size_t(phases * width), -1);
+        std::vector<int> chunks_seen(size_t(ThreadPool::chunk_count(start.data(), phases, grain)), 0);
+        auto f = [&](int32_t p, int32_t first, int32_t last, int32_t chunk) {
+          ++chunks_seen[chunk];
+          for (int32_t i = first; i < last; ++i) {
+            int64_t sum = round;
+            if (p > 0)
+              for (int32_t j = start[p - 1]; j < start[p]; ++j) sum += value[j];
+            value[i] = sum + 1;
+          }
+        };
+        pool.phased_for(start.data(), phases, grain, f);
+        int64_t expected = round + 1;  // phase 0
+        for (int32_t p = 0; p < phases; ++p) {
+          for (int32_t i = start[p]; i < start[p + 1]; ++i) assert_int_equal(value[i], expected);
+          expected = round + width * expected + 1;
+        }
+        for (int c : chunks_seen) assert_int_equal(c, 1);
+      }
     }
     // parallel_for covers [0, n) exactly once.
     std::vector<int> hits(1001, 0);
-    parallel_for(&pool, 1001, [&](int64_t first, int64_t last, int32_t) {
-      for (int64_t i = first; i < last; ++i) ++hits[i];
+    parallel_for(&pool, 1001, 10, [&](int32_t first, int32_t last) {
+      for (int32_t i = first; i < last; ++i) ++hits[i];
     });
     for (int h : hits) assert_int_equal(h, 1);
   }
@@ -68,15 +84,17 @@ static void test_pool_runs_every_thread_and_barrier_orders(void**) {
 }
 
 static void test_pool_sleeps_and_wakes(void**) {
-  // Regions spaced by more than the spin time: the workers go to sleep and must wake up.
+  // Loops spaced by more than the spin time: the workers go to sleep, wake up (or come late,
+  // and the caller does the work).
   ThreadPool pool(3);
   std::atomic<int> count{0};
+  const int32_t start[2] = {0, 64};
   for (int k = 0; k < 5; ++k) {
     std::this_thread::sleep_for(std::chrono::milliseconds(2));
-    auto task = [&](int32_t) { count.fetch_add(1); };
-    pool.run(task);
+    auto f = [&](int32_t, int32_t first, int32_t last, int32_t) { count.fetch_add(last - first); };
+    pool.phased_for(start, 1, 4, f);
   }
-  assert_int_equal(count.load(), 15);
+  assert_int_equal(count.load(), 5 * 64);
 }
 
 static void test_parallel_rotations_are_the_serial_ones(void**) {
@@ -93,8 +111,9 @@ static void test_parallel_assembly_matches_serial(void**) {
   const size_t ne = d.model.elements.size(), nn = d.x.size(), nb = d.model.pattern.block_count();
   std::vector<Mat3> R(ne);
   compute_rotations(d.model, d.x, R);
-  const Colouring colours = colour_elements(d.mesh.tets, d.model.node_count());
+  const Colouring colours = colour_elements(d.mesh.tets, d.model.node_count(), 16);
   assert_true(is_valid_element_colouring(d.mesh.tets, d.model.node_count(), colours));
+  assert_true(colours.colours() > 1 && colours.blocks() > colours.colours());
   const double k_scale = 1e-4 + 1e-5;
   BlockValues A1(nb), A2(nb), A3(nb);
   Vec3List f1(nn), f2(nn), f3(nn);
@@ -122,12 +141,52 @@ static void test_parallel_assembly_matches_serial(void**) {
   assert_le(max_diff(g1, g2), 1e-12 * f_scale);
 }
 
+// The step's parallel pieces, warm: rotations, assembly and the coloured MBGS sweep make no
+// heap allocation on the stepping thread (nor does the pool hand any work that allocates).
+static void test_parallel_step_pieces_do_not_allocate(void**) {
+  const Deformed d;
+  const FemModel& m = d.model;
+  std::vector<Mat3> R(m.elements.size());
+  BlockValues A(m.pattern.block_count());
+  Vec3List f(d.x.size()), b(d.x.size(), Vec3(0, -1e-3, 0)), v(d.x.size(), Vec3::Zero());
+  const Colouring elements = colour_elements(d.mesh.tets, m.node_count(), 16);
+  const Colouring nodes = colour_nodes(m.pattern, 8);
+  assert_true(is_valid_node_colouring(m.pattern, nodes));
+  Projection projection;
+  projection.reset(m.node_count());
+  ContactRows rows;
+  std::vector<double> lambda;
+  MicaSolver solver;
+  std::vector<MicaBody> bodies(1);
+  bodies[0].pattern = &m.pattern;
+  bodies[0].A = &A;
+  bodies[0].b = &b;
+  bodies[0].projection = &projection;
+  bodies[0].v = &v;
+  bodies[0].colours = &nodes;
+  ThreadPool pool(2);
+  MicaSettings ms;
+  ms.pool = &pool;
+  ms.max_iterations = 20;
+  auto step = [&] {
+    compute_rotations(m, d.x, R, pool);
+    set_scaled_mass(m, 1.0, A, pool);
+    assemble_elastic(m, d.x, &R, 1e-4, &A, f, elements, pool);
+    solver.solve(bodies, rows, ms, lambda);
+  };
+  step();  // the first solve sizes the solver's buffers
+  mica_test::start_counting_allocations();
+  for (int k = 0; k < 3; ++k) step();
+  assert_int_equal(mica_test::stop_counting_allocations(), 0);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
-      cmocka_unit_test(test_pool_runs_every_thread_and_barrier_orders),
+      cmocka_unit_test(test_pool_phases_run_in_order),
       cmocka_unit_test(test_pool_sleeps_and_wakes),
       cmocka_unit_test(test_parallel_rotations_are_the_serial_ones),
       cmocka_unit_test(test_parallel_assembly_matches_serial),
+      cmocka_unit_test(test_parallel_step_pieces_do_not_allocate),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
