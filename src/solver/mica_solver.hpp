@@ -59,9 +59,9 @@ class MicaSolver {
   const std::vector<double>& row_diagonal() const { return diag_; }
 
  private:
+  void coloured_sweep(std::vector<MicaBody>& bodies, double relaxation, ThreadPool& pool, double& dv2, double& v2);
   double anticipated_velocity(const std::vector<MicaBody>& bodies, const ContactRows& rows, size_t r) const;
   void project(const ContactRows& rows, size_t r, std::vector<double>& lambda) const;
-  void coloured_sweep(std::vector<MicaBody>& bodies, double relaxation, ThreadPool& pool, double& dv2, double& v2);
 
   std::vector<std::vector<Mat3>> inv_diag_;  // per body, per node: Dt_i^-1
   std::vector<Vec3> g_;                      // per row term: coef Dt^-1 d

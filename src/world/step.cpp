@@ -246,12 +246,12 @@ void World::solve_mica(const std::vector<Body*>& dynamic, double h) {
     // one PGS sweep makes an isolated row's impulse a function of v alone).
     if (settings_.warm_start) b.v_next = b.v;
     else for (Vec3& v : b.v_next) v.setZero();
+    mica_bodies_[k].colours = pool_ && !b.node_colours.empty() ? &b.node_colours : nullptr;
     mica_bodies_[k].pattern = &b.fem.pattern;
     mica_bodies_[k].A = &b.A;
     mica_bodies_[k].b = &b.b;
     mica_bodies_[k].projection = &b.projection;
     mica_bodies_[k].v = &b.v_next;
-    mica_bodies_[k].colours = pool_ && !b.node_colours.empty() ? &b.node_colours : nullptr;
   }
   // Warm start the impulses of contact rows that persist from the last step.
   rows_.build(contacts_, h, settings_.max_recovery_speed);
@@ -261,12 +261,12 @@ void World::solve_mica(const std::vector<Body*>& dynamic, double h) {
     if (it != warm_start_.end()) lambda_[r] = it->second;
   }
   MicaSettings ms;
+  ms.pool = pool_.get();
   ms.tolerance = settings_.tolerance;
   ms.max_iterations = settings_.max_iterations;
   ms.pgs_sweeps = settings_.pgs_sweeps;
   ms.paper_norm = settings_.paper_norm;
   ms.relaxation = settings_.relaxation;
-  ms.pool = pool_.get();
   const MicaReport report = mica_.solve(mica_bodies_, rows_, ms, lambda_);
   row_diagonal_ = mica_.row_diagonal();
   for (size_t k = 0; k < dynamic.size(); ++k) std::swap(dynamic[k]->contact_impulse, mica_bodies_[k].contact_impulse);
