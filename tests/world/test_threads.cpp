@@ -74,8 +74,10 @@ void build(Scene& s, const SceneSpec& spec) {
   if (spec.second_body) {
     BodySettings soft;
     soft.material = {2e4, 0.3, 1000};
-    s.other = s.world.add_body(make_box_grid(Vec3(0.02, 0.1005, 0.02), Vec3(0.08, 0.1305, 0.08), {3, 2, 3}, 6), soft,
-                               Vec3::Zero(), Vec3::Zero());
+    // Off the lower body's grid: a node right above an edge of its surface is a tie between two
+    // triangles that round-off decides, and the two worlds would build different contact sets.
+    s.other = s.world.add_body(make_box_grid(Vec3(0.0213, 0.1005, 0.0161), Vec3(0.0813, 0.1305, 0.0761), {3, 2, 3}, 6),
+                               soft, Vec3::Zero(), Vec3::Zero());
     LpcSpec push;
     push.velocity = Vec3(0, -0.1, 0);
     s.world.add_lpc(s.other, nodes_where(s.world.body(s.other), [](const Vec3& p) { return p.y() > 0.1305 - 1e-9; }),
