@@ -68,6 +68,34 @@ void compute_rotations(const FemModel& m, const Vec3List& x, std::vector<Mat3>& 
     R[e] = proper_rotation(deformation_gradient(m.elements[e], x));
 }
 
+void compute_rotations(const FemModel& m, const Vec3List& x, std::vector<Mat3>& R, ThreadPool& pool) {
+  parallel_for(&pool, int64_t(m.elements.size()), 64, [&](int32_t first, int32_t last) {
+    for (int32_t e = first; e < last; ++e) R[e] = proper_rotation(deformation_gradient(m.elements[e], x));
+  });
+}
+
+void assemble_elastic(const FemModel& m, const Vec3List& x, const std::vector<Mat3>* R, double k_scale,
+                      BlockValues* K, Vec3List& f_int, const Colouring& element_colours, ThreadPool& pool) {
+  parallel_for(&pool, int64_t(f_int.size()), 4096, [&](int32_t first, int32_t last) {
+    for (int32_t i = first; i < last; ++i) f_int[i].setZero();
+  });
+  const Mat3 I = Mat3::Identity();
+  const Colouring& c = element_colours;
+  auto blocks = [&](int32_t, int32_t first, int32_t last, int32_t) {
+    Mat3 Ke[16];
+    for (int32_t n = first; n < last; ++n)
+      for (int32_t e = c.block_start[c.order[n]]; e < c.block_start[c.order[n] + 1]; ++e) {
+        const TetElement& el = m.elements[e];
+        const Mat3& Re = R ? (*R)[e] : I;
+        add_elastic_forces(el, m.lame, Re, deformation_gradient(el, x), f_int);
+        if (!K) continue;
+        rotated_stiffness(el, m.lame, Re, k_scale, Ke);
+        for (int q = 0; q < 16; ++q) (*K)[m.slots[e][q]] += Ke[q];
+      }
+  };
+  pool.phased_for(c.start.data(), c.colours(), 1, blocks);
+}
+
 void assemble_elastic(const FemModel& m, const Vec3List& x, const std::vector<Mat3>* R, double k_scale,
                       BlockValues* K, Vec3List& f_int) {
   for (auto& f : f_int) f.setZero();
@@ -85,6 +113,12 @@ void assemble_elastic(const FemModel& m, const Vec3List& x, const std::vector<Ma
 
 void set_scaled_mass(const FemModel& m, double scale, BlockValues& A) {
   for (size_t k = 0; k < A.size(); ++k) A[k] = (scale * m.mass[k]) * Mat3::Identity();
+}
+
+void set_scaled_mass(const FemModel& m, double scale, BlockValues& A, ThreadPool& pool) {
+  parallel_for(&pool, int64_t(A.size()), 4096, [&](int32_t first, int32_t last) {
+    for (int32_t k = first; k < last; ++k) A[k] = (scale * m.mass[k]) * Mat3::Identity();
+  });
 }
 
 void add_scaled_mass(const FemModel& m, double scale, BlockValues& A) {

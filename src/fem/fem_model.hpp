@@ -4,6 +4,8 @@
 #include <string>
 #include <vector>
 
+#include "core/colouring.hpp"
+#include "core/thread_pool.hpp"
 #include "core/types.hpp"
 #include "fem/block_matrix.hpp"
 #include "fem/material.hpp"
@@ -43,8 +45,19 @@ void compute_rotations(const FemModel& m, const Vec3List& x, std::vector<Mat3>& 
 void assemble_elastic(const FemModel& m, const Vec3List& x, const std::vector<Mat3>* R, double k_scale,
                       BlockValues* K, Vec3List& f_int);
 
+// The same on the threads of `pool`. Rotations: each element's own, so the result is the serial
+// one bit for bit. Assembly: the element blocks colour by colour (`element_colours`: blocks of a
+// colour share no node), so every block of A and every force has one writer at a time and no
+// per-step buffer is needed; the sums run in colour order rather than element order, so A and
+// f_int differ from the serial ones by round-off (but not with the thread count: the order is
+// the colouring's).
+void compute_rotations(const FemModel& m, const Vec3List& x, std::vector<Mat3>& R, ThreadPool& pool);
+void assemble_elastic(const FemModel& m, const Vec3List& x, const std::vector<Mat3>* R, double k_scale,
+                      BlockValues* K, Vec3List& f_int, const Colouring& element_colours, ThreadPool& pool);
+
 // A = scale * M (overwrites every block, so it also clears A).
 void set_scaled_mass(const FemModel& m, double scale, BlockValues& A);
+void set_scaled_mass(const FemModel& m, double scale, BlockValues& A, ThreadPool& pool);
 // A += scale * M
 void add_scaled_mass(const FemModel& m, double scale, BlockValues& A);
 // out = M v

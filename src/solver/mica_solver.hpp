@@ -12,6 +12,8 @@
 #pragma once
 #include <vector>
 
+#include "core/colouring.hpp"
+#include "core/thread_pool.hpp"
 #include "solver/contact_rows.hpp"
 #include "solver/projected_system.hpp"
 
@@ -31,6 +33,9 @@ struct MicaSettings {
   int32_t pgs_sweeps = 1;           // PGS sweeps over the contact rows per iteration
   bool paper_norm = false;          // stop on the 2-norm of the change of (v, lambda) instead
   double relaxation = 1.0;          // MBGS over-relaxation omega in (0, 2); 1 is the paper's Gauss-Seidel
+  // Not null (and every body coloured): the MBGS sweep runs colour by colour, a colour's nodes on
+  // the pool's threads. Null: the paper's sweep in node order.
+  ThreadPool* pool = nullptr;
 };
 
 // One body's system as the solver sees it. v holds the warm start and receives the result.
@@ -42,6 +47,7 @@ struct MicaBody {
   Vec3List* v;
   const std::vector<double>* node_mass = nullptr;  // kg per node: the residual's floor (none if null)
   Vec3List contact_impulse;  // out: G^T lambda per node, N s
+  const Colouring* colours = nullptr;  // node blocks coupled by no block of A share a colour (node_colouring.hpp)
 };
 
 struct MicaReport : SolveReport {
@@ -64,6 +70,7 @@ class MicaSolver {
   static double momentum_residual(const std::vector<MicaBody>& bodies);
 
  private:
+  void coloured_sweep(std::vector<MicaBody>& bodies, double relaxation, ThreadPool& pool, double& dv2, double& v2);
   double anticipated_velocity(const std::vector<MicaBody>& bodies, const ContactRows& rows, size_t r) const;
   void project(const ContactRows& rows, size_t r, std::vector<double>& lambda) const;
 
@@ -72,6 +79,7 @@ class MicaSolver {
   std::vector<double> diag_, c_;             // per row: B_rr, anticipated velocity
   std::vector<std::vector<Vec3>> u_;         // per body, per node: Dt^-1 G^T lambda
   std::vector<double> lambda_old_;
+  std::vector<std::array<double, 2>> block_sums_;  // coloured sweep: |dv|^2 and |v|^2 per block, in sweep order
 };
 
 }  // namespace mica

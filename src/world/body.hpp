@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "collision/bvh.hpp"
+#include "core/colouring.hpp"
 #include "fem/fem_model.hpp"
 #include "solver/direct_solver.hpp"
 #include "solver/pcg.hpp"
@@ -50,6 +51,10 @@ struct Body {
   PcgSolver pcg;
   RestFactor rest_factor;          // MICA with the factored anticipation
   std::vector<Mat3> node_rotation;  // per node, for warping the rest factor
+
+  // For a world with threads > 1 (empty otherwise): blocks of tets that share no node (parallel
+  // assembly) and blocks of nodes that share no block of A (the colour-ordered MBGS sweep).
+  Colouring element_colours, node_colours;
 
   // What A and the factorization were built for; a linear body reuses both while unchanged.
   struct MatrixKey {

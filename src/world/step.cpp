@@ -77,7 +77,10 @@ void World::advance(double h) {
   });
   stage.run(Stage::Rotations, plan.rotations, [&] {
     for (Body* b : dynamic)
-      if (b->settings.corotational) compute_rotations(b->fem, b->x, b->R);
+      if (b->settings.corotational) {
+        if (pool_) compute_rotations(b->fem, b->x, b->R, *pool_);
+        else compute_rotations(b->fem, b->x, b->R);
+      }
   });
   stage.run(Stage::Elements, plan.elements, [&] {
     for (Body* b : dynamic) assemble_elements(*b, h, needs_damping(*b));
@@ -150,8 +153,13 @@ void World::assemble_elements(Body& b, double h, bool damping) const {
   // A linear body keeps A while h and the damping stay: only its forces are recomputed.
   const bool rebuild = b.settings.corotational || !b.matrix_current || !(key == b.matrix_key);
   const std::vector<Mat3>* R = b.settings.corotational ? &b.R : nullptr;
-  if (rebuild) set_scaled_mass(b.fem, 1.0, b.A);
-  assemble_elastic(b.fem, b.x, R, h * h + h * beta, rebuild ? &b.A : nullptr, b.f_int);
+  if (pool_ && !b.element_colours.empty()) {
+    if (rebuild) set_scaled_mass(b.fem, 1.0, b.A, *pool_);
+    assemble_elastic(b.fem, b.x, R, h * h + h * beta, rebuild ? &b.A : nullptr, b.f_int, b.element_colours, *pool_);
+  } else {
+    if (rebuild) set_scaled_mass(b.fem, 1.0, b.A);
+    assemble_elastic(b.fem, b.x, R, h * h + h * beta, rebuild ? &b.A : nullptr, b.f_int);
+  }
   if (rebuild) {
     b.matrix_key = key;
     b.matrix_current = !b.settings.corotational;
@@ -239,6 +247,7 @@ void World::solve_mica(const std::vector<Body*>& dynamic, double h) {
     // one PGS sweep makes an isolated row's impulse a function of v alone).
     if (settings_.warm_start) b.v_next = b.v;
     else for (Vec3& v : b.v_next) v.setZero();
+    mica_bodies_[k].colours = pool_ && !b.node_colours.empty() ? &b.node_colours : nullptr;
     mica_bodies_[k].pattern = &b.fem.pattern;
     mica_bodies_[k].A = &b.A;
     mica_bodies_[k].b = &b.b;
@@ -254,6 +263,7 @@ void World::solve_mica(const std::vector<Body*>& dynamic, double h) {
     if (it != warm_start_.end()) lambda_[r] = it->second;
   }
   MicaSettings ms;
+  ms.pool = pool_.get();
   ms.tolerance = settings_.tolerance;
   ms.max_iterations = settings_.max_iterations;
   ms.pgs_sweeps = settings_.pgs_sweeps;

@@ -2,6 +2,9 @@
 
 #include <cmath>
 
+#include "fem/element_colouring.hpp"
+#include "solver/node_colouring.hpp"
+
 namespace mica {
 
 namespace {
@@ -19,6 +22,11 @@ World::World(const WorldSettings& settings) : settings_(settings) {
     fail(Errc::InvalidArgument, "the body contact margin must be finite and >= 0 m");
   if (!(settings.body_friction >= 0) || !std::isfinite(settings.body_friction))
     fail(Errc::InvalidArgument, "the body friction coefficient must be finite and >= 0");
+  if (settings.threads < 0 || settings.threads > kMaxThreads)
+    fail(Errc::InvalidArgument, "threads must be in 0.." + std::to_string(kMaxThreads) + " (0: every CPU), got " +
+                                    std::to_string(settings.threads));
+  const int32_t threads = ThreadPool::resolve(settings.threads);
+  if (threads > 1) pool_ = std::make_unique<ThreadPool>(threads);
 }
 
 void World::set_gravity(const Vec3& g) {
@@ -43,6 +51,11 @@ Id World::add_body(const TetMesh& mesh, const BodySettings& settings, const Vec3
                                          std::to_string(q.worst_aspect) + ". They slow iterative solvers.");
   if (!settings.is_static)
     for (Vec3& u : body->v) u = velocity;
+  if (pool_ && !settings.is_static) {
+    body->element_colours = colour_elements(body->tets, body->fem.node_count(),
+                                            block_size_for(int32_t(body->tets.size()), 16, 1024));
+    body->node_colours = colour_nodes(body->fem.pattern, block_size_for(body->fem.node_count(), 8, 512));
+  }
   const Id id = bodies_.insert(std::move(body));
   ++bodies_created_;
   return id;
