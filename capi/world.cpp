@@ -28,6 +28,7 @@ mica_world_def world_defaults() {
   d.warm_start = 1;
   d.relaxation = 1.0;
   d.mica_sweep = MICA_SWEEP_GAUSS_SEIDEL;
+  d.threads = 1;
   return d;
 }
 
@@ -62,6 +63,9 @@ mica::WorldSettings translate(const mica_world_def& d) {
   if (!(d.time_budget_ms >= 0) || !std::isfinite(d.time_budget_ms))
     refuse(MICA_ERR_INVALID_ARGUMENT, "def->time_budget_ms must be finite and >= 0 (0: no budget)");
   s.time_budget_ms = d.time_budget_ms;
+  if (d.threads < 0 || d.threads > 1024)
+    refuse(MICA_ERR_INVALID_ARGUMENT, "def->threads must be in [0, 1024] (0: every CPU), got " + std::to_string(d.threads));
+  s.threads = d.threads;
   switch (d.mica_sweep) {
     case MICA_SWEEP_GAUSS_SEIDEL: s.mica_sweep = mica::MicaSweep::GaussSeidel; break;
     case MICA_SWEEP_FACTORED: s.mica_sweep = mica::MicaSweep::Factored; break;

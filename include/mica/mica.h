@@ -154,7 +154,11 @@ typedef struct mica_world_def {
    *  MICA_WARN_NOT_CONVERGED and the statistics say out_of_time and the residual. Default 0: no budget. */
   double time_budget_ms;
   int32_t mica_sweep;      /**< MICA_SWEEP_*; default MICA_SWEEP_GAUSS_SEIDEL */
-  int32_t reserved3;       /**< zero */
+  /** Threads for the step (rotations, element assembly, a colour-ordered Gauss-Seidel sweep):
+   *  1 (default) runs the serial code and the paper's sweep order; 0 every CPU the process may
+   *  run on; n > 1 starts n - 1 workers owned by the world (they sleep between steps). See
+   *  docs/performance.md before raising it: a haptic host also needs a core for the servo loop. */
+  int32_t threads;
 } mica_world_def;
 
 /** Fills `def` with defaults, writing only its first `struct_size` bytes, and records

@@ -126,7 +126,7 @@ class mica_world_def(Structure):
         ("relaxation", c_double),
         ("time_budget_ms", c_double),
         ("mica_sweep", c_int32),
-        ("reserved3", c_int32),
+        ("threads", c_int32),
     ]
 
 

@@ -140,7 +140,7 @@ namespace LibMica
             public double relaxation;
             public double time_budget_ms;
             public int mica_sweep;
-            public int reserved3;
+            public int threads;
         }
 
         [StructLayout(LayoutKind.Sequential)]
