@@ -1,5 +1,7 @@
 #include "solver/factored_mica.hpp"
 
+#include "solver/lcp.hpp"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -74,6 +76,66 @@ void FactoredMicaSolver::apply_impulse_change(std::vector<MicaBody>& bodies,
   }
 }
 
+void FactoredMicaSolver::solve_small_lcp(const ContactRows& rows, double tolerance, const std::vector<double>& lambda) {
+  const size_t nr = rows.size();
+  lambda_next_ = lambda;
+  // Frictionless: Lemke's pivoting on the rows something can move along, exact (PGS on a few
+  // strongly coupled rows, contacts sharing nodes, would crawl and stop far from the answer).
+  bool friction = false;
+  for (size_t r = 0; r < nr; ++r) friction = friction || rows.normal_of[r] >= 0;
+  if (!friction) {
+    live_.clear();
+    for (size_t r = 0; r < nr; ++r)
+      if (diag_[r] > 0) live_.push_back(int32_t(r));
+    const Eigen::Index n = Eigen::Index(live_.size());
+    Eigen::MatrixXd M(n, n);
+    Eigen::VectorXd q(n);
+    for (Eigen::Index a = 0; a < n; ++a) {
+      q(a) = w_[live_[a]];
+      for (Eigen::Index b = 0; b < n; ++b) {
+        M(a, b) = W_(live_[a], live_[b]);
+        q(a) -= M(a, b) * lambda[live_[b]];
+      }
+    }
+    const LcpSolution sol = solve_lcp_lemke(M, q);
+    if (sol.solved) {
+      for (Eigen::Index a = 0; a < n; ++a) lambda_next_[live_[a]] = sol.z(a);
+      return;
+    }
+  }
+  // With friction (a box LCP whose bounds move with the normal impulses), or if pivoting failed:
+  // projected Gauss-Seidel, to well below the tolerance.
+  for (int sweep = 0; sweep < 10000; ++sweep) {
+    double change = 0, size = 0;
+    for (size_t r = 0; r < nr; ++r) {
+      if (diag_[r] == 0) continue;
+      double res = w_[r];
+      for (size_t s = 0; s < nr; ++s) res += W_(r, s) * (lambda_next_[s] - lambda[s]);
+      const double before = lambda_next_[r];
+      lambda_next_[r] -= res / W_(r, r);
+      project(rows, r, lambda_next_);
+      change = std::max(change, std::abs(lambda_next_[r] - before));
+      size = std::max(size, std::abs(lambda_next_[r]));
+    }
+    if (change <= 1e-3 * tolerance * size || size == 0) break;
+  }
+}
+
+double FactoredMicaSolver::complementarity_error(const ContactRows& rows, const std::vector<double>& lambda) {
+  // Per row the natural residual lambda - proj(lambda - w / W0_rr), with the warped compliance's
+  // own diagonal W0 (not the secant-updated one): the test does not trust what it learned.
+  double e2 = 0;
+  probe_ = lambda;
+  for (size_t r = 0; r < rows.size(); ++r) {
+    if (diag_[r] == 0) continue;
+    probe_[r] = lambda[r] - w_[r] / rest_diag_[r];
+    project(rows, r, probe_);
+    e2 += (probe_[r] - lambda[r]) * (probe_[r] - lambda[r]);
+    probe_[r] = lambda[r];
+  }
+  return std::sqrt(e2);
+}
+
 MicaReport FactoredMicaSolver::solve(std::vector<MicaBody>& bodies, const std::vector<FactoredBody>& factored,
                                      const ContactRows& rows, const MicaSettings& settings,
                                      std::vector<double>& lambda) {
@@ -94,9 +156,10 @@ MicaReport FactoredMicaSolver::solve(std::vector<MicaBody>& bodies, const std::v
   build_compliance(bodies, factored, rows);
   lambda.resize(nr, 0.0);
   diag_.assign(nr, 0.0);
+  rest_diag_.assign(nr, 0.0);
   const double w_max = nr ? W_.diagonal().cwiseAbs().maxCoeff() : 0.0;
   for (size_t r = 0; r < nr; ++r) {
-    if (W_(r, r) > 1e-12 * w_max) diag_[r] = W_(r, r);
+    if (W_(r, r) > 1e-12 * w_max) diag_[r] = rest_diag_[r] = W_(r, r);
     else lambda[r] = 0;  // nothing can move along this row
     project(rows, r, lambda);
   }
@@ -106,6 +169,7 @@ MicaReport FactoredMicaSolver::solve(std::vector<MicaBody>& bodies, const std::v
   report.momentum_residual = std::numeric_limits<double>::quiet_NaN();
   double l_scale = 0;
   int32_t outer = 0;
+  double previous_inner_tolerance = 1;
   bool velocities_solved = false;
   while (report.iterations < settings.max_iterations) {
     if (deadline && outer > 0 && Clock::now() >= *deadline) {
@@ -114,13 +178,16 @@ MicaReport FactoredMicaSolver::solve(std::vector<MicaBody>& bodies, const std::v
     }
     ++outer;
     // Velocities for the current impulses: A v = b + G^T lambda on the free directions. While the
-    // impulses still move, a tenth of their last change is accuracy enough (inexact Newton); the
-    // final solves aim a little below the tolerance, so the outer test is not starved.
+    // impulses still move, a hundredth of their last change is accuracy enough (inexact Newton);
+    // near the end the solves aim a little below the tolerance, so the outer test is not starved.
     const double final_tolerance = 0.3 * settings.tolerance;
     const double inner_tolerance =
-        outer == 1 || nr == 0 ? final_tolerance : std::clamp(0.1 * report.impulse_change, final_tolerance, 1e-2);
+        outer == 1 || nr == 0 || report.impulse_change < 30 * settings.tolerance
+            ? final_tolerance
+            : std::clamp(0.01 * report.impulse_change, final_tolerance, std::max(final_tolerance, 1e-2));
     for (size_t bi = 0; bi < nb; ++bi) pcg_[bi].configure(inner_tolerance, settings.max_iterations, deadline);
     velocities_solved = true;
+    report.velocity_change = 0;  // the residual of this round's solves
     for (size_t bi = 0; bi < nb; ++bi) {
       MicaBody& body = bodies[bi];
       body.contact_impulse.assign(size_t(body.pattern->rows), Vec3::Zero());
@@ -156,7 +223,7 @@ MicaReport FactoredMicaSolver::solve(std::vector<MicaBody>& bodies, const std::v
     // it, y = W_true s = w - w_prev. A BFGS update takes that into W and keeps it symmetric
     // positive definite (while s.y > 0, as for the true W), so the rotations the warped factor
     // misses stop slowing the loop.
-    if (outer > 1) {
+    if (outer > 1 && std::max(inner_tolerance, previous_inner_tolerance) <= final_tolerance) {  // only solved pairs measure it
       const Eigen::Map<const Eigen::VectorXd> s_(dlambda_.data(), Eigen::Index(nr));
       const Eigen::VectorXd y = Eigen::Map<const Eigen::VectorXd>(w_.data(), Eigen::Index(nr)) -
                                 Eigen::Map<const Eigen::VectorXd>(w_prev_.data(), Eigen::Index(nr));
@@ -168,21 +235,8 @@ MicaReport FactoredMicaSolver::solve(std::vector<MicaBody>& bodies, const std::v
       }
     }
     w_prev_ = w_;
-    lambda_next_ = lambda;
-    for (int sweep = 0; sweep < 1000; ++sweep) {
-      double change = 0, size = 0;
-      for (size_t r = 0; r < nr; ++r) {
-        if (diag_[r] == 0) continue;
-        double res = w_[r];
-        for (size_t s = 0; s < nr; ++s) res += W_(r, s) * (lambda_next_[s] - lambda[s]);
-        const double before = lambda_next_[r];
-        lambda_next_[r] -= res / W_(r, r);
-        project(rows, r, lambda_next_);
-        change = std::max(change, std::abs(lambda_next_[r] - before));
-        size = std::max(size, std::abs(lambda_next_[r]));
-      }
-      if (change <= 1e-3 * settings.tolerance * size || size == 0) break;
-    }
+    previous_inner_tolerance = inner_tolerance;
+    solve_small_lcp(rows, settings.tolerance, lambda);
     dlambda_.resize(nr);
     double dl2 = 0, l2 = 0;
     for (size_t r = 0; r < nr; ++r) {
@@ -192,7 +246,8 @@ MicaReport FactoredMicaSolver::solve(std::vector<MicaBody>& bodies, const std::v
     }
     if (outer == 1) l_scale = l2;  // the first correction sets the scale when lambda starts at zero
     report.impulse_change = dl2 > 0 ? std::sqrt(dl2 / std::max(l2, l_scale)) : 0.0;
-    if (report.impulse_change <= settings.tolerance && velocities_solved) {
+    if (report.impulse_change <= settings.tolerance && velocities_solved &&
+        complementarity_error(rows, lambda) <= settings.tolerance * std::sqrt(std::max(l2, l_scale))) {
       // v balances the current impulses and the impulses no longer move: done.
       report.momentum_residual = MicaSolver::momentum_residual(bodies);
       report.residual = std::max({report.velocity_change, report.impulse_change, report.momentum_residual});

@@ -37,6 +37,9 @@ class FactoredMicaSolver {
   void apply_impulse_change(std::vector<MicaBody>& bodies, const std::vector<FactoredBody>& factored,
                             const ContactRows& rows, const std::vector<double>& dlambda);
   void project(const ContactRows& rows, size_t r, std::vector<double>& lambda) const;
+  // lambda_next_ solves the LCP on W around lambda: 0 <= lambda_next _|_ w + W (lambda_next - lambda) >= 0
+  // (box bounds on friction rows).
+  void solve_small_lcp(const ContactRows& rows, double tolerance, const std::vector<double>& lambda);
 
   std::vector<PcgSolver> pcg_;
   std::vector<WarpedRestPreconditioner> warp_;
@@ -44,6 +47,10 @@ class FactoredMicaSolver {
   std::vector<Vec3> term_force_;                      // per row term: coef R_i^T S_i d (rest frame)
   Eigen::MatrixXd W_;                                 // G P^-1 G^T
   std::vector<double> w_, w_prev_, lambda_next_, dlambda_, diag_;
+  std::vector<int32_t> live_;
+  std::vector<double> rest_diag_, probe_;  // W_rr before the secant updates; scratch
+  // Of the current lambda against the current row velocities w_ (N s).
+  double complementarity_error(const ContactRows& rows, const std::vector<double>& lambda);
   std::vector<Vec3List> rhs_;
   Eigen::VectorXd y_;
 };
