@@ -40,7 +40,9 @@ struct Body {
   uint64_t lpc_version = 0;    // bumped when a constraint on this body is added or removed
 
   // Per-step work.
-  std::vector<Mat3> R;         // element rotations
+  std::vector<Mat3> R;         // element rotations the step is linearised with
+  std::vector<Mat3> R_end;     // rotations of x_end (computed after the solve: the next step's R)
+  Vec3List x_end;              // the positions R_end belongs to (empty: none)
   BlockValues A;               // M + h C + h^2 K
   Vec3List f_int, f_ext, b, v_next, x_next;
   Projection projection;

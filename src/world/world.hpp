@@ -35,6 +35,14 @@ struct WorldSettings {
   bool body_contact = true;        // contact between bodies (and with static bodies)
   double body_margin = 1e-3;       // m, contacts between bodies are made for gaps below this
   double body_friction = 0;        // Coulomb coefficient between bodies
+  // Co-rotational bodies: a step is linearised with the element rotations of its start. When an
+  // element's rotation at the step's end differs from the one the step used by more than
+  // relinearise_angle (rad), the step is solved again, linearised at the end rotations (one
+  // Newton-like iteration of the nonlinear backward-Euler step), at most relinearise_max times.
+  // 0 turns it off. Costs nothing in a step where no element turns that far (the end rotations
+  // are the next step's start rotations).
+  double relinearise_angle = 0.2;
+  int32_t relinearise_max = 4;
   std::function<void(LogLevel, const std::string&)> log;  // optional
 };
 
@@ -139,6 +147,9 @@ class World {
   void build_projection(Body& b, double h) const;
   void form_rhs(Body& b, double h) const;
   void solve_velocities(Body& b, double h);
+  // Co-rotational re-linearisation (relinearise.cpp).
+  void start_rotations(Body& b) const;
+  void relinearise(const std::vector<Body*>& dynamic, double h, StageRunner& stage, const std::function<void()>& solve);
   void advance(double h);
   void record(const SolveReport& report);
   void check_finite(const std::vector<Body*>& dynamic) const;
@@ -154,6 +165,7 @@ class World {
   SlotMap<DeviceLink, IdKind::Device> devices_;
   std::vector<double> row_diagonal_;                // W_rr (or B_rr) per row: the compliance a row sees
   std::vector<Body*> dynamic_;                      // this step's dynamic bodies
+  std::vector<Body*> relinearised_;                 // bodies solved again at their end rotations
   std::vector<Tool*> step_tools_;
   std::vector<SurfaceView> views_;
   std::vector<Contact> contacts_;
