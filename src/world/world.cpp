@@ -19,6 +19,8 @@ World::World(const WorldSettings& settings) : settings_(settings) {
     fail(Errc::InvalidArgument, "the body contact margin must be finite and >= 0 m");
   if (!(settings.body_friction >= 0) || !std::isfinite(settings.body_friction))
     fail(Errc::InvalidArgument, "the body friction coefficient must be finite and >= 0");
+  if (!(settings.relinearise_tolerance >= 0) || !std::isfinite(settings.relinearise_tolerance))
+    fail(Errc::InvalidArgument, "relinearise_tolerance must be finite and >= 0");
 }
 
 void World::set_gravity(const Vec3& g) {

@@ -35,14 +35,16 @@ struct WorldSettings {
   bool body_contact = true;        // contact between bodies (and with static bodies)
   double body_margin = 1e-3;       // m, contacts between bodies are made for gaps below this
   double body_friction = 0;        // Coulomb coefficient between bodies
-  // Co-rotational bodies: a step is linearised with the element rotations of its start. When an
-  // element's rotation at the step's end differs from the one the step used by more than
-  // relinearise_angle (rad), the step is solved again, linearised at the end rotations (one
-  // Newton-like iteration of the nonlinear backward-Euler step), at most relinearise_max times.
-  // 0 turns it off. Costs nothing in a step where no element turns that far (the end rotations
-  // are the next step's start rotations).
-  double relinearise_angle = 0.2;
-  int32_t relinearise_max = 4;
+  // Co-rotational bodies: the step is linearised with the element rotations of its start, which
+  // can add energy when elements turn far within one step. After each solve the energy the step
+  // gained beyond the work done on the bodies is checked (summed over the steps since the energy
+  // last went down); above relinearise_tolerance times the bodies' energy the step is solved
+  // again by Newton iterations of the fully implicit step (re-linearised at the rotations of the
+  // iterate, with a line search), at most relinearise_max solves in all; relinearise_max < 2
+  // turns this off (the frozen-rotation step, unchecked). Costs two element energies per element
+  // per step when no step needs it (the rotations it computes are the next step's).
+  double relinearise_tolerance = 1e-3;
+  int32_t relinearise_max = 8;
   std::function<void(LogLevel, const std::string&)> log;  // optional
 };
 
@@ -165,7 +167,10 @@ class World {
   SlotMap<DeviceLink, IdKind::Device> devices_;
   std::vector<double> row_diagonal_;                // W_rr (or B_rr) per row: the compliance a row sees
   std::vector<Body*> dynamic_;                      // this step's dynamic bodies
-  std::vector<Body*> relinearised_;                 // bodies solved again at their end rotations
+  struct {  // relinearise: the energy (J) the steps since it last went down added, net
+    double committed = 0, pending = 0;
+    int64_t pending_step = -1;  // the step whose completion commits `pending`
+  } debt_;
   std::vector<Tool*> step_tools_;
   std::vector<SurfaceView> views_;
   std::vector<Contact> contacts_;
