@@ -11,6 +11,7 @@ Body::Body(const TetMesh& mesh, const BodySettings& s, const std::string& body_n
   v.assign(n, Vec3::Zero());
   node_forces.assign(n, Vec3::Zero());
   R.assign(fem.elements.size(), Mat3::Identity());
+  R_end.assign(fem.elements.size(), Mat3::Identity());
   A.assign(fem.pattern.block_count(), Mat3::Zero());
   for (Vec3List* w : {&f_int, &f_ext, &b, &v_next, &x_next, &contact_impulse}) w->assign(n, Vec3::Zero());
   projection.reset(int32_t(n));

@@ -7,6 +7,7 @@
 #include "collision/bvh.hpp"
 #include "core/colouring.hpp"
 #include "fem/fem_model.hpp"
+#include "fem/rotation_stiffness.hpp"
 #include "solver/direct_solver.hpp"
 #include "solver/pcg.hpp"
 #include "solver/rest_factor.hpp"
@@ -42,7 +43,17 @@ struct Body {
   uint64_t lpc_version = 0;    // bumped when a constraint on this body is added or removed
 
   // Per-step work.
-  std::vector<Mat3> R;         // element rotations
+  std::vector<Mat3> R;         // element rotations the step is linearised with
+  std::vector<Mat3> R_end;     // rotations of x_end (computed after the solve: the next step's R)
+  Vec3List x_end;              // the positions R_end belongs to (empty: none)
+  struct Relinearisation {     // world/relinearise.cpp; sized on first use
+    std::vector<Mat3> R_start;        // the step's start rotations
+    std::vector<TwistModes> modes;    // the linearisation's twist stiffness (empty: none)
+    Vec3List v_iter, v_lin, v_best, v_trial, scratch;
+    double u_start = 0, k_start = 0;  // J, elastic and kinetic energy at the step's start
+    double u_end = 0;                 // J, elastic energy at x_end
+    bool u_start_known = false;       // u_start is U(x) (x == the last step's x_end)
+  } relin;
   BlockValues A;               // M + h C + h^2 K
   Vec3List f_int, f_ext, b, v_next, x_next;
   Projection projection;

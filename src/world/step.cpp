@@ -77,10 +77,7 @@ void World::advance(double h) {
   });
   stage.run(Stage::Rotations, plan.rotations, [&] {
     for (Body* b : dynamic)
-      if (b->settings.corotational) {
-        if (pool_) compute_rotations(b->fem, b->x, b->R, *pool_);
-        else compute_rotations(b->fem, b->x, b->R);
-      }
+      if (b->settings.corotational) start_rotations(*b);
   });
   stage.run(Stage::Elements, plan.elements, [&] {
     for (Body* b : dynamic) assemble_elements(*b, h, needs_damping(*b));
@@ -92,7 +89,7 @@ void World::advance(double h) {
   stage.run(Stage::Constraints, plan.constraints, [&] {
     for (Body* b : dynamic) build_projection(*b, h);
   });
-  stage.run(Stage::Solve, plan.solve, [&] {
+  const std::function<void()> solve = [&] {
     if (settings_.solver == SolverKind::Mica) {
       solve_mica(dynamic, h);
     } else if (!contacts_.empty()) {
@@ -100,7 +97,9 @@ void World::advance(double h) {
     } else {
       for (Body* b : dynamic) solve_velocities(*b, h);
     }
-  });
+  };
+  stage.run(Stage::Solve, plan.solve, solve);
+  if (plan.rotations && plan.solve) relinearise(dynamic, h, stage, solve);
   stage.run(Stage::Integrate, plan.integrate, [&] {
     for (Body* b : dynamic)
       for (size_t i = 0; i < b->x.size(); ++i) b->x_next[i] = b->x[i] + h * b->v_next[i];

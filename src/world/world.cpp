@@ -27,6 +27,8 @@ World::World(const WorldSettings& settings) : settings_(settings) {
                                     std::to_string(settings.threads));
   const int32_t threads = ThreadPool::resolve(settings.threads);
   if (threads > 1) pool_ = std::make_unique<ThreadPool>(threads);
+  if (!(settings.relinearise_tolerance >= 0) || !std::isfinite(settings.relinearise_tolerance))
+    fail(Errc::InvalidArgument, "relinearise_tolerance must be finite and >= 0");
 }
 
 void World::set_gravity(const Vec3& g) {

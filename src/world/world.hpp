@@ -52,6 +52,16 @@ struct WorldSettings {
   // a colour's nodes in parallel. The colour order changes MICA's iterates (not its fixed point)
   // against the paper's natural order; results do not depend on the count once it is above 1.
   int32_t threads = 1;
+  // Co-rotational bodies: the step is linearised with the element rotations of its start, which
+  // can add energy when elements turn far within one step. After each solve the energy the step
+  // gained beyond the work done on the bodies is checked (summed over the steps since the energy
+  // last went down); above relinearise_tolerance times the bodies' energy the step is solved
+  // again by Newton iterations of the fully implicit step (re-linearised at the rotations of the
+  // iterate, with a line search), at most relinearise_max solves in all; relinearise_max < 2
+  // turns this off (the frozen-rotation step, unchecked). Costs two element energies per element
+  // per step when no step needs it (the rotations it computes are the next step's).
+  double relinearise_tolerance = 1e-3;
+  int32_t relinearise_max = 8;
   std::function<void(LogLevel, const std::string&)> log;  // optional
 };
 
@@ -157,6 +167,9 @@ class World {
   void build_projection(Body& b, double h) const;
   void form_rhs(Body& b, double h) const;
   void solve_velocities(Body& b, double h);
+  // Co-rotational re-linearisation (relinearise.cpp).
+  void start_rotations(Body& b) const;
+  void relinearise(const std::vector<Body*>& dynamic, double h, StageRunner& stage, const std::function<void()>& solve);
   void advance(double h);
   void record(const SolveReport& report);
   void check_finite(const std::vector<Body*>& dynamic) const;
@@ -172,6 +185,10 @@ class World {
   SlotMap<DeviceLink, IdKind::Device> devices_;
   std::vector<double> row_diagonal_;                // W_rr (or B_rr) per row: the compliance a row sees
   std::vector<Body*> dynamic_;                      // this step's dynamic bodies
+  struct {  // relinearise: the energy (J) the steps since it last went down added, net
+    double committed = 0, pending = 0;
+    int64_t pending_step = -1;  // the step whose completion commits `pending`
+  } debt_;
   std::vector<Tool*> step_tools_;
   std::chrono::steady_clock::time_point step_start_;  // for the time budget
   std::vector<SurfaceView> views_;

@@ -1,0 +1,363 @@
+// Co-rotational re-linearisation (K1 in docs/stability.md).
+//
+// The step A v+ = M v + h (f_R(x) + f_ext) is backward Euler with the element rotations R frozen
+// at the step's start. The elastic force f_R(y) = -sum R Ke (R^T y - X) is affine in y, so the
+// step is exactly backward Euler on the quadratic energy U_R, and on U_R it never gains energy.
+// The model's energy U(y) uses each element's own rotation R(y); when elements turn far within
+// one step (a released twist, a flapping thin plate, stiff bodies at long steps), the frozen
+// rotations move nodes along straight lines where they should turn, and U(x+) can be far above
+// U_R(x+): a released 180-degree twist went from 5.9 J to 420 J in one step.
+//
+// The check, after every solve of a step with co-rotational bodies: the energy the step gained
+// beyond the work done on the bodies (loads, constraints, contacts) is, from the exact energy
+// balance of the linearised step,
+//   growth = [U(x+) - U_lin(x+)] - [U(x) - U_lin(x)] - dissipation,
+// U_lin the quadratic energy the step was linearised with (U_R for the first solve),
+// dissipation = |v+ - v|_M^2 / 2 + h^2 v+^T K v+ / 2 + h v+^T C v+ >= 0. Accepted while the
+// growth, summed over the steps since the energy last went down (`energy_debt_`), stays below
+// WorldSettings::relinearise_tolerance times the bodies' energy. The first screen costs one
+// rotation and two element energies per element: the rotations at x+ are the next step's start
+// rotations (start_rotations reuses them when the positions did not change in between), so the
+// check replaces the next step's rotation pass rather than adding one.
+//
+// The remedy when a step fails the check: Newton iterations of the fully implicit step
+//   M (v+ - v) = h (f(x + h v+) + f_ext) - h C v+ + G^T lambda + r,
+// i.e. minimising the incremental potential
+//   phi(v) = |v - v_n|_M^2 / 2 + U(x + h v) - h f_ext . v + h v^T C v / 2
+// over the same contact and projection constraints (their rows are linear in v and stay those of
+// the step's start). Each iteration linearises at the current iterate x_k = x + h v_k with its
+// rotations R_k = R(x_k) and the projected Hessian of U: the warped stiffness R_k Ke R_k^T plus
+// the positive twist stiffness G_k it leaves out (fem/rotation_stiffness.hpp; without G the
+// iteration stalls or diverges on stretched thin elements). Since f_R is affine,
+// f(x_k) - H (y - x_k) = f_{R_k}(y) - G_k (y - x_k): the pipeline's own assembly with R_k, plus
+// h^2 G_k in A and h G_k v_k in f_int. The solution v^ of each linearisation is a full solve of the
+// step's complementarity problem; a backtracking line search on phi between the iterate and v^
+// (both feasible: the constraint set is convex) chooses the next iterate. The step ends with the
+// first solution that passes the check, or after relinearise_max solves with the one that gained
+// the least, so the kept velocities, impulses, A and b always belong to one solve (the LPC
+// reactions and tool forces come from them).
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "fem/rotation.hpp"
+#include "world/world.hpp"
+
+namespace mica {
+
+namespace {
+
+// v^T M w
+double mass_dot(const FemModel& m, const Vec3List& v, const Vec3List& w) {
+  const BlockPattern& p = m.pattern;
+  double s = 0;
+  for (int32_t i = 0; i < p.rows; ++i) {
+    Vec3 sum = Vec3::Zero();
+    for (int32_t k = p.row_start[i]; k < p.row_start[i + 1]; ++k) sum += m.mass[k] * w[p.col[k]];
+    s += v[i].dot(sum);
+  }
+  return s;
+}
+
+struct BodyTerms {
+  double alpha = 0, beta = 0;  // Rayleigh damping, if the body is damped
+  bool loads = false;          // f_ext is part of the step
+};
+
+struct Eval {
+  double growth = 0;  // J gained beyond the work done on the bodies
+  double scale = 0;   // J, the bodies' energy
+  double phi = 0;     // J, the incremental potential (all dynamic bodies)
+};
+
+// x_end = x + h v and, for a co-rotational body, R_end = R(x_end).
+void end_state(Body& b, const Vec3List& v, double h) {
+  b.x_end.resize(b.x.size());
+  for (size_t i = 0; i < b.x.size(); ++i) b.x_end[i] = b.x[i] + h * v[i];
+}
+
+// The first screen of the step's solution b.v_next, linearised with b.R (the step's start
+// rotations): computes R_end and returns [U(x+) - U_R(x+)] (an upper bound of the growth) and
+// the scale; caches U(x+) for the next step.
+Eval screen(Body& b, double h) {
+  const FemModel& m = b.fem;
+  end_state(b, b.v_next, h);
+  double U1 = 0, UR1 = 0, U0 = 0;
+  const bool start_known = b.relin.u_start_known;
+  for (size_t e = 0; e < m.elements.size(); ++e) {
+    const TetElement& el = m.elements[e];
+    const Mat3 F1 = deformation_gradient(el, b.x_end);
+    b.R_end[e] = proper_rotation(F1);
+    U1 += elastic_energy(el, m.lame, b.R_end[e], F1);
+    UR1 += elastic_energy(el, m.lame, b.R[e], F1);
+    if (!start_known) U0 += elastic_energy(el, m.lame, b.R[e], deformation_gradient(el, b.x));
+  }
+  if (!start_known) b.relin.u_start = U0;
+  b.relin.k_start = 0.5 * mass_dot(m, b.v, b.v);
+  b.relin.u_end = U1;
+  Eval out;
+  out.growth = U1 - UR1;
+  out.scale = std::max(b.relin.k_start + b.relin.u_start, 0.5 * mass_dot(m, b.v_next, b.v_next) + U1);
+  return out;
+}
+
+// The full evaluation of velocities v of body b for a step linearised with b.R (and, when
+// b.relin.modes is not empty, the twist stiffness at x + h v_lin); R_start the step's start
+// rotations (they define the damping in phi). Sets x_end, R_end; caches U(x_end).
+Eval evaluate(Body& b, const Vec3List& v, double h, const BodyTerms& d, const std::vector<Mat3>& R_start) {
+  const FemModel& m = b.fem;
+  const bool corot = b.settings.corotational;
+  end_state(b, v, h);
+  // U1 = U(x+); UL1, UL0 = the linearisation's quadratic energy at x+ and at x; vKv = v^T K v
+  // with its stiffness (the damping's K: R Ke R^T, without G); g* = the twist terms.
+  double U1 = 0, UL1 = 0, UL0 = 0, vKv = 0, vKv_start = 0, gvv = 0, gdd = 0, gll = 0;
+  const Mat3 I = Mat3::Identity();
+  const bool twist = !b.relin.modes.empty();
+  for (size_t e = 0; e < m.elements.size(); ++e) {
+    const TetElement& el = m.elements[e];
+    const Mat3& R = corot ? b.R[e] : I;
+    const Mat3 F1 = deformation_gradient(el, b.x_end);
+    if (corot) b.R_end[e] = proper_rotation(F1);
+    U1 += elastic_energy(el, m.lame, corot ? b.R_end[e] : I, F1);
+    UL1 += elastic_energy(el, m.lame, R, F1);
+    UL0 += elastic_energy(el, m.lame, R, deformation_gradient(el, b.x));
+    // v^T (R Ke R^T) v is twice the strain energy of the displacement v in the frame R.
+    const Mat3 Fv = deformation_gradient(el, v);
+    vKv += 2 * elastic_energy(el, m.lame, R, Fv + R);
+    if (d.beta != 0) {
+      const Mat3& Rs = corot ? R_start[e] : I;
+      vKv_start += 2 * elastic_energy(el, m.lame, Rs, Fv + Rs);
+    }
+    if (!twist) continue;
+    const TwistModes& t = b.relin.modes[e];
+    for (int32_t q = 0; q < t.count; ++q) {
+      double cv = 0, cl = 0;
+      for (int a = 0; a < 4; ++a) {
+        cv += t.q[q][a].dot(v[el.nodes[a]]);
+        cl += t.q[q][a].dot(b.relin.v_lin[el.nodes[a]]);
+      }
+      gvv += t.weight[q] * cv * cv;
+      gdd += t.weight[q] * (cv - cl) * (cv - cl);
+      gll += t.weight[q] * cl * cl;
+    }
+  }
+  // The linearisation is backward Euler on U_L(y) = U_R(y) + (y - x_lin)^T G (y - x_lin) / 2.
+  UL1 += 0.5 * h * h * gdd;
+  UL0 += 0.5 * h * h * gll;
+  Vec3List& dv = b.relin.scratch;
+  dv.resize(v.size());
+  for (size_t i = 0; i < v.size(); ++i) dv[i] = v[i] - b.v[i];
+  const double dvMdv = mass_dot(m, dv, dv), vMv = mass_dot(m, v, v);
+  const double dissipation = 0.5 * dvMdv + 0.5 * h * h * (vKv + gvv) + h * (d.alpha * vMv + d.beta * vKv);
+  const double U0 = b.relin.u_start, K0 = b.relin.k_start;
+  Eval out;
+  out.growth = (U1 - UL1) - (U0 - UL0) - dissipation;
+  // The work done on the body in the step, by the balance of the linearised step.
+  const double work = (0.5 * vMv + UL1) - (K0 + UL0) + dissipation;
+  out.scale = K0 + U0 + std::fabs(work);
+  double fv = 0;
+  if (d.loads)
+    for (size_t i = 0; i < v.size(); ++i) fv += b.f_ext[i].dot(v[i]);
+  out.phi = 0.5 * dvMdv + U1 - h * fv + 0.5 * h * (d.alpha * vMv + d.beta * vKv_start);
+  b.relin.u_end = U1;
+  return out;
+}
+
+// The linearisation at x_end = x + h v_iter (whose rotations b.R are) gains the positive twist
+// stiffness G: A += h^2 G, and f(x_end) - H (y - x_end) = f_R(y) - G (y - x_end) adds h G v_iter
+// to f_int (b = M v + h (f_int + f_ext)).
+void add_twist_stiffness(Body& b, double h) {
+  const FemModel& m = b.fem;
+  b.relin.modes.resize(m.elements.size());
+  b.relin.v_lin = b.relin.v_iter;
+  for (size_t e = 0; e < m.elements.size(); ++e) {
+    const TetElement& el = m.elements[e];
+    TwistModes& t = b.relin.modes[e];
+    t = twist_modes(el, m.lame, deformation_gradient(el, b.x_end));
+    for (int32_t q = 0; q < t.count; ++q) {
+      double c = 0;
+      for (int a = 0; a < 4; ++a) c += t.q[q][a].dot(b.relin.v_lin[el.nodes[a]]);
+      const double w = t.weight[q];
+      for (int a = 0; a < 4; ++a) {
+        b.f_int[el.nodes[a]] += (h * w * c) * t.q[q][a];
+        for (int c2 = 0; c2 < 4; ++c2) b.A[m.slots[e][4 * a + c2]] += (h * h * w) * t.q[q][a] * t.q[q][c2].transpose();
+      }
+    }
+  }
+}
+
+}  // namespace
+
+void World::start_rotations(Body& b) const {
+  // The rotations computed after the last step's solve, if the positions are still those.
+  b.relin.u_start_known = !b.x_end.empty() && b.x_end == b.x;
+  if (b.relin.u_start_known) {
+    std::swap(b.R, b.R_end);
+    b.relin.u_start = b.relin.u_end;
+  } else if (pool_) {
+    compute_rotations(b.fem, b.x, b.R, *pool_);
+  } else {
+    compute_rotations(b.fem, b.x, b.R);
+  }
+  b.x_end.clear();
+}
+
+void World::relinearise(const std::vector<Body*>& dynamic, double h, StageRunner& stage,
+                        const std::function<void()>& solve) {
+  const double tol = settings_.relinearise_tolerance;
+  const int32_t max_solves = settings_.relinearise_max;
+  if (max_solves < 2) return;
+  // The growth the last step added to the debt counts once that step went through.
+  if (debt_.pending_step == stats_.step_count) debt_.committed = debt_.pending;
+  debt_.pending_step = -1;
+  const double debt = debt_.committed;
+  auto settle = [&](double growth) {
+    debt_.pending = std::max(0.0, debt + growth);
+    debt_.pending_step = stats_.step_count + 1;
+  };
+  auto time_rotations = [&](auto&& f) {  // the rotations and energies of the check
+    const auto start = std::chrono::steady_clock::now();
+    f();
+    const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    StageStats& s = stats_.stages[size_t(Stage::Rotations)];
+    s.ms_last_step += ms;
+    s.ms_total += ms;
+  };
+
+  // The screen: the rotation update U(x+) - U_R(x+) bounds the growth from above.
+  Eval cur;
+  time_rotations([&] {
+    for (Body* b : dynamic) {
+      if (!b->settings.corotational) continue;
+      b->relin.modes.clear();
+      const Eval e = screen(*b, h);
+      cur.growth += e.growth;
+      cur.scale += e.scale;
+    }
+  });
+  if (debt + cur.growth <= tol * cur.scale) {
+    settle(cur.growth);
+    return;
+  }
+
+  // The full check, with the step's dissipation.
+  std::vector<BodyTerms> terms(dynamic.size());
+  for (size_t k = 0; k < dynamic.size(); ++k) {
+    const Body& b = *dynamic[k];
+    if (needs_damping(b)) terms[k] = {b.settings.rayleigh_alpha, b.settings.rayleigh_beta, false};
+    terms[k].loads = needs_loads(b);
+  }
+  auto evaluate_all = [&](bool trial) {  // v_next, or the line search's trial velocities
+    Eval sum;
+    for (size_t k = 0; k < dynamic.size(); ++k) {
+      Body& b = *dynamic[k];
+      const Eval e = evaluate(b, trial ? b.relin.v_trial : b.v_next, h, terms[k], b.relin.R_start);
+      sum.phi += e.phi;
+      if (!b.settings.corotational) continue;
+      sum.growth += e.growth;
+      sum.scale += e.scale;
+    }
+    return sum;
+  };
+  for (Body* b : dynamic) {
+    b->relin.R_start = b->R;
+    b->relin.modes.clear();
+  }
+  time_rotations([&] { cur = evaluate_all(false); });
+  auto passes = [&](const Eval& e) { return debt + e.growth <= tol * e.scale; };
+  if (passes(cur)) {
+    settle(cur.growth);
+    return;
+  }
+
+  // Newton iterations. Linearise at x + h v_iter (x_end, R_end hold its positions and rotations:
+  // the last evaluation was of the iterate) or at the step's start, and solve.
+  auto linearise_and_solve = [&](bool at_start) {
+    for (Body* b : dynamic) {
+      if (!b->settings.corotational) continue;
+      b->R = at_start ? b->relin.R_start : b->R_end;
+      b->relin.modes.clear();
+    }
+    stage.run(Stage::Elements, true, [&] {
+      for (Body* b : dynamic) {
+        if (!b->settings.corotational) continue;  // the others' A and forces do not change
+        assemble_elements(*b, h, needs_damping(*b));
+        if (!at_start) add_twist_stiffness(*b, h);
+      }
+    });
+    stage.run(Stage::Damping, std::any_of(dynamic.begin(), dynamic.end(), [&](Body* b) { return needs_damping(*b); }),
+              [&] {
+                for (Body* b : dynamic)
+                  if (b->settings.corotational && needs_damping(*b)) add_damping(*b, h);
+              });
+    // The statistics report the solve whose solution the step keeps; iterations add up.
+    stats_.solver_residual = 0;
+    stats_.converged = true;
+    stage.run(Stage::Solve, true, solve);
+  };
+  for (Body* b : dynamic) b->relin.v_iter = b->v_next;
+  double phi_iter = cur.phi, best = cur.growth;
+  int32_t best_solve = 1, solves = 1;
+  bool solution_evaluated = true;  // the last evaluation was of v_next
+  while (solves < max_solves) {
+    linearise_and_solve(false);
+    ++solves;
+    time_rotations([&] { cur = evaluate_all(false); });
+    solution_evaluated = true;
+    if (passes(cur)) {
+      settle(cur.growth);
+      return;
+    }
+    if (cur.growth < best) {
+      best = cur.growth;
+      best_solve = solves;
+      for (Body* b : dynamic) b->relin.v_best = b->relin.v_iter;  // the linearisation point
+    }
+    if (solves == max_solves) break;
+    if (cur.phi < phi_iter) {
+      for (Body* b : dynamic) b->relin.v_iter = b->v_next;
+      phi_iter = cur.phi;
+      continue;
+    }
+    // Backtrack: v_iter + t (v_next - v_iter), t = 1/2, 1/4, ..., 1/64.
+    bool moved = false;
+    for (double t = 0.5; t > 0.01 && !moved; t *= 0.5) {
+      Eval e;
+      time_rotations([&] {
+        for (Body* b : dynamic) {
+          b->relin.v_trial.resize(b->v_next.size());
+          for (size_t i = 0; i < b->v_next.size(); ++i)
+            b->relin.v_trial[i] = b->relin.v_iter[i] + t * (b->v_next[i] - b->relin.v_iter[i]);
+        }
+        e = evaluate_all(true);
+      });
+      solution_evaluated = false;
+      if (e.phi < phi_iter) {
+        for (Body* b : dynamic) b->relin.v_iter.swap(b->relin.v_trial);
+        phi_iter = e.phi;
+        moved = true;
+      }
+    }
+    if (!moved) break;  // no descent along the direction: the iteration cannot improve
+  }
+  // No solve passed: keep the one that gained the least, solving it again if it was not the last.
+  if (best_solve != solves) {
+    if (best_solve > 1) {
+      for (Body* b : dynamic) {
+        b->relin.v_iter = b->relin.v_best;
+        end_state(*b, b->relin.v_iter, h);
+        if (b->settings.corotational) {
+          if (pool_) compute_rotations(b->fem, b->x_end, b->R_end, *pool_);
+          else compute_rotations(b->fem, b->x_end, b->R_end);
+        }
+      }
+    }
+    linearise_and_solve(best_solve == 1);
+    solution_evaluated = false;
+  }
+  // Whatever is kept, x_end and R_end must be of its end positions (the next step's start).
+  if (!solution_evaluated) time_rotations([&] { cur = evaluate_all(false); });
+  settle(cur.growth);
+}
+
+}  // namespace mica
