@@ -29,6 +29,8 @@ mica_world_def world_defaults() {
   d.relaxation = 1.0;
   d.mica_sweep = MICA_SWEEP_GAUSS_SEIDEL;
   d.threads = 1;
+  d.relinearise_tolerance = 1e-3;
+  d.relinearise_max = 8;
   return d;
 }
 
@@ -66,6 +68,10 @@ mica::WorldSettings translate(const mica_world_def& d) {
   if (d.threads < 0 || d.threads > 1024)
     refuse(MICA_ERR_INVALID_ARGUMENT, "def->threads must be in [0, 1024] (0: every CPU), got " + std::to_string(d.threads));
   s.threads = d.threads;
+  if (!(d.relinearise_tolerance >= 0) || !std::isfinite(d.relinearise_tolerance))
+    refuse(MICA_ERR_INVALID_ARGUMENT, "def->relinearise_tolerance must be finite and >= 0");
+  s.relinearise_tolerance = d.relinearise_tolerance;
+  s.relinearise_max = d.relinearise_max;
   switch (d.mica_sweep) {
     case MICA_SWEEP_GAUSS_SEIDEL: s.mica_sweep = mica::MicaSweep::GaussSeidel; break;
     case MICA_SWEEP_FACTORED: s.mica_sweep = mica::MicaSweep::Factored; break;

@@ -159,6 +159,13 @@ typedef struct mica_world_def {
    *  run on; n > 1 starts n - 1 workers owned by the world (they sleep between steps). See
    *  docs/performance.md before raising it: a haptic host also needs a core for the servo loop. */
   int32_t threads;
+  /** Co-rotational bodies: a step linearised at its start's rotations can gain energy when
+   *  elements turn far within it. When a step gained more than this fraction of the bodies'
+   *  energy beyond the work done on them, it is solved again by Newton iterations re-linearised at
+   *  the new rotations, with a line search (docs/stability.md, K1). Default 1e-3. */
+  double relinearise_tolerance;
+  int32_t relinearise_max; /**< at most this many solves per step for that; < 2 turns the check off; default 8 */
+  int32_t reserved4;       /**< zero */
 } mica_world_def;
 
 /** Fills `def` with defaults, writing only its first `struct_size` bytes, and records

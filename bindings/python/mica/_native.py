@@ -127,6 +127,9 @@ class mica_world_def(Structure):
         ("time_budget_ms", c_double),
         ("mica_sweep", c_int32),
         ("threads", c_int32),
+        ("relinearise_tolerance", c_double),
+        ("relinearise_max", c_int32),
+        ("reserved4", c_int32),
     ]
 
 

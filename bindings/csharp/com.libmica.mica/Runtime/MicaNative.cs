@@ -141,6 +141,9 @@ namespace LibMica
             public double time_budget_ms;
             public int mica_sweep;
             public int threads;
+            public double relinearise_tolerance;
+            public int relinearise_max;
+            public int reserved4;
         }
 
         [StructLayout(LayoutKind.Sequential)]
