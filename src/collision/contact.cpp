@@ -81,12 +81,15 @@ void collide_bodies(const SurfaceView& a, const SurfaceView& b, double margin_at
     if (best_tri < 0 || best > reach) continue;
     const Tri& t = (*b.triangles)[best_tri];
     const Vec3 face = (xb[t[1]] - xb[t[0]]).cross(xb[t[2]] - xb[t[0]]).normalized();  // outward
+    // The side: from the pseudo-normal of the face, edge or vertex the nearest point lies on.
+    const Vec3 outward = b.normals->at(best_tri, t, best_point.weights, face);
     const Vec3 d = p - best_point.point;
-    const bool inside = d.dot(face) < 0;
+    const bool inside = d.dot(outward) < 0;
     const double gap = inside ? -best : best;
     if (gap >= margin) continue;
     // The normal separates a's node from b: along d outside, against it inside.
-    const Vec3 normal = best > 1e-12 ? Vec3((inside ? -d : d) / best) : face;
+    Vec3 normal = best > 1e-12 ? Vec3((inside ? -d : d) / best) : outward.normalized();
+    if (!normal.allFinite()) normal = face;  // a node on a collapsed feature: the face has to do
     Contact c{contact_key(a.key, b.key, uint64_t(node)), -1, node_point(a.index, node), BodyPoint{}, normal, p, gap,
               friction, Vec3::Zero()};
     if (b.index >= 0) c.b = triangle_point(b.index, t, best_point.weights);  // a static b is an obstacle

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "collision/bvh.hpp"
+#include "collision/pseudo_normals.hpp"
 #include "collision/tool.hpp"
 
 namespace mica {
@@ -51,6 +52,7 @@ struct SurfaceView {
   const std::vector<Tri>* triangles;
   const std::vector<int32_t>* nodes;  // surface nodes
   const TriangleBvh* bvh;
+  const SurfacePseudoNormals* normals;  // of the triangles at x: which side of the surface a point is on
   double depth;                     // m, the deepest penetration looked for
   double travel;                    // m, how far a node may move this step (h times the top speed; 0 when static)
 };
@@ -64,7 +66,9 @@ void collide_tool(const Tool& tool, int32_t tool_index, uint64_t tool_key, const
                   std::vector<Contact>& out);
 
 // Surface nodes of body a against the surface triangles of body b (b may be static: an
-// obstacle). Call it for (a, b) and (b, a). Speculative like collide_tool.
+// obstacle). Call it for (a, b) and (b, a). Speculative like collide_tool. Inside and outside come
+// from b's pseudo-normal at the nearest point (a face, an edge or a vertex): b's surface must be
+// closed and wound outwards.
 void collide_bodies(const SurfaceView& a, const SurfaceView& b, double margin, double friction,
                     std::vector<Contact>& out);
 

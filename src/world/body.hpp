@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "collision/bvh.hpp"
+#include "collision/pseudo_normals.hpp"
 #include "fem/fem_model.hpp"
 #include "solver/direct_solver.hpp"
 #include "solver/pcg.hpp"
@@ -31,6 +32,7 @@ struct Body {
   std::vector<Tri> surface;
   std::vector<int32_t> surface_node_list;  // candidates for contact
   TriangleBvh bvh;                         // over the surface triangles, refit every step
+  SurfacePseudoNormals pseudo_normals;     // of the surface, updated with the tree
   double surface_edge = 0;                 // m, mean surface edge length: the deepest penetration looked for
 
   // State.
