@@ -15,6 +15,13 @@ void ContactRows::clear() {
   key.clear();
 }
 
+double normal_bias(const Contact& contact, double h, double max_recovery_speed) {
+  const double closing = contact.gap / h;
+  if (closing >= 0) return closing;
+  const double approach = contact.tool >= 0 ? contact.normal.dot(contact.other_velocity) : 0.0;
+  return std::min(std::max(closing + approach, -max_recovery_speed) - approach, 0.0);
+}
+
 void ContactRows::build(const std::vector<Contact>& contacts, double h, double max_recovery_speed) {
   clear();
   auto add_row = [&](size_t c, const Vec3& d, double b, int32_t normal_row, double friction, uint64_t kind) {
@@ -32,7 +39,7 @@ void ContactRows::build(const std::vector<Contact>& contacts, double h, double m
   for (size_t c = 0; c < contacts.size(); ++c) {
     const Contact& ct = contacts[c];
     const int32_t normal_row = int32_t(direction.size());
-    add_row(c, ct.normal, std::max(ct.gap / h, -max_recovery_speed), -1, 0.0, 0);
+    add_row(c, ct.normal, normal_bias(ct, h, max_recovery_speed), -1, 0.0, 0);
     if (ct.friction <= 0) continue;
     // Any orthonormal tangent pair: the box bounds make friction isotropic enough for PGS.
     const Vec3 t1 = ct.normal.unitOrthogonal(), t2 = ct.normal.cross(t1);
