@@ -62,6 +62,9 @@ struct SurfaceView {
 // nodes alone would let the tool slip between them). Speculative: the margin grows by how
 // far the tool and the body can travel in the step (h), so a fast approach is caught before it
 // crosses; the constraint keeps the true gap, so the sides may close it but not cross it.
+// Swept: the tool is at its new pose, and where it moved past a node or a triangle in the step
+// (the nearest-point normal would push it on along its path relative to the tool, through to the
+// far side), the contact keeps it on the side it was on at the start instead (tool_sweep.hpp).
 void collide_tool(const Tool& tool, int32_t tool_index, uint64_t tool_key, const SurfaceView& body, double h,
                   std::vector<Contact>& out);
 
