@@ -1,5 +1,7 @@
 #include "collision/contact.hpp"
 
+#include <algorithm>
+
 #include "collision/closest_point.hpp"
 #include "collision/tool_sweep.hpp"
 #include "collision/triangle_contact.hpp"
@@ -54,6 +56,10 @@ void collide_tool(const Tool& tool, int32_t tool_index, uint64_t tool_key, const
   const ToolSweep sweep(tool);
   const bool swept = sweep.moved() && tool.shape != ToolShape::Plane;
   const Vec3List& x = *body.x;
+  // The nodes the tool went past (their start side and the nearest-point normal disagree), in
+  // ascending order as body.nodes; kept between calls so that a step allocates nothing here.
+  thread_local std::vector<int32_t> passed_nodes;
+  passed_nodes.clear();
   for (int32_t node : *body.nodes) {
     if (!reach.contains(x[node])) continue;
     const SurfacePoint s = closest_surface_point(tool, x[node]);
@@ -62,7 +68,11 @@ void collide_tool(const Tool& tool, int32_t tool_index, uint64_t tool_key, const
     // The nearest-point normal pushes the node on along its path relative to the tool: the tool
     // passed it, and that would push it out of the tool's far side. Keep it on its start side.
     if (swept && s.normal.dot(x[node] - sweep.start_relative(x[node])) > 0) {
-      if (!node_start_side(tool, sweep, x[node], side) && s.distance < 0) continue;
+      if (!node_start_side(tool, sweep, x[node], side)) {
+        if (s.distance < 0) continue;
+      } else if (side.normal.dot(s.normal) < 0) {
+        passed_nodes.push_back(node);
+      }
       if (side.gap >= margin) continue;
     }
     out.push_back(Contact{contact_key(tool_key, body.key, uint64_t(node)), tool_index, node_point(body.index, node),
@@ -70,14 +80,8 @@ void collide_tool(const Tool& tool, int32_t tool_index, uint64_t tool_key, const
                           tool_point_velocity(tool, x[node])});
   }
   if (tool.shape == ToolShape::Plane) return;  // a plane's deepest point on a triangle is a node
-  // Whether the tool went past a node this step (see the node loop above), and whether the
-  // node's path misses the tool altogether.
-  auto passed = [&](int32_t n) {
-    const SurfacePoint s = closest_surface_point(tool, x[n]);
-    SideContact side;
-    return s.distance < margin && s.normal.dot(x[n] - sweep.start_relative(x[n])) > 0 &&
-           node_start_side(tool, sweep, x[n], side);
-  };
+  auto passed = [&](int32_t n) { return std::binary_search(passed_nodes.begin(), passed_nodes.end(), n); };
+  // Whether the node's path misses the tool altogether.
   auto misses = [&](int32_t n) {
     SideContact side;
     return !node_start_side(tool, sweep, x[n], side);
@@ -86,7 +90,7 @@ void collide_tool(const Tool& tool, int32_t tool_index, uint64_t tool_key, const
     const Tri& t = (*body.triangles)[tri];
     // Edges from a node the tool went past to one beside its path (each edge once: from the
     // triangle that has it as (i, j), i < j).
-    for (int k = 0; swept && k < 3; ++k) {
+    for (int k = 0; !passed_nodes.empty() && k < 3; ++k) {
       int32_t i = t[k], j = t[(k + 1) % 3];
       if (i > j) continue;
       if (!(passed(i) && misses(j))) {
