@@ -64,7 +64,11 @@ struct SurfaceView {
 // crosses; the constraint keeps the true gap, so the sides may close it but not cross it.
 // Swept: the tool is at its new pose, and where it moved past a node or a triangle in the step
 // (the nearest-point normal would push it on along its path relative to the tool, through to the
-// far side), the contact keeps it on the side it was on at the start instead (tool_sweep.hpp).
+// far side), the contact keeps it on the side it was on at the start instead (tool_sweep.hpp):
+// the tangent plane where the tool met it in the step, or its nearest point at the start when it
+// was inside then and that side differs from the nearest point's now. An edge that the tool met
+// in the step, or that runs from a node it went past to one whose path misses it, gets a contact
+// too (its two nodes share it); otherwise edges are left to their nodes.
 void collide_tool(const Tool& tool, int32_t tool_index, uint64_t tool_key, const SurfaceView& body, double h,
                   std::vector<Contact>& out);
 

@@ -17,12 +17,12 @@ bool node_start_side(const Tool& tool, const ToolSweep& sweep, const Vec3& x, Si
   const SurfacePoint s0 = closest_surface_point(tool, y0);
   if (s0.distance <= 0) {
     // Inside at the start: the side of its nearest surface point then, y0 - d n.
-    side = {s0.normal, s0.distance + s0.normal.dot(x - y0)};
+    side = {s0.normal, s0.distance + s0.normal.dot(x - y0), 0.0};
     return true;
   }
   SegmentEntry e;
   if (!segment_entry(tool, y0, x, e)) return false;
-  side = {e.normal, e.normal.dot(x - e.point)};
+  side = {e.normal, e.normal.dot(x - e.point), e.t};
   return true;
 }
 
@@ -45,7 +45,7 @@ bool edge_start_side(const Tool& tool, const ToolSweep& sweep, const Vec3& xi, c
 }
 
 bool triangle_start_side(const Tool& tool, const ToolSweep& sweep, const Vec3& a, const Vec3& b, const Vec3& c,
-                         TriangleHit& hit) {
+                         TriangleHit& hit, double& t) {
   const Vec3 end[3] = {a, b, c};
   Vec3 start[3];
   double speed = 0;  // the longest path of a corner, hence of any point of the triangle
@@ -57,7 +57,7 @@ bool triangle_start_side(const Tool& tool, const ToolSweep& sweep, const Vec3& a
   // Touching means within this of the tool: close enough for the normal at the touch, far enough
   // that the distance query still has a direction to give.
   const double touch = 1e-3 * speed;
-  double t = 0;
+  t = 0;
   for (int k = 0; k < kMaxAdvances; ++k) {
     Vec3 at[3];
     for (int j = 0; j < 3; ++j) at[j] = start[j] + t * (end[j] - start[j]);

@@ -32,6 +32,7 @@ class ToolSweep {
 struct SideContact {
   Vec3 normal;
   double gap;
+  double t = 0;  // where on its path the point met the tool: 0 when inside at the start
 };
 
 // For a node at x: false when its path never meets the tool (nothing to keep it from). Exact
@@ -57,6 +58,6 @@ bool edge_start_side(const Tool& tool, const ToolSweep& sweep, const Vec3& xi, c
 // keeps only what the triangle's nodes say).
 constexpr int kMaxAdvances = 40;
 bool triangle_start_side(const Tool& tool, const ToolSweep& sweep, const Vec3& a, const Vec3& b, const Vec3& c,
-                         TriangleHit& hit);
+                         TriangleHit& hit, double& t);  // t: where on the path it touched (0: at the start)
 
 }  // namespace mica

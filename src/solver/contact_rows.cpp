@@ -16,10 +16,9 @@ void ContactRows::clear() {
 }
 
 double normal_bias(const Contact& contact, double h, double max_recovery_speed) {
-  const double closing = contact.gap / h;
-  if (closing >= 0) return closing;
-  const double approach = contact.tool >= 0 ? contact.normal.dot(contact.other_velocity) : 0.0;
-  return std::min(std::max(closing + approach, -max_recovery_speed) - approach, 0.0);
+  // A receding tool explains none of the penetration: approach >= 0.
+  const double approach = contact.tool >= 0 ? std::max(contact.normal.dot(contact.other_velocity), 0.0) : 0.0;
+  return std::max(contact.gap / h + approach, -max_recovery_speed) - approach;
 }
 
 void ContactRows::build(const std::vector<Contact>& contacts, double h, double max_recovery_speed) {

@@ -34,8 +34,10 @@ struct ContactRows {
 // injects energy). A tool's contact is measured at the tool's new pose, so its gap includes the
 // tool's own approach this step, h n . u (u: the tool's velocity at the point, other_velocity):
 // that part is not penetration to recover slowly but motion to make way for, so only the rest,
-// gap / h + n . u (the penetration at the step's start), is clamped. The clamp only ever relaxes
-// the row: the bias is at least gap / h and, for a penetrating contact, at most 0.
+// gap / h + n . u (the penetration at the step's start), is clamped:
+//   bias = max(gap / h + a, -max_recovery_speed) - a,   a = max(n . u, 0)
+// (a receding tool, n . u < 0, explains none of the penetration: the plain clamp). The bias is at
+// least gap / h, equal to it for a gap >= 0, and at most 0 for a penetrating contact.
 double normal_bias(const Contact& contact, double h, double max_recovery_speed);
 
 }  // namespace mica
