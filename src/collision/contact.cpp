@@ -67,13 +67,10 @@ void collide_tool(const Tool& tool, int32_t tool_index, uint64_t tool_key, const
     SideContact side{s.normal, s.distance};
     // The nearest-point normal pushes the node on along its path relative to the tool: the tool
     // passed it, and that would push it out of the tool's far side. Keep it on its start side.
-    // (A node inside since the step's start, on the side the nearest point gives, keeps that one.)
     if (swept && s.normal.dot(x[node] - sweep.start_relative(x[node])) > 0) {
       const bool met = node_start_side(tool, sweep, x[node], side);
       if (!met && s.distance < 0) continue;
-      const bool through = met && side.normal.dot(s.normal) < 0;
-      if (through) passed_nodes.push_back(node);
-      if (met && side.t == 0 && !through) side = {s.normal, s.distance, 0.0};
+      if (met && side.normal.dot(s.normal) < 0) passed_nodes.push_back(node);
       if (side.gap >= margin) continue;
     }
     out.push_back(Contact{contact_key(tool_key, body.key, uint64_t(node)), tool_index, node_point(body.index, node),
@@ -108,14 +105,14 @@ void collide_tool(const Tool& tool, int32_t tool_index, uint64_t tool_key, const
     }
     TriangleHit hit;
     if (!collide_triangle(tool, x[t[0]], x[t[1]], x[t[2]], margin, hit)) return;
-    bool touched_in_step = false;
+    bool swept_through = false;  // the tool met the triangle in the step, or now lies across it
     if (swept && hit.normal.dot(hit.point - sweep.start_relative(hit.point)) > 0) {
       // As for the nodes; a triangle whose start side is undecided is left to its nodes.
       TriangleHit side;
       double t_touch = 0;
       if (triangle_start_side(tool, sweep, x[t[0]], x[t[1]], x[t[2]], side, t_touch)) {
-        touched_in_step = t_touch > 0;
-        if (touched_in_step || side.normal.dot(hit.normal) < 0) hit = side;
+        swept_through = t_touch > 0 || side.normal.dot(hit.normal) < 0;
+        hit = side;
       } else if (hit.gap < 0) {
         return;
       }
@@ -129,13 +126,14 @@ void collide_tool(const Tool& tool, int32_t tool_index, uint64_t tool_key, const
                             tool.friction, tool_point_velocity(tool, hit.point)});
       return;
     }
-    // The tool swept into an edge in the step: the edge's nodes may lie on either side of the
-    // tool's path, and the edge between them must not end across it (otherwise, as at rest, an
-    // edge is left to its nodes). The two nodes share the contact, made once: by the triangle that
-    // has the edge as (i, j) with i < j (each edge of a closed surface appears once each way round).
+    // On an edge the tool swept into (or now lies across): the edge's nodes may lie on either side
+    // of the tool's path, and the edge between them must not end across it (otherwise, as at
+    // rest, an edge is left to its nodes). The two nodes share the contact, made once: by the
+    // triangle that has the edge as (i, j) with i < j (each edge of a closed surface appears once
+    // each way round).
     const int32_t i = t[(corner + 1) % 3], j = t[(corner + 2) % 3];
     const double wi = hit.weights[(corner + 1) % 3], wj = hit.weights[(corner + 2) % 3];
-    if (!touched_in_step || i > j || std::min(wi, wj) <= kInteriorWeight) return;
+    if (!swept_through || i > j || std::min(wi, wj) <= kInteriorWeight) return;
     out.push_back(Contact{contact_key(tool_key, body.key, kEdgeFeature | uint64_t(i) << 32 | uint64_t(j)), tool_index,
                           edge_point(body.index, i, j, wi, wj), BodyPoint{}, hit.normal, hit.point, hit.gap,
                           tool.friction, tool_point_velocity(tool, hit.point)});  // key (i, j), i < j: the

@@ -65,10 +65,10 @@ struct SurfaceView {
 // Swept: the tool is at its new pose, and where it moved past a node or a triangle in the step
 // (the nearest-point normal would push it on along its path relative to the tool, through to the
 // far side), the contact keeps it on the side it was on at the start instead (tool_sweep.hpp):
-// the tangent plane where the tool met it in the step, or its nearest point at the start when it
-// was inside then and that side differs from the nearest point's now. An edge that the tool met
-// in the step, or that runs from a node it went past to one whose path misses it, gets a contact
-// too (its two nodes share it); otherwise edges are left to their nodes.
+// the tangent plane where the tool met it in the step, or at its nearest point at the start when
+// it was inside then. An edge gets a contact too (its two nodes share it) where the tool met it in
+// the step or lies across it now, or where it runs from a node the tool went past to one whose
+// path misses the tool; otherwise edges are left to their nodes.
 void collide_tool(const Tool& tool, int32_t tool_index, uint64_t tool_key, const SurfaceView& body, double h,
                   std::vector<Contact>& out);
 

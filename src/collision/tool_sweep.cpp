@@ -17,12 +17,12 @@ bool node_start_side(const Tool& tool, const ToolSweep& sweep, const Vec3& x, Si
   const SurfacePoint s0 = closest_surface_point(tool, y0);
   if (s0.distance <= 0) {
     // Inside at the start: the side of its nearest surface point then, y0 - d n.
-    side = {s0.normal, s0.distance + s0.normal.dot(x - y0), 0.0};
+    side = {s0.normal, s0.distance + s0.normal.dot(x - y0)};
     return true;
   }
   SegmentEntry e;
   if (!segment_entry(tool, y0, x, e)) return false;
-  side = {e.normal, e.normal.dot(x - e.point), e.t};
+  side = {e.normal, e.normal.dot(x - e.point)};
   return true;
 }
 

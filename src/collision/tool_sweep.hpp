@@ -32,7 +32,6 @@ class ToolSweep {
 struct SideContact {
   Vec3 normal;
   double gap;
-  double t = 0;  // where on its path the point met the tool: 0 when inside at the start
 };
 
 // For a node at x: false when its path never meets the tool (nothing to keep it from). Exact
