@@ -139,7 +139,7 @@ typedef struct mica_world_def {
   int32_t pgs_sweeps;      /**< MICA: PGS sweeps over the contacts per iteration; default 1 */
   int32_t paper_norm;      /**< MICA: 1 stops on the paper's 2-norm of the change of (v, lambda);
                                 default 0: relative changes of v and of lambda, each below tolerance */
-  double max_recovery_speed; /**< m/s: the penetration recovery gap/h is clamped at -this; default 1 */
+  double max_recovery_speed; /**< m/s: penetration is recovered at most this fast (for a tool, beyond its own approach); default 1 */
   int32_t body_contact;    /**< 1: bodies collide with each other and with static bodies; default 1 */
   int32_t reserved1;       /**< zero */
   double body_margin;      /**< m: contacts between bodies are made for gaps below this; default 0.001 */

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "collision/bvh.hpp"
+#include "collision/pseudo_normals.hpp"
 #include "collision/tool.hpp"
 
 namespace mica {
@@ -51,6 +52,7 @@ struct SurfaceView {
   const std::vector<Tri>* triangles;
   const std::vector<int32_t>* nodes;  // surface nodes
   const TriangleBvh* bvh;
+  const SurfacePseudoNormals* normals;  // of the triangles at x: which side of the surface a point is on
   double depth;                     // m, the deepest penetration looked for
   double travel;                    // m, how far a node may move this step (h times the top speed; 0 when static)
 };
@@ -60,11 +62,20 @@ struct SurfaceView {
 // nodes alone would let the tool slip between them). Speculative: the margin grows by how
 // far the tool and the body can travel in the step (h), so a fast approach is caught before it
 // crosses; the constraint keeps the true gap, so the sides may close it but not cross it.
+// Swept: the tool is at its new pose, and where it moved past a node or a triangle in the step
+// (the nearest-point normal would push it on along its path relative to the tool, through to the
+// far side), the contact keeps it on the side it was on at the start instead (tool_sweep.hpp):
+// the tangent plane where the tool met it in the step, or at its nearest point at the start when
+// it was inside then. An edge gets a contact too (its two nodes share it) where the tool met it in
+// the step or lies across it now, or where it runs from a node the tool went past to one whose
+// path misses the tool; otherwise edges are left to their nodes.
 void collide_tool(const Tool& tool, int32_t tool_index, uint64_t tool_key, const SurfaceView& body, double h,
                   std::vector<Contact>& out);
 
 // Surface nodes of body a against the surface triangles of body b (b may be static: an
-// obstacle). Call it for (a, b) and (b, a). Speculative like collide_tool.
+// obstacle). Call it for (a, b) and (b, a). Speculative like collide_tool. Inside and outside come
+// from b's pseudo-normal at the nearest point (a face, an edge or a vertex): b's surface must be
+// closed and wound outwards.
 void collide_bodies(const SurfaceView& a, const SurfaceView& b, double margin, double friction,
                     std::vector<Contact>& out);
 

@@ -15,6 +15,12 @@ void ContactRows::clear() {
   key.clear();
 }
 
+double normal_bias(const Contact& contact, double h, double max_recovery_speed) {
+  // A receding tool explains none of the penetration: approach >= 0.
+  const double approach = contact.tool >= 0 ? std::max(contact.normal.dot(contact.other_velocity), 0.0) : 0.0;
+  return std::max(contact.gap / h + approach, -max_recovery_speed) - approach;
+}
+
 void ContactRows::build(const std::vector<Contact>& contacts, double h, double max_recovery_speed) {
   clear();
   auto add_row = [&](size_t c, const Vec3& d, double b, int32_t normal_row, double friction, uint64_t kind) {
@@ -32,7 +38,7 @@ void ContactRows::build(const std::vector<Contact>& contacts, double h, double m
   for (size_t c = 0; c < contacts.size(); ++c) {
     const Contact& ct = contacts[c];
     const int32_t normal_row = int32_t(direction.size());
-    add_row(c, ct.normal, std::max(ct.gap / h, -max_recovery_speed), -1, 0.0, 0);
+    add_row(c, ct.normal, normal_bias(ct, h, max_recovery_speed), -1, 0.0, 0);
     if (ct.friction <= 0) continue;
     // Any orthonormal tangent pair: the box bounds make friction isotropic enough for PGS.
     const Vec3 t1 = ct.normal.unitOrthogonal(), t2 = ct.normal.cross(t1);

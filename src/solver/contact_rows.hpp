@@ -17,7 +17,7 @@ struct ContactRows {
   std::vector<int32_t> start;     // rows + 1 offsets into terms
   std::vector<RowTerm> terms;
   std::vector<Vec3> direction;    // n for a normal row, a unit tangent for a friction row
-  std::vector<double> bias;       // gap / h (clamped) for normal rows; -t . v_tool for friction rows
+  std::vector<double> bias;       // normal_bias for normal rows; -t . v_tool for friction rows
   std::vector<int32_t> normal_of; // -1 for a normal row; the normal row of a friction row
   std::vector<double> mu;         // friction coefficient of a friction row
   std::vector<int32_t> contact;   // the contact each row belongs to
@@ -25,8 +25,19 @@ struct ContactRows {
 
   size_t size() const { return direction.size(); }
   void clear();
-  // Rows of all contacts; gap / h is clamped at -max_recovery_speed.
+  // Rows of all contacts; normal rows get normal_bias.
   void build(const std::vector<Contact>& contacts, double h, double max_recovery_speed);
 };
+
+// The bias of a contact's normal row, n . v + bias >= 0: gap / h, the velocity that closes the gap
+// in the step, except that penetration is recovered at no more than max_recovery_speed (more
+// injects energy). A tool's contact is measured at the tool's new pose, so its gap includes the
+// tool's own approach this step, h n . u (u: the tool's velocity at the point, other_velocity):
+// that part is not penetration to recover slowly but motion to make way for, so only the rest,
+// gap / h + n . u (the penetration at the step's start), is clamped:
+//   bias = max(gap / h + a, -max_recovery_speed) - a,   a = max(n . u, 0)
+// (a receding tool, n . u < 0, explains none of the penetration: the plain clamp). The bias is at
+// least gap / h, equal to it for a gap >= 0, and at most 0 for a penetrating contact.
+double normal_bias(const Contact& contact, double h, double max_recovery_speed);
 
 }  // namespace mica

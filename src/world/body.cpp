@@ -17,6 +17,8 @@ Body::Body(const TetMesh& mesh, const BodySettings& s, const std::string& body_n
   projection.reset(int32_t(n));
   pcg.reserve(n);
   bvh.build(x, surface);
+  pseudo_normals.build(surface, n);
+  pseudo_normals.update(x, surface);
   for (const Tri& t : surface)
     for (int k = 0; k < 3; ++k) surface_edge += (x[t[k]] - x[t[(k + 1) % 3]]).norm();
   surface_edge /= double(3 * surface.size());

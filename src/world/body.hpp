@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "collision/bvh.hpp"
+#include "collision/pseudo_normals.hpp"
 #include "core/colouring.hpp"
 #include "fem/fem_model.hpp"
 #include "fem/rotation_stiffness.hpp"
@@ -34,6 +35,7 @@ struct Body {
   std::vector<Tri> surface;
   std::vector<int32_t> surface_node_list;  // candidates for contact
   TriangleBvh bvh;                         // over the surface triangles, refit every step
+  SurfacePseudoNormals pseudo_normals;     // of the surface, updated with the tree
   double surface_edge = 0;                 // m, mean surface edge length: the deepest penetration looked for
 
   // State.

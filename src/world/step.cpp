@@ -216,9 +216,11 @@ void World::collide(const std::vector<Body*>& dynamic, double h) {
     double speed = 0;
     if (index >= 0) {
       b.bvh.refit(b.x);
+      b.pseudo_normals.update(b.x, b.surface);
       for (int32_t i : b.surface_node_list) speed = std::max(speed, b.v[i].norm());
     }
-    views_.push_back(SurfaceView{index, id, &b.x, &b.surface, &b.surface_node_list, &b.bvh, b.surface_edge, h * speed});
+    views_.push_back(SurfaceView{index, id, &b.x, &b.surface, &b.surface_node_list, &b.bvh, &b.pseudo_normals,
+                                 b.surface_edge, h * speed});
   });
   tools_.for_each([&](Id tool_id, Tool& t) {
     step_tools_.push_back(&t);

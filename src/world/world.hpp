@@ -36,7 +36,7 @@ struct WorldSettings {
   double tolerance = 1e-8;
   bool plan_all_stages = false;  // run every stage even when its effect is absent
   int32_t pgs_sweeps = 1;          // MICA: PGS sweeps over the contacts per iteration
-  double max_recovery_speed = 1.0; // m/s, clamps gap / h for penetrating contacts
+  double max_recovery_speed = 1.0; // m/s, clamps the recovery of penetration (normal_bias)
   bool paper_norm = false;         // MICA: stop on the paper's 2-norm of the change
   double relaxation = 1.0;         // MICA: MBGS over-relaxation omega in (0, 2)
   MicaSweep mica_sweep = MicaSweep::GaussSeidel;

@@ -1,5 +1,6 @@
 // Contact between bodies: a cube dropped on a static slab comes to rest carrying its weight,
-// and two deformable bodies pressed together agree with the exact reference.
+// two deformable bodies pressed together agree with the exact reference, and a contact that
+// reports a node inside the other body has it inside.
 #include "test_util.hpp"
 
 using namespace mica;
@@ -20,6 +21,15 @@ std::vector<int32_t> nodes_where(const Body& b, int axis, double value) {
   for (int32_t i = 0; i < b.fem.node_count(); ++i)
     if (std::fabs(b.fem.rest[i][axis] - value) < 1e-9) found.push_back(i);
   return found;
+}
+
+// p inside one of the elements (nodes x, elements tets) of a body.
+bool inside_body(const std::vector<Tet>& tets, const Vec3List& x, const Vec3& p) {
+  for (const Tet& t : tets)
+    if (signed_volume(p, x[t[1]], x[t[2]], x[t[3]]) > 0 && signed_volume(x[t[0]], p, x[t[2]], x[t[3]]) > 0 &&
+        signed_volume(x[t[0]], x[t[1]], p, x[t[3]]) > 0 && signed_volume(x[t[0]], x[t[1]], x[t[2]], p) > 0)
+      return true;
+  return false;
 }
 
 }  // namespace
@@ -111,10 +121,48 @@ static void test_two_bodies_pressed_together_match_reference(void**) {
   assert_le(worst_f, 1e-5);
 }
 
+// docs/stability.md, K3: a block pressed 8 mm into another and held. Beside the indent the lower
+// block's surface stands higher than the upper block's bottom face, so lower nodes there lie
+// above that face's plane while their nearest point on the upper block is its bottom edge. They
+// are outside (about 2 cm from it), and were reported 2 cm deep (the face's side) and pushed.
+static void test_nodes_beside_an_edge_are_not_reported_inside(void**) {
+  WorldSettings ws = settings(SolverKind::Direct);
+  ws.gravity = Vec3::Zero();
+  World world(ws);
+  BodySettings soft;
+  soft.material = {1e6, 0.49, 1000};
+  const Id lower = world.add_body(make_box_grid(Vec3(0, 0, 0), Vec3(0.1, 0.05, 0.1), {4, 2, 4}, 6), soft,
+                                  Vec3::Zero(), Vec3::Zero());
+  world.add_lpc(lower, nodes_where(world.body(lower), 1, 0.0), LpcSpec{});
+  const Id upper = world.add_body(make_box_grid(Vec3(0.02, 0.052, 0.02), Vec3(0.08, 0.092, 0.08), {3, 2, 3}, 6),
+                                  soft, Vec3::Zero(), Vec3::Zero());
+  const Id push = world.add_lpc(upper, nodes_where(world.body(upper), 1, 0.092), LpcSpec{});
+  const Body* bodies[2] = {&world.body(lower), &world.body(upper)};  // the step's dynamic-body order
+  int penetrating = 0;
+  double deepest_false = 0;
+  for (int k = 0; k < 20; ++k) {
+    world.set_lpc_velocity(push, k < 10 ? Vec3(0, -0.1, 0) : Vec3::Zero());
+    const Vec3List start[2] = {bodies[0]->x, bodies[1]->x};  // the positions the contacts are made at
+    world.step(0.01);
+    for (const Contact& c : world.contacts()) {
+      if (c.tool >= 0 || !(c.gap < 0)) continue;
+      ++penetrating;
+      const int other = 1 - c.a.body;
+      if (!inside_body(bodies[other]->tets, start[other], start[c.a.body][c.a.nodes[0]]))
+        deepest_false = std::max(deepest_false, -c.gap);
+    }
+  }
+  print_message("%d penetrating body contacts; deepest reported for a node outside: %.3g m\n", penetrating,
+                deepest_false);
+  assert_true(penetrating > 0);
+  assert_true(deepest_false < 1e-9);  // a node on the surface may round either way
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_cube_rests_on_a_static_slab),
       cmocka_unit_test(test_two_bodies_pressed_together_match_reference),
+      cmocka_unit_test(test_nodes_beside_an_edge_are_not_reported_inside),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
