@@ -257,7 +257,13 @@ MicaReport FactoredMicaSolver::solve(std::vector<MicaBody>& bodies, const std::v
     apply_impulse_change(bodies, factored, rows, dlambda_);
     lambda = lambda_next_;
   }
-  // Stopped early: the impulses in G^T lambda are those the velocities were last solved with.
+  // Stopped early (cap or budget): report G^T lambda of the impulses returned, and how far the
+  // velocities are from balancing them.
+  for (MicaBody& body : bodies) body.contact_impulse.assign(size_t(body.pattern->rows), Vec3::Zero());
+  for (size_t r = 0; r < nr; ++r)
+    for (int32_t t = rows.start[r]; t < rows.start[r + 1]; ++t)
+      bodies[rows.terms[t].body].contact_impulse[rows.terms[t].node] +=
+          rows.terms[t].coef * lambda[r] * rows.direction[r];
   report.momentum_residual = MicaSolver::momentum_residual(bodies);
   report.residual = std::max({report.velocity_change, report.impulse_change, report.momentum_residual});
   return report;

@@ -411,8 +411,10 @@ static void test_converged_steps_are_solved(void**) {
 // The time budget: the solve stops when the step has used its budget, says it did not converge,
 // and reports the residual it reached; the step still completes with finite results.
 static void test_time_budget_stops_the_solve(void**) {
-  for (SolverKind solver : {SolverKind::Mica, SolverKind::Pcg}) {
+  for (int config = 0; config < 3; ++config) {
+    const SolverKind solver = config == 2 ? SolverKind::Pcg : SolverKind::Mica;
     WorldSettings ws = settings(solver, 1e-14);
+    ws.mica_sweep = config == 1 ? MicaSweep::Factored : MicaSweep::GaussSeidel;
     ws.max_iterations = 1000000000;
     ws.time_budget_ms = 1;
     World world(ws);
@@ -428,12 +430,15 @@ static void test_time_budget_stops_the_solve(void**) {
     world.add_lpc(body, top, pull);
     world.step(0.01);
     const WorldStats& st = world.stats();
-    print_message("solver %d: %d iterations in %.2f ms, residual %.2e\n", int(solver), st.solver_iterations,
+    print_message("config %d: %d iterations in %.2f ms, residual %.2e\n", config, st.solver_iterations,
                   st.ms_last_step, st.solver_residual);
     assert_true(st.out_of_time);
     assert_false(st.converged);
     assert_true(st.solver_iterations >= 1 && st.solver_iterations < ws.max_iterations);
-    assert_true(std::isfinite(st.solver_residual) && st.solver_residual > ws.tolerance);
+    assert_true(std::isfinite(st.solver_residual));
+    // The factored sweep's first iteration is exact on this unrotated body (its factorization used
+    // up the budget first); the others stop far from 1e-14.
+    if (config != 1) assert_true(st.solver_residual > ws.tolerance);
     for (const Vec3& x : world.body(body).x) assert_true(x.allFinite());
   }
 }
