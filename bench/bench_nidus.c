@@ -15,9 +15,11 @@
  * Memory: VmRSS (/proc/self/status) before and after mica_body_create_from_file, and after the
  * first step (when the solver's buffers exist), divided by the tets.
  *
- * usage: bench_nidus [mesh] [tolerance] [steps] [warm-up] [E] [dt] [gauss-seidel steps]
- *          defaults: data/nidus/nidus.msh 1e-6 200 40 1e4 0.01 30; runs MICA with the factored
- *          sweep, then with the paper's Gauss-Seidel sweep, and prints both and their ratio
+ * usage: bench_nidus [mesh] [tolerance] [steps] [warm-up] [E] [dt] [gauss-seidel steps] [refactor interval]
+ *          defaults: data/nidus/nidus.msh 1e-6 200 40 1e4 0.01 30 4; runs MICA with the factored
+ *          sweep (the first step's factor), again with the factor refreshed in the background every
+ *          `refactor interval` steps (0 skips it), then with the paper's Gauss-Seidel sweep (0 steps
+ *          skip it), and prints each and their ratios
  *        bench_nidus --scaling <out.csv> [max-tets]
  *          time per step against tets on box grids: a 0.1 m cube of n^3 cubes x 6 tets
  *          (E = 2e4 Pa, alpha = 2, gravity, base fixed), a 2 cm sphere 6 mm deep +- 3 mm at
@@ -151,7 +153,7 @@ static int press(mica_world* world, mica_tool_id tool, const double c[3], double
 static const char* sweep_name(int32_t sweep) { return sweep == MICA_SWEEP_FACTORED ? "factored" : "gauss-seidel"; }
 
 static int nidus(const char* path, double tol, int steps, int warmup, double E, double dt, int32_t sweep,
-                 figures* result) {
+                 int32_t refactor, figures* result) {
   mica_world* world = NULL;
   mica_world_def wd = mica_world_def_default();
   wd.gravity[1] = 0; /* the lesion is carried by the tissue around it */
@@ -159,6 +161,7 @@ static int nidus(const char* path, double tol, int steps, int warmup, double E, 
   wd.tolerance = tol;
   wd.max_iterations = 100000;
   wd.mica_sweep = sweep;
+  wd.refactor_interval = refactor;
   if (mica_world_create(&wd, &world) != MICA_OK) {
     fprintf(stderr, "%s\n", mica_world_last_error(NULL));
     return 1;
@@ -235,8 +238,8 @@ static int nidus(const char* path, double tol, int steps, int warmup, double E, 
   printf("# mesh %s: %d nodes (%d DOF), %d tets, %.1f x %.1f x %.1f mm; held by %d nodes (lowest fifth)\n", path,
          fig.nodes, 3 * fig.nodes, fig.tets, 1e3 * (hi[0] - lo[0]), 1e3 * (hi[1] - lo[1]), 1e3 * (hi[2] - lo[2]), n);
   printf("# E = %.3g Pa, nu = 0.4, rho = 1000, alpha = 2; forceps tip: sphere R = %.1f mm, 2 mm deep +- 1 mm at 1 Hz; "
-"MICA (%s sweep) tol %.0e, dt = %g ms; %d warm-up steps, %d timed; %ld thread(s) in the process\n",
-         E, 1e3 * R, sweep_name(sweep), tol, 1e3 * dt, warmup, steps, threads);
+"MICA (%s sweep, refactor_interval %d) tol %.0e, dt = %g ms; %d warm-up steps, %d timed; %ld thread(s) in the process\n",
+         E, 1e3 * R, sweep_name(sweep), refactor, tol, 1e3 * dt, warmup, steps, threads);
   printf("median ms/step        %.3f\n", fig.median);
   printf("p95 ms/step           %.3f\n", fig.p95);
   printf("mean ms/step          %.3f\n", fig.mean);
@@ -335,20 +338,30 @@ int main(int argc, char** argv) {
   const double E = argc > 5 ? atof(argv[5]) : 1e4;
   const double dt = argc > 6 ? atof(argv[6]) : 0.01;
   const int gs_steps = argc > 7 ? atoi(argv[7]) : 30;
-  if (!(tol > 0) || steps < 1 || warmup < 2 || !(E > 0) || !(dt > 0) || gs_steps < 0) {
-    fprintf(stderr, "usage: bench_nidus [mesh] [tolerance] [steps] [warm-up >= 2] [E] [dt] [gauss-seidel steps]\n");
+  const int refactor = argc > 8 ? atoi(argv[8]) : 4;
+  if (!(tol > 0) || steps < 1 || warmup < 2 || !(E > 0) || !(dt > 0) || gs_steps < 0 || refactor < 0) {
+    fprintf(stderr, "usage: bench_nidus [mesh] [tolerance] [steps] [warm-up >= 2] [E] [dt] [gauss-seidel steps] "
+                    "[refactor interval]\n");
     return 2;
   }
-  printf("# command: OPENBLAS_NUM_THREADS=1 taskset -c 1 build/bench/bench_nidus %s %g %d %d %g %g %d\n", path, tol,
-         steps, warmup, E, dt, gs_steps);
-  /* Both MICA sweeps on the same scene, one after the other in this process: the factored one
-   * over `steps` timed steps, the paper's Gauss-Seidel (hundreds of times slower) over fewer. */
-  figures factored, gs;
+  printf("# command: OPENBLAS_NUM_THREADS=1 taskset -c 1 build/bench/bench_nidus %s %g %d %d %g %g %d %d\n", path, tol,
+         steps, warmup, E, dt, gs_steps, refactor);
+  /* The MICA sweeps on the same scene, one after the other in this process: the factored one
+   * with the factor of the first step, then with a background refresh every `refactor` steps
+   * (its worker thread runs beside the step: give the process a second core to see what it is
+   * worth), and the paper's Gauss-Seidel (hundreds of times slower) over fewer steps. */
+  figures factored, refreshed, gs;
   printf("\n## factored sweep\n");
-  if (nidus(path, tol, steps, warmup, E, dt, MICA_SWEEP_FACTORED, &factored)) return 1;
+  if (nidus(path, tol, steps, warmup, E, dt, MICA_SWEEP_FACTORED, 0, &factored)) return 1;
+  if (refactor > 0) {
+    printf("\n## factored sweep, factor refreshed every %d steps in the background\n", refactor);
+    if (nidus(path, tol, steps, warmup, E, dt, MICA_SWEEP_FACTORED, refactor, &refreshed)) return 1;
+    printf("\nmedian ms/step: factored %.2f, refreshed every %d steps %.2f: %.2fx\n", factored.median, refactor,
+           refreshed.median, factored.median / refreshed.median);
+  }
   if (gs_steps == 0) return 0;
   printf("\n## gauss-seidel sweep (the paper's)\n");
-  if (nidus(path, tol, gs_steps, warmup, E, dt, MICA_SWEEP_GAUSS_SEIDEL, &gs)) return 1;
+  if (nidus(path, tol, gs_steps, warmup, E, dt, MICA_SWEEP_GAUSS_SEIDEL, 0, &gs)) return 1;
   printf("\nmedian ms/step: factored %.2f, gauss-seidel %.2f: %.1fx faster; target 5 ms (paper: ~100 ms)\n",
          factored.median, gs.median, gs.median / factored.median);
   return 0;

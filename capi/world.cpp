@@ -72,6 +72,10 @@ mica::WorldSettings translate(const mica_world_def& d) {
     refuse(MICA_ERR_INVALID_ARGUMENT, "def->relinearise_tolerance must be finite and >= 0");
   s.relinearise_tolerance = d.relinearise_tolerance;
   s.relinearise_max = d.relinearise_max;
+  if (d.refactor_interval < 0)
+    refuse(MICA_ERR_INVALID_ARGUMENT, "def->refactor_interval must be >= 0 (0: no background refresh), got " +
+                                          std::to_string(d.refactor_interval));
+  s.refactor_interval = d.refactor_interval;
   switch (d.mica_sweep) {
     case MICA_SWEEP_GAUSS_SEIDEL: s.mica_sweep = mica::MicaSweep::GaussSeidel; break;
     case MICA_SWEEP_FACTORED: s.mica_sweep = mica::MicaSweep::Factored; break;

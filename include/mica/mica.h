@@ -165,7 +165,15 @@ typedef struct mica_world_def {
    *  the new rotations, with a line search (docs/stability.md, K1). Default 1e-3. */
   double relinearise_tolerance;
   int32_t relinearise_max; /**< at most this many solves per step for that; < 2 turns the check off; default 8 */
-  int32_t reserved4;       /**< zero */
+  /** Since 0.4. MICA_SWEEP_FACTORED on co-rotational bodies: every this many solves (one per
+   *  step, more when a step is re-linearised) the factor is refreshed from the current system:
+   *  copied, factored on a background thread (one per body) while the steps go on, and used from
+   *  that many solves later (in lockstep: the step waits for a late factorization, so results do
+   *  not depend on timing). The refreshed factor keeps the velocity and contact solves to a few
+   *  iterations where the rest factor's warping leaves tens. Default 0: factor only when the time
+   *  step, damping or constraint set changes. Costs a second core while it runs, and a second
+   *  factor's memory (docs/performance.md). */
+  int32_t refactor_interval;
 } mica_world_def;
 
 /** Fills `def` with defaults, writing only its first `struct_size` bytes, and records

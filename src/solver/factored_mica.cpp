@@ -15,9 +15,8 @@ const Mat3& projector(const MicaBody& body, int32_t i) {
   return body.projection->active() && body.projection->is_constrained[i] ? body.projection->S[i] : identity;
 }
 
-Mat3 rotation(const FactoredBody& f, int32_t i) {
-  return f.node_rotation ? (*f.node_rotation)[i] : Mat3::Identity();
-}
+// How far node i turned since the factor's step.
+Mat3 rotation(const FactoredBody& f, int32_t i) { return f.factor->turn(f.node_rotation, i); }
 
 }  // namespace
 
@@ -39,7 +38,7 @@ void FactoredMicaSolver::build_compliance(const std::vector<MicaBody>& bodies,
   for (size_t r = 0; r < nr; ++r)
     for (int32_t t = rows.start[r]; t < rows.start[r + 1]; ++t) {
       const RowTerm& term = rows.terms[t];
-      term_columns_[t] = &factored[term.body].rest->columns(term.node);
+      term_columns_[t] = &factored[term.body].factor->columns(term.node);
       term_force_[t] = term.coef * (rotation(factored[term.body], term.node).transpose() *
                                     (projector(bodies[term.body], term.node) * rows.direction[r]));
       row_of[t] = int32_t(r);
@@ -128,7 +127,7 @@ double FactoredMicaSolver::complementarity_error(const ContactRows& rows, const 
   probe_ = lambda;
   for (size_t r = 0; r < rows.size(); ++r) {
     if (diag_[r] == 0) continue;
-    probe_[r] = lambda[r] - w_[r] / rest_diag_[r];
+    probe_[r] = lambda[r] - w_[r] / warped_diag_[r];
     project(rows, r, probe_);
     e2 += (probe_[r] - lambda[r]) * (probe_[r] - lambda[r]);
     probe_[r] = lambda[r];
@@ -150,16 +149,16 @@ MicaReport FactoredMicaSolver::solve(std::vector<MicaBody>& bodies, const std::v
   warp_.resize(nb);
   rhs_.resize(nb);
   for (size_t bi = 0; bi < nb; ++bi) {
-    warp_[bi].bind(factored[bi].rest, factored[bi].node_rotation);
+    warp_[bi].bind(factored[bi].factor, factored[bi].node_rotation);
     pcg_[bi].set_preconditioner(&warp_[bi]);
   }
   build_compliance(bodies, factored, rows);
   lambda.resize(nr, 0.0);
   diag_.assign(nr, 0.0);
-  rest_diag_.assign(nr, 0.0);
+  warped_diag_.assign(nr, 0.0);
   const double w_max = nr ? W_.diagonal().cwiseAbs().maxCoeff() : 0.0;
   for (size_t r = 0; r < nr; ++r) {
-    if (W_(r, r) > 1e-12 * w_max) diag_[r] = rest_diag_[r] = W_(r, r);
+    if (W_(r, r) > 1e-12 * w_max) diag_[r] = warped_diag_[r] = W_(r, r);
     else lambda[r] = 0;  // nothing can move along this row
     project(rows, r, lambda);
   }

@@ -1,11 +1,12 @@
 // MICA with a factored anticipation: the same problem and outer loop as MicaSolver (anticipate
 // the contact velocities, update the impulses by projected Gauss-Seidel, update the velocities,
 // stop on the change of the solution and a balanced momentum), with the block-diagonal
-// anticipation Dt^-1 replaced by the warped rest factor P^-1 = S R K^-1 R^T S (rest_factor.hpp):
+// anticipation Dt^-1 replaced by the warped factor of a recent system, P^-1 = S Q K_f^-1 Q^T S
+// (lagged_factor.hpp):
 //  - velocities: projected conjugate gradients preconditioned by P^-1 (a few iterations where
 //    block Gauss-Seidel needs thousands on stiff or fine meshes);
 //  - contact: the impulses see the compliance W = G P^-1 G^T, a small dense matrix built from the
-//    cached columns of K^-1 at the contact nodes, solved by projected Gauss-Seidel; the
+//    cached columns of K_f^-1 at the contact nodes, solved by projected Gauss-Seidel; the
 //    velocities then follow the impulse change through the same columns.
 // With P = A the loop would end after one correction; the rotations' mismatch costs a few more.
 #pragma once
@@ -13,13 +14,13 @@
 
 #include "solver/mica_solver.hpp"
 #include "solver/pcg.hpp"
-#include "solver/rest_factor.hpp"
+#include "solver/lagged_factor.hpp"
 
 namespace mica {
 
 // What the factored loop needs beyond MicaBody, per body.
 struct FactoredBody {
-  RestFactor* rest;                         // updated for this step's h, damping and constraints
+  LaggedFactor* factor;                     // updated for this step's h, damping and constraints
   const std::vector<Mat3>* node_rotation;   // null: the linear model (no warping)
 };
 
@@ -33,7 +34,7 @@ class FactoredMicaSolver {
  private:
   void build_compliance(const std::vector<MicaBody>& bodies, const std::vector<FactoredBody>& factored,
                         const ContactRows& rows);
-  // v += S R K^-1 R^T S G^T dlambda, through the cached columns.
+  // v += S Q K_f^-1 Q^T S G^T dlambda, through the cached columns.
   void apply_impulse_change(std::vector<MicaBody>& bodies, const std::vector<FactoredBody>& factored,
                             const ContactRows& rows, const std::vector<double>& dlambda);
   void project(const ContactRows& rows, size_t r, std::vector<double>& lambda) const;
@@ -42,13 +43,13 @@ class FactoredMicaSolver {
   void solve_small_lcp(const ContactRows& rows, double tolerance, const std::vector<double>& lambda);
 
   std::vector<PcgSolver> pcg_;
-  std::vector<WarpedRestPreconditioner> warp_;
-  std::vector<const Eigen::MatrixXd*> term_columns_;  // per row term: K^-1 columns of its node
-  std::vector<Vec3> term_force_;                      // per row term: coef R_i^T S_i d (rest frame)
+  std::vector<WarpedFactorPreconditioner> warp_;
+  std::vector<const Eigen::MatrixXd*> term_columns_;  // per row term: K_f^-1 columns of its node
+  std::vector<Vec3> term_force_;                      // per row term: coef Q_i^T S_i d (the factor's frame)
   Eigen::MatrixXd W_;                                 // G P^-1 G^T
   std::vector<double> w_, w_prev_, lambda_next_, dlambda_, diag_;
   std::vector<int32_t> live_;
-  std::vector<double> rest_diag_, probe_;  // W_rr before the secant updates; scratch
+  std::vector<double> warped_diag_, probe_;  // W_rr before the secant updates; scratch
   // Of the current lambda against the current row velocities w_ (N s).
   double complementarity_error(const ContactRows& rows, const std::vector<double>& lambda);
   std::vector<Vec3List> rhs_;

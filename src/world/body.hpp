@@ -11,7 +11,7 @@
 #include "fem/rotation_stiffness.hpp"
 #include "solver/direct_solver.hpp"
 #include "solver/pcg.hpp"
-#include "solver/rest_factor.hpp"
+#include "solver/lagged_factor.hpp"
 #include "solver/projection.hpp"
 
 namespace mica {
@@ -62,8 +62,8 @@ struct Body {
   Vec3List contact_impulse;    // G^T lambda of the last step, N s
   DirectSolver direct;
   PcgSolver pcg;
-  RestFactor rest_factor;          // MICA with the factored anticipation
-  std::vector<Mat3> node_rotation;  // per node, for warping the rest factor
+  LaggedFactor factor;             // MICA with the factored anticipation
+  std::vector<Mat3> node_rotation;  // per node, for warping the factor
 
   // For a world with threads > 1 (empty otherwise): blocks of tets that share no node (parallel
   // assembly) and blocks of nodes that share no block of A (the colour-ordered MBGS sweep).

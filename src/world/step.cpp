@@ -279,11 +279,15 @@ void World::solve_mica(const std::vector<Body*>& dynamic, double h) {
     for (size_t k = 0; k < dynamic.size(); ++k) {
       Body& b = *dynamic[k];
       const bool damped = needs_damping(b);
-      b.rest_factor.update(b.fem, {h, damped ? b.settings.rayleigh_alpha : 0.0, damped ? b.settings.rayleigh_beta : 0.0,
-                                   b.lpc_version},
-                           b.projection);
-      if (b.settings.corotational) compute_node_rotations(b.fem, b.R, b.node_rotation);
-      factored_bodies_[k] = {&b.rest_factor, b.settings.corotational ? &b.node_rotation : nullptr};
+      const std::vector<Mat3>* rotation = nullptr;
+      if (b.settings.corotational) {
+        compute_node_rotations(b.fem, b.R, b.node_rotation);
+        rotation = &b.node_rotation;
+      }
+      const LaggedFactor::Key key{h, damped ? b.settings.rayleigh_alpha : 0.0,
+                                  damped ? b.settings.rayleigh_beta : 0.0, b.lpc_version};
+      b.factor.update(b.fem, key, b.A, b.projection, rotation, rotation ? settings_.refactor_interval : 0);
+      factored_bodies_[k] = {&b.factor, rotation};
     }
     record(factored_mica_.solve(mica_bodies_, factored_bodies_, rows_, ms, lambda_));
     row_diagonal_ = factored_mica_.row_diagonal();

@@ -40,6 +40,10 @@ struct WorldSettings {
   bool paper_norm = false;         // MICA: stop on the paper's 2-norm of the change
   double relaxation = 1.0;         // MICA: MBGS over-relaxation omega in (0, 2)
   MicaSweep mica_sweep = MicaSweep::GaussSeidel;
+  // Factored sweep: refresh each co-rotational body's factor from its current system every this
+  // many steps, factored on a background thread and adopted that many steps later (0: refactor
+  // only when the step size, damping or constraint set changes).
+  int32_t refactor_interval = 0;
   double time_budget_ms = 0;       // iterative solvers: > 0 stops the solve after this much wall-clock time
   bool warm_start = true;          // MICA: start from the last step's velocities and impulses (else zero)
   bool body_contact = true;        // contact between bodies (and with static bodies)

@@ -129,7 +129,7 @@ class mica_world_def(Structure):
         ("threads", c_int32),
         ("relinearise_tolerance", c_double),
         ("relinearise_max", c_int32),
-        ("reserved4", c_int32),
+        ("refactor_interval", c_int32),
     ]
 
 

@@ -143,7 +143,7 @@ namespace LibMica
             public int threads;
             public double relinearise_tolerance;
             public int relinearise_max;
-            public int reserved4;
+            public int refactor_interval;
         }
 
         [StructLayout(LayoutKind.Sequential)]

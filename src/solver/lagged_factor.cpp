@@ -1,0 +1,111 @@
+#include "solver/lagged_factor.hpp"
+
+#include "fem/rotation.hpp"
+
+namespace mica {
+
+LaggedFactor::LaggedFactor() : active_(std::make_unique<Slot>()), pending_(std::make_unique<Slot>()) {}
+
+LaggedFactor::~LaggedFactor() {
+  if (job_.valid()) job_.wait();
+}
+
+void LaggedFactor::factor(Slot& slot, const FemModel& fem, const BlockValues& A, const Projection& projection,
+                          const std::vector<Mat3>* node_rotation) {
+  if (!slot.direct.analyzed()) slot.direct.analyze(fem.pattern);
+  slot.direct.factorize(ProjectedSystem{fem.pattern, A, projection});
+  if (node_rotation) slot.rotation = *node_rotation;
+  else slot.rotation.clear();
+  ++factorizations_;
+}
+
+void LaggedFactor::adopt() {
+  try {
+    job_.get();
+  } catch (...) {
+    return;  // the copied system did not factor (not positive definite): keep the one in use
+  }
+  std::swap(active_, pending_);
+  columns_.clear();
+}
+
+bool LaggedFactor::update(const FemModel& fem, const Key& key, const BlockValues& A, const Projection& projection,
+                          const std::vector<Mat3>* node_rotation, int32_t interval) {
+  ++step_;
+  node_count_ = fem.node_count();
+  if (!(key == key_) || !active_->direct.analyzed()) {
+    // A new step size, damping or constraint set: what is in flight is for another system.
+    if (job_.valid()) {
+      job_.wait();
+      job_ = {};
+    }
+    factor(*active_, fem, A, projection, node_rotation);  // throws on failure: the key stays, the next step retries
+    key_ = key;
+    launched_at_ = step_;  // the next refresh starts from a later step
+    columns_.clear();
+    return true;
+  }
+  if (interval <= 0) return false;
+  bool changed = false;
+  if (job_.valid() && step_ - launched_at_ >= interval) {
+    adopt();
+    changed = true;
+  }
+  if (!job_.valid() && step_ > launched_at_) {
+    Slot& slot = *pending_;
+    if (!slot.direct.analyzed()) slot.direct.analyze(fem.pattern);
+    slot.A = A;
+    slot.projection = projection;
+    if (node_rotation) slot.rotation = *node_rotation;
+    else slot.rotation.clear();
+    const BlockPattern* pattern = &fem.pattern;  // fixed for the body's life, which outlives the job
+    job_ = std::async(std::launch::async, [&slot, pattern] {
+      slot.direct.factorize(ProjectedSystem{*pattern, slot.A, slot.projection});
+    });
+    ++factorizations_;
+    launched_at_ = step_;
+  }
+  return changed;
+}
+
+void LaggedFactor::solve(const Vec3List& in, Vec3List& out) const {
+  active_->direct.solve_raw(flat(in), x_);
+  out.resize(in.size());
+  flat(out) = x_.col(0);
+}
+
+const Eigen::MatrixXd& LaggedFactor::columns(int32_t node) {
+  auto it = columns_.find(node);
+  if (it != columns_.end()) return it->second;
+  Eigen::MatrixXd unit = Eigen::MatrixXd::Zero(3 * node_count_, 3);
+  unit.block<3, 3>(3 * node, 0).setIdentity();
+  Eigen::MatrixXd& X = columns_[node];
+  active_->direct.solve_raw(unit, X);
+  return X;
+}
+
+void WarpedFactorPreconditioner::apply(const Vec3List& r, Vec3List& z) {
+  if (!rotation_) {
+    factor_->solve(r, z);
+    return;
+  }
+  const size_t n = r.size();
+  turn_.resize(n);
+  rotated_.resize(n);
+  for (size_t i = 0; i < n; ++i) {
+    turn_[i] = factor_->turn(rotation_, int32_t(i));
+    rotated_[i] = turn_[i].transpose() * r[i];
+  }
+  factor_->solve(rotated_, z);
+  for (size_t i = 0; i < n; ++i) z[i] = turn_[i] * z[i];
+}
+
+void compute_node_rotations(const FemModel& fem, const std::vector<Mat3>& element_rotation,
+                            std::vector<Mat3>& node_rotation) {
+  node_rotation.assign(size_t(fem.node_count()), Mat3::Zero());
+  for (size_t e = 0; e < fem.elements.size(); ++e)
+    for (int32_t a : fem.elements[e].nodes) node_rotation[size_t(a)] += element_rotation[e];
+  for (Mat3& R : node_rotation) R = R.isZero(0) ? Mat3::Identity() : proper_rotation(R);
+}
+
+}  // namespace mica

@@ -1,0 +1,99 @@
+// A sparse Cholesky factor of a recent state of a body's velocity system, K_f = S A_f S + I - S,
+// kept with the node rotations R_f of the step it was built from. A later co-rotated system
+// differs from it mostly by how far each node has turned since, which the warped preconditioner
+// Q K_f^-1 Q^T, Q_i = R_i R_f,i^T, undoes node by node (stiffness warping: Mueller and Gross 2004;
+// Saupin, Duriez and Cotin 2008 use it for contact compliance; Courtecuisse et al. 2010 refresh
+// the factor asynchronously, as here).
+//
+// Refactored at once when the step, the damping or the constraint set changed; and, with a
+// refresh interval L > 0, every L steps in the background: the system of step k is copied and
+// factored on a worker thread while steps k .. k+L-1 run, and adopted at step k+L. Adoption is in
+// lockstep (the step waits if the worker is late), so results never depend on timing.
+#pragma once
+#include <Eigen/Dense>
+#include <future>
+#include <memory>
+#include <unordered_map>
+
+#include "fem/fem_model.hpp"
+#include "solver/direct_solver.hpp"
+#include "solver/pcg.hpp"
+
+namespace mica {
+
+class LaggedFactor {
+ public:
+  struct Key {
+    double h = 0, alpha = 0, beta = 0;
+    uint64_t lpc_version = ~uint64_t(0);
+    bool operator==(const Key& o) const {
+      return h == o.h && alpha == o.alpha && beta == o.beta && lpc_version == o.lpc_version;
+    }
+  };
+  LaggedFactor();
+  ~LaggedFactor();  // waits for a background factorization in flight
+  LaggedFactor(const LaggedFactor&) = delete;
+  LaggedFactor& operator=(const LaggedFactor&) = delete;
+
+  // Once per step, with this step's system A (M + h C + h^2 K of the current rotations), its
+  // projection and node rotations (null: a linear body, no warping). Factors A at once when the
+  // key changed; otherwise adopts and launches background factorizations every `interval` steps
+  // (0: never). Returns true if the factor in use changed.
+  bool update(const FemModel& fem, const Key& key, const BlockValues& A, const Projection& projection,
+              const std::vector<Mat3>* node_rotation, int32_t interval);
+  // out = K_f^-1 in (the factor's frame, no warping).
+  void solve(const Vec3List& in, Vec3List& out) const;
+  // The three columns of K_f^-1 belonging to `node` (3n x 3), kept until the factor changes: the
+  // response of every node to a unit force on `node`.
+  const Eigen::MatrixXd& columns(int32_t node);
+  // Q_i = R_i R_f,i^T: how far node i turned since the factor's step (R_i: now).
+  Mat3 turn(const std::vector<Mat3>* node_rotation, int32_t i) const {
+    if (!node_rotation) return Mat3::Identity();
+    return active_->rotation.empty() ? (*node_rotation)[i] : Mat3((*node_rotation)[i] * active_->rotation[i].transpose());
+  }
+  int64_t factorizations() const { return factorizations_; }
+  int32_t node_count() const { return node_count_; }
+
+ private:
+  struct Slot {
+    DirectSolver direct;
+    BlockValues A;            // the copy the worker factors
+    Projection projection;
+    std::vector<Mat3> rotation;  // R_f per node (empty: identity)
+  };
+  void factor(Slot& slot, const FemModel& fem, const BlockValues& A, const Projection& projection,
+              const std::vector<Mat3>* node_rotation);
+  void adopt();
+
+  Key key_;
+  std::unique_ptr<Slot> active_, pending_;
+  std::future<void> job_;     // the background factorization of *pending_
+  int64_t step_ = 0, launched_at_ = -1;
+  int64_t factorizations_ = 0;
+  int32_t node_count_ = 0;
+  mutable Eigen::MatrixXd x_;
+  std::unordered_map<int32_t, Eigen::MatrixXd> columns_;
+};
+
+// The warped preconditioner z = Q K_f^-1 Q^T r (Q per node, see LaggedFactor::turn).
+class WarpedFactorPreconditioner : public Preconditioner {
+ public:
+  void bind(LaggedFactor* factor, const std::vector<Mat3>* node_rotation) {
+    factor_ = factor;
+    rotation_ = node_rotation;
+  }
+  void apply(const Vec3List& r, Vec3List& z) override;
+
+ private:
+  LaggedFactor* factor_ = nullptr;
+  const std::vector<Mat3>* rotation_ = nullptr;
+  Vec3List rotated_;
+  std::vector<Mat3> turn_;
+};
+
+// Per node, the rotation nearest the sum of its elements' rotations (identity for a node in no
+// element).
+void compute_node_rotations(const FemModel& fem, const std::vector<Mat3>& element_rotation,
+                            std::vector<Mat3>& node_rotation);
+
+}  // namespace mica
