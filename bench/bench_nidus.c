@@ -20,8 +20,8 @@
  *          sweep (the first step's factor), again with the factor refreshed in the background every
  *          `refactor interval` steps (0 skips it), then with the paper's Gauss-Seidel sweep (0 steps
  *          skip it), and prints each and their ratios
- *        bench_nidus --scaling <out.csv> [max-tets]
- *          time per step against tets on box grids: a 0.1 m cube of n^3 cubes x 6 tets
+ *        bench_nidus --scaling <out.csv> [max-tets] [factored|gauss-seidel]
+ *          time per step against tets on box grids (MICA's factored sweep unless told otherwise): a 0.1 m cube of n^3 cubes x 6 tets
  *          (E = 2e4 Pa, alpha = 2, gravity, base fixed), a 2 cm sphere 6 mm deep +- 3 mm at
  *          1 Hz, MICA tol 1e-6; 9 warm-up steps, then 20 timed (10 above 40k tets); 1k to 100k
  *          tets, with the memory per tet of each box.
@@ -252,7 +252,7 @@ static int nidus(const char* path, double tol, int steps, int warmup, double E, 
   return 0;
 }
 
-static int scaling(const char* csv_path, int max_tets) {
+static int scaling(const char* csv_path, int max_tets, int32_t sweep) {
   FILE* csv = fopen(csv_path, "w");
   if (!csv) {
     fprintf(stderr, "cannot write %s\n", csv_path);
@@ -260,10 +260,11 @@ static int scaling(const char* csv_path, int max_tets) {
   }
   char m[300];
   machine(m, sizeof m);
-  fprintf(csv, "# bench_nidus --scaling: %s\n", m);
+  fprintf(csv, "# bench_nidus --scaling: %s; MICA %s sweep\n", m, sweep_name(sweep));
   fprintf(csv, "cells,nodes,tets,ms_median,ms_p95,iterations,ms_per_iteration,mem_B_per_tet,force_N\n");
   printf("# bench_nidus --scaling: %s\n", m);
-  printf("# command: OPENBLAS_NUM_THREADS=1 taskset -c 1 build/bench/bench_nidus --scaling %s %d\n", csv_path, max_tets);
+  printf("# command: OPENBLAS_NUM_THREADS=1 taskset -c 1 build/bench/bench_nidus --scaling %s %d %s\n", csv_path, max_tets,
+         sweep_name(sweep));
   printf("%6s %8s %8s %10s %10s %10s %12s %10s\n", "cells", "nodes", "tets", "median ms", "p95 ms", "iters",
          "ms/iter", "B/tet");
   const int sizes[] = {6, 8, 11, 14, 18, 22, 26, 30};
@@ -275,6 +276,7 @@ static int scaling(const char* csv_path, int max_tets) {
     wd.solver = MICA_SOLVER_MICA;
     wd.tolerance = 1e-6;
     wd.max_iterations = 100000;
+    wd.mica_sweep = sweep;
     if (mica_world_create(&wd, &world) != MICA_OK) return 1;
     mica_body_def bd = mica_body_def_default();
     bd.youngs_modulus = 2e4;
@@ -326,10 +328,11 @@ static int scaling(const char* csv_path, int max_tets) {
 int main(int argc, char** argv) {
   if (argc > 1 && strcmp(argv[1], "--scaling") == 0) {
     if (argc < 3) {
-      fprintf(stderr, "usage: bench_nidus --scaling <out.csv> [max-tets]\n");
+      fprintf(stderr, "usage: bench_nidus --scaling <out.csv> [max-tets] [factored|gauss-seidel]\n");
       return 2;
     }
-    return scaling(argv[2], argc > 3 ? atoi(argv[3]) : 110000);
+    const int32_t sweep = argc > 4 && strcmp(argv[4], "gauss-seidel") == 0 ? MICA_SWEEP_GAUSS_SEIDEL : MICA_SWEEP_FACTORED;
+    return scaling(argv[2], argc > 3 ? atoi(argv[3]) : 110000, sweep);
   }
   const char* path = argc > 1 ? argv[1] : "data/nidus/nidus.msh";
   const double tol = argc > 2 ? atof(argv[2]) : 1e-6;

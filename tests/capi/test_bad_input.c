@@ -642,6 +642,14 @@ static void test_nonfinite_world_def(void** state) {
     EXPECT_FAIL_NO_WORLD(fx, MICA_ERR_INVALID_ARGUMENT, mica_world_create(&wd, &w), "relinearise_tolerance");
     assert_null(w);
   }
+  const int32_t bad_refactor[2] = {-1, INT32_MIN};
+  for (int i = 0; i < 2; ++i) {
+    mica_world_def wd = mica_world_def_default();
+    wd.refactor_interval = bad_refactor[i];
+    mica_world* w = (mica_world*)&wd;
+    EXPECT_FAIL_NO_WORLD(fx, MICA_ERR_INVALID_ARGUMENT, mica_world_create(&wd, &w), "refactor_interval");
+    assert_null(w);
+  }
   const int32_t bad_sweep_kind[3] = {2, -1, INT32_MAX};
   for (int i = 0; i < 3; ++i) {
     mica_world_def wd = mica_world_def_default();
