@@ -6,6 +6,26 @@
 
 namespace mica {
 
+DirectSolver::~DirectSolver() {
+  for (cholmod_dense** d : {&x_, &y_, &e_})
+    if (*d) cholmod_free_dense(d, &llt_.cholmod());
+}
+
+void DirectSolver::solve_raw(const Eigen::Ref<const Eigen::MatrixXd>& B, Eigen::MatrixXd& X) {
+  cholmod_dense b{};  // a view of B (CHOLMOD reads it only)
+  b.nrow = size_t(B.rows());
+  b.ncol = size_t(B.cols());
+  b.nzmax = b.nrow * b.ncol;
+  b.d = size_t(B.outerStride());
+  b.x = const_cast<double*>(B.data());
+  b.xtype = CHOLMOD_REAL;
+  b.dtype = CHOLMOD_DOUBLE;
+  if (!cholmod_solve2(CHOLMOD_A, llt_.factor(), &b, nullptr, &x_, nullptr, &y_, &e_, &llt_.cholmod()))
+    fail(Errc::Numerical, "CHOLMOD could not solve with the factorization");
+  X.resize(B.rows(), B.cols());
+  X = Eigen::Map<const Eigen::MatrixXd>(static_cast<const double*>(x_->x), B.rows(), B.cols());
+}
+
 void DirectSolver::analyze(const BlockPattern& pattern) {
   const int32_t n = 3 * pattern.rows;
   std::vector<Eigen::Triplet<double>> entries;
@@ -52,8 +72,8 @@ SolveReport DirectSolver::solve(const ProjectedSystem& sys, const Vec3List& b, V
   tmp_.resize(n);
   check_.resize(n);
   sys.right_hand_side(b, rhs_, tmp_);
-  const Eigen::VectorXd y = llt_.solve(flat(rhs_));
-  flat(v) = y;
+  solve_raw(flat(rhs_), y_flat_);
+  flat(v) = y_flat_.col(0);
   // The residual of the projected system, reported like the iterative solvers'.
   sys.apply(v, check_, tmp_);
   const double rhs_norm = flat(rhs_).norm();
@@ -68,7 +88,8 @@ SolveReport DirectSolver::solve(const ProjectedSystem& sys, const Vec3List& b, V
 SolveReport DirectSolver::solve_homogeneous(const ProjectedSystem& sys, const Vec3List& f, Vec3List& y) {
   rhs_ = f;
   for (int32_t i : sys.projection.nodes) rhs_[i] = sys.projection.S[i] * f[i];
-  flat(y) = llt_.solve(flat(rhs_));
+  solve_raw(flat(rhs_), y_flat_);
+  flat(y) = y_flat_.col(0);
   SolveReport report;
   report.iterations = 1;
   return report;

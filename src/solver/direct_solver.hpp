@@ -12,6 +12,10 @@ namespace mica {
 
 class DirectSolver : public LinearSolver {
  public:
+  DirectSolver() = default;
+  ~DirectSolver() override;
+  DirectSolver(const DirectSolver&) = delete;  // owns CHOLMOD workspaces
+  DirectSolver& operator=(const DirectSolver&) = delete;
   // Builds the scalar lower-triangular pattern from the block pattern and analyses it.
   void analyze(const BlockPattern& pattern);
   bool analyzed() const { return analyzed_; }
@@ -20,9 +24,10 @@ class DirectSolver : public LinearSolver {
   // Both solves use the last factorization.
   SolveReport solve(const ProjectedSystem& sys, const Vec3List& b, Vec3List& v) override;
   SolveReport solve_homogeneous(const ProjectedSystem& sys, const Vec3List& f, Vec3List& y) override;
-  // X = (S A S + I - S)^-1 B for any right-hand sides (no projection applied to B).
-  template <class Rhs>
-  void solve_raw(const Rhs& B, Eigen::MatrixXd& X) const { X = llt_.solve(B); }
+  // X = (S A S + I - S)^-1 B for any right-hand sides (no projection applied to B), through
+  // cholmod_solve2 with workspaces kept between calls: no allocation once X has its size and the
+  // workspaces have grown to the widest B.
+  void solve_raw(const Eigen::Ref<const Eigen::MatrixXd>& B, Eigen::MatrixXd& X);
   int64_t factorizations() const { return factorizations_; }
 
  private:
@@ -31,8 +36,14 @@ class DirectSolver : public LinearSolver {
   BlockValues projected_;                      // S A S + I - S per block
   // Supernodal LL^T: dense BLAS on the supernodes, about twice as fast as the simplicial LDL^T
   // with OpenBLAS on bodies of a few thousand nodes (docs/architecture.md).
-  Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> llt_;
+  // Eigen's wrapper, opened to cholmod_solve2 (its factor is a protected member).
+  struct Factor : Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> {
+    cholmod_factor* factor() const { return m_cholmodFactor; }
+  };
+  Factor llt_;
+  cholmod_dense *x_ = nullptr, *y_ = nullptr, *e_ = nullptr;  // cholmod_solve2's solution and workspaces
   Vec3List rhs_, tmp_, check_;
+  Eigen::MatrixXd y_flat_;
   bool analyzed_ = false;
   int64_t factorizations_ = 0;
 };

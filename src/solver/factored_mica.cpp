@@ -34,6 +34,12 @@ void FactoredMicaSolver::build_compliance(const std::vector<MicaBody>& bodies,
   const size_t nr = rows.size(), nt = rows.terms.size();
   term_columns_.resize(nt);
   term_force_.resize(nt);
+  for (size_t bi = 0; bi < factored.size(); ++bi) {  // the new contact nodes' columns, one solve per body
+    contact_nodes_.clear();
+    for (const RowTerm& term : rows.terms)
+      if (term.body == int32_t(bi)) contact_nodes_.push_back(term.node);
+    factored[bi].factor->prepare_columns(contact_nodes_);
+  }
   std::vector<int32_t> row_of(nt);
   for (size_t r = 0; r < nr; ++r)
     for (int32_t t = rows.start[r]; t < rows.start[r + 1]; ++t) {
@@ -52,6 +58,21 @@ void FactoredMicaSolver::build_compliance(const std::vector<MicaBody>& bodies,
       const Mat3 block = X.block<3, 3>(3 * rows.terms[t].node, 0);
       W_(row_of[t], row_of[u]) += term_force_[t].dot(block * term_force_[u]);
     }
+}
+
+void FactoredMicaSolver::start_compliance(const std::vector<MicaBody>& bodies,
+                                          const std::vector<FactoredBody>& factored, const ContactRows& rows,
+                                          std::vector<double>& lambda) {
+  const size_t nr = rows.size();
+  build_compliance(bodies, factored, rows);
+  diag_.assign(nr, 0.0);
+  warped_diag_.assign(nr, 0.0);
+  const double w_max = nr ? W_.diagonal().cwiseAbs().maxCoeff() : 0.0;
+  for (size_t r = 0; r < nr; ++r) {
+    if (W_(r, r) > 1e-12 * w_max) diag_[r] = warped_diag_[r] = W_(r, r);
+    else lambda[r] = 0;  // nothing can move along this row
+    project(rows, r, lambda);
+  }
 }
 
 void FactoredMicaSolver::apply_impulse_change(std::vector<MicaBody>& bodies,
@@ -152,16 +173,10 @@ MicaReport FactoredMicaSolver::solve(std::vector<MicaBody>& bodies, const std::v
     warp_[bi].bind(factored[bi].factor, factored[bi].node_rotation);
     pcg_[bi].set_preconditioner(&warp_[bi]);
   }
-  build_compliance(bodies, factored, rows);
   lambda.resize(nr, 0.0);
-  diag_.assign(nr, 0.0);
-  warped_diag_.assign(nr, 0.0);
-  const double w_max = nr ? W_.diagonal().cwiseAbs().maxCoeff() : 0.0;
-  for (size_t r = 0; r < nr; ++r) {
-    if (W_(r, r) > 1e-12 * w_max) diag_[r] = warped_diag_[r] = W_(r, r);
-    else lambda[r] = 0;  // nothing can move along this row
-    project(rows, r, lambda);
-  }
+  start_compliance(bodies, factored, rows, lambda);
+  bool may_refactor = settings.refactor_after > 0;
+  for (const FactoredBody& f : factored) may_refactor = may_refactor && f.node_rotation;  // else the factor is A's
 
   MicaReport report;
   report.converged = false;
@@ -175,6 +190,18 @@ MicaReport FactoredMicaSolver::solve(std::vector<MicaBody>& bodies, const std::v
       report.out_of_time = true;
       break;
     }
+    // A solve that has used as many iterations as a factorization costs (crushed elements turning
+    // fast under a tool) gives up on the factor: the current system is factored now, and the loop
+    // then ends in a few rounds. Once per solve; the secant history belongs to the old factor.
+    if (may_refactor && report.iterations >= settings.refactor_after) {
+      for (size_t bi = 0; bi < nb; ++bi)
+        factored[bi].factor->refactor_now(*bodies[bi].pattern, *bodies[bi].A, *bodies[bi].projection,
+                                          factored[bi].node_rotation);
+      start_compliance(bodies, factored, rows, lambda);
+      previous_inner_tolerance = 1;
+      may_refactor = false;
+      ++report.refactorizations;
+    }
     ++outer;
     // Velocities for the current impulses: A v = b + G^T lambda on the free directions. While the
     // impulses still move, a hundredth of their last change is accuracy enough (inexact Newton);
@@ -184,7 +211,10 @@ MicaReport FactoredMicaSolver::solve(std::vector<MicaBody>& bodies, const std::v
         outer == 1 || nr == 0 || report.impulse_change < 30 * settings.tolerance
             ? final_tolerance
             : std::clamp(0.01 * report.impulse_change, final_tolerance, std::max(final_tolerance, 1e-2));
-    for (size_t bi = 0; bi < nb; ++bi) pcg_[bi].configure(inner_tolerance, settings.max_iterations, deadline);
+    // While a refactor is still possible, no single solve may run past the point where it pays.
+    const int32_t inner_cap = may_refactor ? std::max(1, settings.refactor_after - report.iterations)
+                                           : settings.max_iterations;
+    for (size_t bi = 0; bi < nb; ++bi) pcg_[bi].configure(inner_tolerance, inner_cap, deadline);
     velocities_solved = true;
     report.velocity_change = 0;  // the residual of this round's solves
     for (size_t bi = 0; bi < nb; ++bi) {
@@ -207,6 +237,7 @@ MicaReport FactoredMicaSolver::solve(std::vector<MicaBody>& bodies, const std::v
     }
     if (report.out_of_time) break;
     if (nr == 0) {
+      if (!velocities_solved && may_refactor) continue;  // stopped where refactoring pays: refactor, go on
       report.converged = velocities_solved;
       break;
     }

@@ -32,6 +32,9 @@ class FactoredMicaSolver {
   const std::vector<double>& row_diagonal() const { return diag_; }
 
  private:
+  // W, its diagonal and the rows nothing can move along, from the factor in use.
+  void start_compliance(const std::vector<MicaBody>& bodies, const std::vector<FactoredBody>& factored,
+                        const ContactRows& rows, std::vector<double>& lambda);
   void build_compliance(const std::vector<MicaBody>& bodies, const std::vector<FactoredBody>& factored,
                         const ContactRows& rows);
   // v += S Q K_f^-1 Q^T S G^T dlambda, through the cached columns.
@@ -48,7 +51,7 @@ class FactoredMicaSolver {
   std::vector<Vec3> term_force_;                      // per row term: coef Q_i^T S_i d (the factor's frame)
   Eigen::MatrixXd W_;                                 // G P^-1 G^T
   std::vector<double> w_, w_prev_, lambda_next_, dlambda_, diag_;
-  std::vector<int32_t> live_;
+  std::vector<int32_t> live_, contact_nodes_;
   std::vector<double> warped_diag_, probe_;  // W_rr before the secant updates; scratch
   // Of the current lambda against the current row velocities w_ (N s).
   double complementarity_error(const ContactRows& rows, const std::vector<double>& lambda);

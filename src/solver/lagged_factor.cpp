@@ -1,5 +1,7 @@
 #include "solver/lagged_factor.hpp"
 
+#include <algorithm>
+
 #include "fem/rotation.hpp"
 
 namespace mica {
@@ -10,13 +12,25 @@ LaggedFactor::~LaggedFactor() {
   if (job_.valid()) job_.wait();
 }
 
-void LaggedFactor::factor(Slot& slot, const FemModel& fem, const BlockValues& A, const Projection& projection,
+void LaggedFactor::factor(Slot& slot, const BlockPattern& pattern, const BlockValues& A, const Projection& projection,
                           const std::vector<Mat3>* node_rotation) {
-  if (!slot.direct.analyzed()) slot.direct.analyze(fem.pattern);
-  slot.direct.factorize(ProjectedSystem{fem.pattern, A, projection});
+  if (!slot.direct.analyzed()) slot.direct.analyze(pattern);
+  slot.direct.factorize(ProjectedSystem{pattern, A, projection});
   if (node_rotation) slot.rotation = *node_rotation;
   else slot.rotation.clear();
+  slot.born = step_;
   ++factorizations_;
+}
+
+void LaggedFactor::refactor_now(const BlockPattern& pattern, const BlockValues& A, const Projection& projection,
+                                const std::vector<Mat3>* node_rotation) {
+  columns_.clear();
+  try {
+    factor(*active_, pattern, A, projection, node_rotation);
+  } catch (...) {
+    key_ = Key{};  // the factor in use is gone: the next update factors again
+    throw;
+  }
 }
 
 void LaggedFactor::adopt() {
@@ -25,6 +39,7 @@ void LaggedFactor::adopt() {
   } catch (...) {
     return;  // the copied system did not factor (not positive definite): keep the one in use
   }
+  if (pending_->born < active_->born) return;  // refactored since it was launched
   std::swap(active_, pending_);
   columns_.clear();
 }
@@ -39,7 +54,7 @@ bool LaggedFactor::update(const FemModel& fem, const Key& key, const BlockValues
       job_.wait();
       job_ = {};
     }
-    factor(*active_, fem, A, projection, node_rotation);  // throws on failure: the key stays, the next step retries
+    factor(*active_, fem.pattern, A, projection, node_rotation);  // throws on failure: the key stays, the next step retries
     key_ = key;
     launched_at_ = step_;  // the next refresh starts from a later step
     columns_.clear();
@@ -58,6 +73,7 @@ bool LaggedFactor::update(const FemModel& fem, const Key& key, const BlockValues
     slot.projection = projection;
     if (node_rotation) slot.rotation = *node_rotation;
     else slot.rotation.clear();
+    slot.born = step_;
     const BlockPattern* pattern = &fem.pattern;  // fixed for the body's life, which outlives the job
     job_ = std::async(std::launch::async, [&slot, pattern] {
       slot.direct.factorize(ProjectedSystem{*pattern, slot.A, slot.projection});
@@ -82,6 +98,19 @@ const Eigen::MatrixXd& LaggedFactor::columns(int32_t node) {
   Eigen::MatrixXd& X = columns_[node];
   active_->direct.solve_raw(unit, X);
   return X;
+}
+
+void LaggedFactor::prepare_columns(const std::vector<int32_t>& nodes) {
+  missing_.clear();
+  for (int32_t node : nodes)
+    if (!columns_.count(node) && std::find(missing_.begin(), missing_.end(), node) == missing_.end())
+      missing_.push_back(node);
+  if (missing_.empty()) return;
+  const Eigen::Index k = Eigen::Index(missing_.size());
+  units_.setZero(3 * node_count_, 3 * k);
+  for (Eigen::Index q = 0; q < k; ++q) units_.block<3, 3>(3 * missing_[q], 3 * q).setIdentity();
+  active_->direct.solve_raw(units_, batch_);
+  for (Eigen::Index q = 0; q < k; ++q) columns_[missing_[q]] = batch_.middleCols<3>(3 * q);
 }
 
 void WarpedFactorPreconditioner::apply(const Vec3List& r, Vec3List& z) {

@@ -41,11 +41,19 @@ class LaggedFactor {
   // (0: never). Returns true if the factor in use changed.
   bool update(const FemModel& fem, const Key& key, const BlockValues& A, const Projection& projection,
               const std::vector<Mat3>* node_rotation, int32_t interval);
+  // Factors the given system now, on the calling thread (the factored sweep's remedy when a solve
+  // with the current factor drags on). A background factorization in flight goes on, and is
+  // dropped at adoption as older than this one.
+  void refactor_now(const BlockPattern& pattern, const BlockValues& A, const Projection& projection,
+                    const std::vector<Mat3>* node_rotation);
   // out = K_f^-1 in (the factor's frame, no warping).
   void solve(const Vec3List& in, Vec3List& out) const;
   // The three columns of K_f^-1 belonging to `node` (3n x 3), kept until the factor changes: the
   // response of every node to a unit force on `node`.
   const Eigen::MatrixXd& columns(int32_t node);
+  // Computes the columns of all these nodes not yet cached, in one solve (many right-hand sides
+  // cost far less than one solve each with a supernodal factor).
+  void prepare_columns(const std::vector<int32_t>& nodes);
   // Q_i = R_i R_f,i^T: how far node i turned since the factor's step (R_i: now).
   Mat3 turn(const std::vector<Mat3>* node_rotation, int32_t i) const {
     if (!node_rotation) return Mat3::Identity();
@@ -60,8 +68,9 @@ class LaggedFactor {
     BlockValues A;            // the copy the worker factors
     Projection projection;
     std::vector<Mat3> rotation;  // R_f per node (empty: identity)
+    int64_t born = -1;           // the solve whose system it is
   };
-  void factor(Slot& slot, const FemModel& fem, const BlockValues& A, const Projection& projection,
+  void factor(Slot& slot, const BlockPattern& pattern, const BlockValues& A, const Projection& projection,
               const std::vector<Mat3>* node_rotation);
   void adopt();
 
@@ -72,6 +81,8 @@ class LaggedFactor {
   int64_t factorizations_ = 0;
   int32_t node_count_ = 0;
   mutable Eigen::MatrixXd x_;
+  Eigen::MatrixXd units_, batch_;  // prepare_columns' right-hand sides and solutions
+  std::vector<int32_t> missing_;
   std::unordered_map<int32_t, Eigen::MatrixXd> columns_;
 };
 

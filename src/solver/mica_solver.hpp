@@ -36,6 +36,9 @@ struct MicaSettings {
   // Not null (and every body coloured): the MBGS sweep runs colour by colour, a colour's nodes on
   // the pool's threads. Null: the paper's sweep in node order.
   ThreadPool* pool = nullptr;
+  // Factored sweep, co-rotational bodies: refactor the current system once a solve has used this
+  // many conjugate-gradient iterations (0: never).
+  int32_t refactor_after = 0;
 };
 
 // One body's system as the solver sees it. v holds the warm start and receives the result.
@@ -55,6 +58,7 @@ struct MicaReport : SolveReport {
   double impulse_change = 0;   // last change of lambda, relative to its scale
   double paper_change = 0;     // last 2-norm of the change of (v, lambda), the paper's test
   double momentum_residual = 0;  // last true residual, relative (see MicaSettings; NaN if never checked)
+  int32_t refactorizations = 0;  // factored sweep: factorizations of the current system during the solve
 };
 
 class MicaSolver {

@@ -270,6 +270,7 @@ void World::solve_mica(const std::vector<Body*>& dynamic, double h) {
   ms.pgs_sweeps = settings_.pgs_sweeps;
   ms.paper_norm = settings_.paper_norm;
   ms.relaxation = settings_.relaxation;
+  ms.refactor_after = settings_.refactor_after;
   if (settings_.time_budget_ms > 0)  // what the stages before the solve left of the step's budget
     ms.time_budget_ms = std::max(1e-6, settings_.time_budget_ms - std::chrono::duration<double, std::milli>(
                                                                        std::chrono::steady_clock::now() - step_start_)

@@ -44,6 +44,10 @@ struct WorldSettings {
   // many steps, factored on a background thread and adopted that many steps later (0: refactor
   // only when the step size, damping or constraint set changes).
   int32_t refactor_interval = 0;
+  // Factored sweep: a solve that has used this many conjugate-gradient iterations refactors the
+  // current system and goes on with it (about what a factorization costs on a body of some
+  // thousand nodes; 0: never).
+  int32_t refactor_after = 100;
   double time_budget_ms = 0;       // iterative solvers: > 0 stops the solve after this much wall-clock time
   bool warm_start = true;          // MICA: start from the last step's velocities and impulses (else zero)
   bool body_contact = true;        // contact between bodies (and with static bodies)

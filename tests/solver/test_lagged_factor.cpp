@@ -1,6 +1,7 @@
 // The factored sweep with a factor refreshed in the background (LaggedFactor): results do not
 // depend on when the worker finishes (lockstep adoption), a refreshed factor keeps a turning body
-// to fewer iterations than the first step's, and a changed constraint set refactors at once.
+// to fewer iterations than the first step's, a changed constraint set refactors at once, and a
+// solve that drags on refactors the current system.
 #include <chrono>
 #include <cstring>
 #include <thread>
@@ -20,11 +21,12 @@ struct Twist {
 
 // A soft cube, base fixed, its top dragged sideways (the elements turn) while a sphere presses its
 // side: rotations and contact in every step.
-Twist make_twist(int32_t refactor) {
+Twist make_twist(int32_t refactor, int32_t refactor_after = 100) {
   WorldSettings ws;
   ws.solver = SolverKind::Mica;
   ws.mica_sweep = MicaSweep::Factored;
   ws.refactor_interval = refactor;
+  ws.refactor_after = refactor_after;
   ws.tolerance = 1e-8;
   ws.max_iterations = 100000;
   ws.gravity = Vec3::Zero();
@@ -101,10 +103,37 @@ static void test_refresh_saves_iterations(void**) {
   assert_true(refreshed.iterations < frozen.iterations);
 }
 
+// A solve that drags on refactors the current system and then ends within a few iterations.
+static void test_long_solve_refactors(void**) {
+  Twist never = make_twist(0, 0), soon = make_twist(0, 8);
+  int32_t worst = 0;
+  for (int k = 0; k < 20; ++k) {
+    step(never);
+    step(soon);
+    worst = std::max(worst, soon.world->stats().solver_iterations);
+    const Vec3List& a = never.world->body(never.body).v;
+    const Vec3List& b = soon.world->body(soon.body).v;
+    double diff = 0, size = 0;
+    for (size_t i = 0; i < a.size(); ++i) {
+      diff = std::max(diff, (a[i] - b[i]).norm());
+      size = std::max(size, a[i].norm());
+    }
+    assert_true(diff <= 1e-6 * size);  // both converged to 1e-8 on the same step
+  }
+  const int64_t n = soon.world->body(soon.body).factor.factorizations();
+  print_message("20 steps: %lld iterations never refactoring, %lld refactoring after 8 (%lld factorizations, "
+                "at most %d iterations in a step)\n",
+                (long long)never.iterations, (long long)soon.iterations, (long long)n, worst);
+  assert_int_equal(never.world->body(never.body).factor.factorizations(), 1);
+  assert_true(n > 1);
+  assert_true(soon.iterations < never.iterations);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_results_do_not_depend_on_timing),
       cmocka_unit_test(test_refresh_saves_iterations),
+      cmocka_unit_test(test_long_solve_refactors),
   };
   return cmocka_run_group_tests(tests, nullptr, nullptr);
 }

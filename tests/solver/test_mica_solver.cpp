@@ -23,6 +23,7 @@ struct SceneSpec {
   struct Sweep {
     MicaSweep kind = MicaSweep::GaussSeidel;
     int32_t refactor = 0;  // factored: refresh the factor in the background every this many solves
+    int32_t refactor_after = 100;  // factored: refactor the current system once a solve used this many iterations
   } sweep;
 };
 
@@ -85,6 +86,7 @@ Vec3 compare_with_reference(const SceneSpec& spec, int steps, const Vec3& tool_v
   WorldSettings ms = settings(SolverKind::Mica, 1e-10);
   ms.mica_sweep = spec.sweep.kind;
   ms.refactor_interval = spec.sweep.refactor;
+  ms.refactor_after = spec.sweep.refactor_after;
   Scene mica{World(ms)}, exact{World(settings(SolverKind::Direct, 1e-10))};
   build(mica, spec);
   build(exact, spec);
@@ -117,9 +119,10 @@ Vec3 compare_with_reference(const SceneSpec& spec, int steps, const Vec3& tool_v
     }
     if (lmax > 0) worst_l = std::max(worst_l, ldiff / lmax);
   }
-  print_message("%s (refresh %d), %d steps: worst relative difference in v %.3g, in lambda %.3g; %d active contact-steps\n",
-                spec.sweep.kind == MicaSweep::Factored ? "factored" : "Gauss-Seidel", spec.sweep.refactor, steps,
-                worst_v, worst_l, active);
+  print_message("%s (refresh %d, refactor after %d), %d steps: worst relative difference in v %.3g, in lambda %.3g; "
+                "%d active contact-steps\n",
+                spec.sweep.kind == MicaSweep::Factored ? "factored" : "Gauss-Seidel", spec.sweep.refactor,
+                spec.sweep.refactor_after, steps, worst_v, worst_l, active);
   if (spec.tool) assert_true(active > 0);
   assert_le(worst_v, rel_tol);
   assert_le(worst_l, rel_tol);
@@ -129,8 +132,12 @@ Vec3 compare_with_reference(const SceneSpec& spec, int steps, const Vec3& tool_v
 }  // namespace
 
 // Each scene with both MICA sweeps: the paper's block Gauss-Seidel and the factored anticipation,
-// the latter with the first step's factor and with one refreshed in the background every 2 solves.
-constexpr SceneSpec::Sweep kSweeps[] = {{MicaSweep::GaussSeidel, 0}, {MicaSweep::Factored, 0}, {MicaSweep::Factored, 2}};
+// the latter with the first step's factor, with one refreshed in the background every 2 solves,
+// and with the current system refactored as soon as a solve has used 3 iterations.
+constexpr SceneSpec::Sweep kSweeps[] = {{MicaSweep::GaussSeidel, 0, 100},
+                                        {MicaSweep::Factored, 0, 100},
+                                        {MicaSweep::Factored, 2, 100},
+                                        {MicaSweep::Factored, 0, 3}};
 
 static void test_grasp_drag_matches_reference(void**) {
   for (SceneSpec::Sweep sweep : kSweeps) {

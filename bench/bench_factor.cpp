@@ -1,0 +1,86 @@
+// CHOLMOD on a body's velocity system: simplicial LDL^T against supernodal LL^T (what
+// DirectSolver and the factored sweep use), analysis, numeric factorization and solves with 1
+// and 3 right-hand sides, on a mesh file (default: the nidus mesh). The system is that of the
+// body's first step (co-rotational, E = 1e4 Pa, nu = 0.4, rho = 1000, Rayleigh alpha = 2,
+// dt = 10 ms, no constraints). Each figure is the best of 5 (factorizations) or 20 (solves).
+//
+// usage: bench_factor [mesh]
+//   OPENBLAS_NUM_THREADS=1 taskset -c 1 build/bench/bench_factor data/nidus/nidus.msh
+#include <Eigen/CholmodSupport>
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <string>
+
+#include "mesh/mesh_io.hpp"
+#include "world/world.hpp"
+
+using namespace mica;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+double ms_since(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
+
+template <class Factor>
+void time_factor(const char* name, Factor& f, const Eigen::SparseMatrix<double>& lower) {
+  auto t = Clock::now();
+  f.analyzePattern(lower);
+  const double analyse = ms_since(t);
+  double factor = 1e300, solve1 = 1e300, solve3 = 1e300;
+  for (int k = 0; k < 5; ++k) {
+    t = Clock::now();
+    f.factorize(lower);
+    factor = std::min(factor, ms_since(t));
+  }
+  const Eigen::VectorXd b = Eigen::VectorXd::Random(lower.rows());
+  const Eigen::MatrixXd B = Eigen::MatrixXd::Random(lower.rows(), 3);
+  Eigen::VectorXd x;
+  Eigen::MatrixXd X;
+  for (int k = 0; k < 20; ++k) {
+    t = Clock::now();
+    x = f.solve(b);
+    solve1 = std::min(solve1, ms_since(t));
+    t = Clock::now();
+    X = f.solve(B);
+    solve3 = std::min(solve3, ms_since(t));
+  }
+  std::printf("%-22s analyse %7.2f ms  factor %8.2f ms  solve 1 rhs %6.3f ms  3 rhs %6.3f ms  %s\n", name, analyse,
+              factor, solve1, solve3, f.info() == Eigen::Success ? "ok" : "FAILED");
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const std::string path = argc > 1 ? argv[1] : "data/nidus/nidus.msh";
+  WorldSettings ws;
+  ws.gravity = Vec3::Zero();
+  World world(ws);
+  BodySettings bs;
+  bs.material = {1e4, 0.4, 1000};
+  bs.rayleigh_alpha = 2;
+  const Id id = world.add_body(load_mesh(path), bs, Vec3::Zero(), Vec3::Zero());
+  world.step(0.01);  // assembles A
+  const Body& body = world.body(id);
+  const BlockPattern& p = body.fem.pattern;
+  std::vector<Eigen::Triplet<double>> entries;
+  for (int32_t i = 0; i < p.rows; ++i)
+    for (int32_t k = p.row_start[i]; k < p.row_start[i + 1]; ++k)
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c)
+          if (3 * i + r >= 3 * p.col[k] + c) entries.emplace_back(3 * i + r, 3 * p.col[k] + c, body.A[k](r, c));
+  Eigen::SparseMatrix<double> lower(3 * p.rows, 3 * p.rows);
+  lower.setFromTriplets(entries.begin(), entries.end());
+  std::printf("# bench_factor: %s: %d nodes (%d DOF), %zu tets; %ld stored entries (lower triangle)\n", path.c_str(),
+              p.rows, 3 * p.rows, body.tets.size(), long(lower.nonZeros()));
+  std::printf("# command: OPENBLAS_NUM_THREADS=1 taskset -c 1 build/bench/bench_factor %s\n", path.c_str());
+  {
+    Eigen::CholmodSimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Lower> f;
+    time_factor("simplicial LDL^T", f, lower);
+  }
+  {
+    Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> f;
+    time_factor("supernodal LL^T", f, lower);
+  }
+  return 0;
+}
