@@ -15,19 +15,22 @@
  * Memory: VmRSS (/proc/self/status) before and after mica_body_create_from_file, and after the
  * first step (when the solver's buffers exist), divided by the tets.
  *
- * usage: bench_nidus [mesh] [tolerance] [steps] [warm-up] [E] [dt] [gauss-seidel steps] [refactor interval]
+ * usage: bench_nidus [mesh] [tolerance] [steps] [warm-up] [E] [dt] [gauss-seidel steps] [refactor interval] [linear]
  *          defaults: data/nidus/nidus.msh 1e-6 200 40 1e4 0.01 30 4; runs MICA with the factored
  *          sweep (the first step's factor), again with the factor refreshed in the background every
  *          `refactor interval` steps (0 skips it), then with the paper's Gauss-Seidel sweep (0 steps
- *          skip it), and prints each and their ratios
+ *          skip it), and prints each and their ratios; `linear` makes the body linear (constant
+ *          stiffness: the factor is exact and never changes; the interval is then moot)
  *        bench_nidus --scaling <out.csv> [max-tets] [factored|gauss-seidel]
  *          time per step against tets on box grids (MICA's factored sweep unless told otherwise): a 0.1 m cube of n^3 cubes x 6 tets
  *          (E = 2e4 Pa, alpha = 2, gravity, base fixed), a 2 cm sphere 6 mm deep +- 3 mm at
  *          1 Hz, MICA tol 1e-6; 9 warm-up steps, then 20 timed (10 above 40k tets); 1k to 100k
  *          tets, with the memory per tet of each box.
- * Run it pinned to one core, with CHOLMOD's BLAS kept to one thread (OpenBLAS starts a worker
- * thread at load even though MICA never calls it):
- *   OPENBLAS_NUM_THREADS=1 taskset -c 1 build/bench/bench_nidus
+ * Run it with CHOLMOD's BLAS and OpenMP kept to one thread (the step runs on the calling thread;
+ * the refreshed variant adds one background thread, so leave it a second core; pin the scaling
+ * curve to one):
+ *   OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 build/bench/bench_nidus
+ *   OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 taskset -c 1 build/bench/bench_nidus --scaling out/scaling.csv
  */
 #define _GNU_SOURCE
 #include <math.h>
@@ -153,7 +156,7 @@ static int press(mica_world* world, mica_tool_id tool, const double c[3], double
 static const char* sweep_name(int32_t sweep) { return sweep == MICA_SWEEP_FACTORED ? "factored" : "gauss-seidel"; }
 
 static int nidus(const char* path, double tol, int steps, int warmup, double E, double dt, int32_t sweep,
-                 int32_t refactor, figures* result) {
+                 int32_t refactor, int32_t model, figures* result) {
   mica_world* world = NULL;
   mica_world_def wd = mica_world_def_default();
   wd.gravity[1] = 0; /* the lesion is carried by the tissue around it */
@@ -171,6 +174,7 @@ static int nidus(const char* path, double tol, int steps, int warmup, double E, 
   bd.poisson_ratio = 0.4;
   bd.density = 1000;
   bd.rayleigh_alpha = 2;
+  bd.model = model;
   figures fig;
   memset(&fig, 0, sizeof fig);
   const long rss0 = status_kb("VmRSS:");
@@ -238,8 +242,9 @@ static int nidus(const char* path, double tol, int steps, int warmup, double E, 
   printf("# mesh %s: %d nodes (%d DOF), %d tets, %.1f x %.1f x %.1f mm; held by %d nodes (lowest fifth)\n", path,
          fig.nodes, 3 * fig.nodes, fig.tets, 1e3 * (hi[0] - lo[0]), 1e3 * (hi[1] - lo[1]), 1e3 * (hi[2] - lo[2]), n);
   printf("# E = %.3g Pa, nu = 0.4, rho = 1000, alpha = 2; forceps tip: sphere R = %.1f mm, 2 mm deep +- 1 mm at 1 Hz; "
-"MICA (%s sweep, refactor_interval %d) tol %.0e, dt = %g ms; %d warm-up steps, %d timed; %ld thread(s) in the process\n",
-         E, 1e3 * R, sweep_name(sweep), refactor, tol, 1e3 * dt, warmup, steps, threads);
+"MICA (%s sweep, refactor_interval %d) tol %.0e, dt = %g ms; %s body; %d warm-up steps, %d timed; %ld thread(s) in the process\n",
+         E, 1e3 * R, sweep_name(sweep), refactor, tol, 1e3 * dt, model == MICA_MODEL_LINEAR ? "linear" : "co-rotational",
+         warmup, steps, threads);
   printf("median ms/step        %.3f\n", fig.median);
   printf("p95 ms/step           %.3f\n", fig.p95);
   printf("mean ms/step          %.3f\n", fig.mean);
@@ -263,7 +268,7 @@ static int scaling(const char* csv_path, int max_tets, int32_t sweep) {
   fprintf(csv, "# bench_nidus --scaling: %s; MICA %s sweep\n", m, sweep_name(sweep));
   fprintf(csv, "cells,nodes,tets,ms_median,ms_p95,iterations,ms_per_iteration,mem_B_per_tet,force_N\n");
   printf("# bench_nidus --scaling: %s\n", m);
-  printf("# command: OPENBLAS_NUM_THREADS=1 taskset -c 1 build/bench/bench_nidus --scaling %s %d %s\n", csv_path, max_tets,
+  printf("# command: OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 taskset -c 1 build/bench/bench_nidus --scaling %s %d %s\n", csv_path, max_tets,
          sweep_name(sweep));
   printf("%6s %8s %8s %10s %10s %10s %12s %10s\n", "cells", "nodes", "tets", "median ms", "p95 ms", "iters",
          "ms/iter", "B/tet");
@@ -342,29 +347,31 @@ int main(int argc, char** argv) {
   const double dt = argc > 6 ? atof(argv[6]) : 0.01;
   const int gs_steps = argc > 7 ? atoi(argv[7]) : 30;
   const int refactor = argc > 8 ? atoi(argv[8]) : 4;
+  const int linear = argc > 9 && strcmp(argv[9], "linear") == 0;
   if (!(tol > 0) || steps < 1 || warmup < 2 || !(E > 0) || !(dt > 0) || gs_steps < 0 || refactor < 0) {
     fprintf(stderr, "usage: bench_nidus [mesh] [tolerance] [steps] [warm-up >= 2] [E] [dt] [gauss-seidel steps] "
-                    "[refactor interval]\n");
+                    "[refactor interval] [linear]\n");
     return 2;
   }
-  printf("# command: OPENBLAS_NUM_THREADS=1 taskset -c 1 build/bench/bench_nidus %s %g %d %d %g %g %d %d\n", path, tol,
-         steps, warmup, E, dt, gs_steps, refactor);
+  printf("# command: OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 build/bench/bench_nidus %s %g %d %d %g %g %d %d%s\n", path,
+         tol, steps, warmup, E, dt, gs_steps, refactor, linear ? " linear" : "");
   /* The MICA sweeps on the same scene, one after the other in this process: the factored one
    * with the factor of the first step, then with a background refresh every `refactor` steps
    * (its worker thread runs beside the step: give the process a second core to see what it is
    * worth), and the paper's Gauss-Seidel (hundreds of times slower) over fewer steps. */
+  const int32_t model = linear ? MICA_MODEL_LINEAR : MICA_MODEL_COROTATIONAL;
   figures factored, refreshed, gs;
   printf("\n## factored sweep\n");
-  if (nidus(path, tol, steps, warmup, E, dt, MICA_SWEEP_FACTORED, 0, &factored)) return 1;
+  if (nidus(path, tol, steps, warmup, E, dt, MICA_SWEEP_FACTORED, 0, model, &factored)) return 1;
   if (refactor > 0) {
     printf("\n## factored sweep, factor refreshed every %d steps in the background\n", refactor);
-    if (nidus(path, tol, steps, warmup, E, dt, MICA_SWEEP_FACTORED, refactor, &refreshed)) return 1;
+    if (nidus(path, tol, steps, warmup, E, dt, MICA_SWEEP_FACTORED, refactor, model, &refreshed)) return 1;
     printf("\nmedian ms/step: factored %.2f, refreshed every %d steps %.2f: %.2fx\n", factored.median, refactor,
            refreshed.median, factored.median / refreshed.median);
   }
   if (gs_steps == 0) return 0;
   printf("\n## gauss-seidel sweep (the paper's)\n");
-  if (nidus(path, tol, gs_steps, warmup, E, dt, MICA_SWEEP_GAUSS_SEIDEL, 0, &gs)) return 1;
+  if (nidus(path, tol, gs_steps, warmup, E, dt, MICA_SWEEP_GAUSS_SEIDEL, 0, model, &gs)) return 1;
   printf("\nmedian ms/step: factored %.2f, gauss-seidel %.2f: %.1fx faster; target 5 ms (paper: ~100 ms)\n",
          factored.median, gs.median, gs.median / factored.median);
   return 0;

@@ -3,8 +3,8 @@
 # Output: out/study/*.csv, out/study/*.png, out/study/tables.md, out/study/logs/*.log.
 # See docs/accuracy-vs-time.md and docs/performance.md.
 #
-#   scripts/study.sh            the full study: about 11 minutes on a 2-core machine shared
-#                               with other work (a third to a half of a core for the study)
+#   scripts/study.sh            the full study: 4 minutes on a quiet 2-core machine (11 when
+#                               it shared the machine with other work, in libmica 0.2)
 #   scripts/study.sh quick      a smoke test: a few configurations of each part
 #
 # Environment: MICA_STUDY_BUILD (default ./build-study) is the CMake build folder;
@@ -16,7 +16,7 @@ build=${MICA_STUDY_BUILD:-$root/build-study}
 out=${MICA_STUDY_OUT:-$root/out/study}
 mkdir -p "$out/logs"
 rm -f "$out/logs/times.txt.new"
-export OPENBLAS_NUM_THREADS=1 # CHOLMOD's BLAS: one thread, like the library's own step
+export OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1 # CHOLMOD: BLAS and OpenMP on one thread, like the step
 start=$SECONDS
 
 # ---- build (libmica, bench_nidus, the study programs) when missing or out of date
@@ -29,7 +29,7 @@ echo "study: building in $build (log: $out/logs/build.log)"
 bin="$build/study-bin"
 mkdir -p "$bin"
 study_programs=(study_sweep study_anchors study_filter)
-if cmake --build "$build" --target help 2>/dev/null | grep -q study_sweep; then
+if cmake --build "$build" --target help 2>/dev/null | grep study_sweep >/dev/null; then  # not -q: an early exit would fail the pipe
   # bench/CMakeLists.txt has add_subdirectory(study): the targets exist.
   cmake --build "$build" -j 2 --target "${study_programs[@]}" >>"$out/logs/build.log" 2>&1
   for p in "${study_programs[@]}"; do cp "$build/bench/study/$p" "$bin/$p"; done

@@ -116,10 +116,13 @@ typedef void (*mica_log_fn)(int32_t level, const char* message, void* user);
 #define MICA_SOLVER_MICA 2   /**< MICA: constraint anticipation, PGS on contacts, modified block Gauss-Seidel */
 
 #define MICA_SWEEP_GAUSS_SEIDEL 0 /**< MICA's velocity sweep as in the paper: modified block Gauss-Seidel */
-/** MICA with a factored anticipation: the rest system's sparse Cholesky factor, warped by node
- *  rotations, preconditions the velocity solve (conjugate gradients) and gives the contact rows
- *  their compliance; far fewer iterations on stiff or fine meshes, one factorization per time
- *  step, damping and constraint set (docs/solvers.md). */
+/** MICA with a factored anticipation: a sparse Cholesky factor of a recent system (the first
+ *  step's after any change of time step, damping or constraint set), warped by node rotations,
+ *  preconditions the velocity solve (conjugate gradients) and gives the contact rows their
+ *  compliance; far fewer iterations on stiff or fine meshes. A solve that has used 100
+ *  conjugate-gradient iterations (crushed elements turning fast under a tool) refactors the
+ *  current system and ends in a few more; `refactor_interval` also refreshes the factor in the
+ *  background (docs/solvers.md). */
 #define MICA_SWEEP_FACTORED 1
 
 /** How to create a world: fill with mica_world_def_default(), then change fields. */
@@ -169,10 +172,11 @@ typedef struct mica_world_def {
    *  step, more when a step is re-linearised) the factor is refreshed from the current system:
    *  copied, factored on a background thread (one per body) while the steps go on, and used from
    *  that many solves later (in lockstep: the step waits for a late factorization, so results do
-   *  not depend on timing). The refreshed factor keeps the velocity and contact solves to a few
-   *  iterations where the rest factor's warping leaves tens. Default 0: factor only when the time
-   *  step, damping or constraint set changes. Costs a second core while it runs, and a second
-   *  factor's memory (docs/performance.md). */
+   *  not depend on timing). Meant for bodies that keep turning far from the factor's shape; on the
+   *  nidus benchmark (a tool crushing a few elements) it did not pay reliably (0.83-1.29x in
+   *  four runs, docs/performance.md).
+   *  Default 0: factor when the time step, damping or constraint set changes, and when a solve
+   *  drags on. Costs a second core while it runs, and a second factor's memory. */
   int32_t refactor_interval;
 } mica_world_def;
 
