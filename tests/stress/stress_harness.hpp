@@ -161,10 +161,14 @@ struct Case {
   char scenario = '?';
   double E = 1e4, nu = 0.3, h = 1e-2;
   SolverKind solver = SolverKind::Mica;
+  MicaSweep sweep = MicaSweep::GaussSeidel;  // MICA only
   double tol = 1e-6;
   int max_iter = 200;
+  const char* solver_label() const {
+    return solver == SolverKind::Mica && sweep == MicaSweep::Factored ? "mica-f" : solver_name(solver);
+  }
   std::string label() const {
-    return format("[%c E=%.0e nu=%g h=%g %s tol=%.0e cap=%d]", scenario, E, nu, h, solver_name(solver), tol, max_iter);
+    return format("[%c E=%.0e nu=%g h=%g %s tol=%.0e cap=%d]", scenario, E, nu, h, solver_label(), tol, max_iter);
   }
 };
 
@@ -609,7 +613,7 @@ class Csv {
     };
     const std::string scene = quote(r.scene), notes = quote(r.notes);
     std::fprintf(f_, "%c,%s,%s,%.3g,%g,%g,%.0e,%d,%d,%d,%d,%.1f,%.4g,%.4g,%.4g,%.3g,%.3g,%.4g,%.4g,%.4g,%.4g,%.4g,%d,%d,%d,%d,%d,%d,%.4g,%.4g,%.3f,%s,%s\n",
-                 r.c.scenario, scene.c_str(), solver_name(r.c.solver), r.c.E, r.c.nu, r.c.h, r.c.tol, r.c.max_iter,
+                 r.c.scenario, scene.c_str(), r.c.solver_label(), r.c.E, r.c.nu, r.c.h, r.c.tol, r.c.max_iter,
                  r.steps, r.nonconverged, r.hidden_nonconverged, r.steps ? double(r.iterations) / r.steps : 0.0, r.energy_ratio,
                  r.energy_ratio_all, r.energy_ratio_solver, r.residual, r.energy_limit, r.recovery_ratio, r.penetration, r.penetration_nonconverged, r.penetration_ref,
                  r.penetration_limit, r.max_contacts, r.max_rows, r.inverted_start, r.max_inverted, r.recovery_steps, r.recovery_budget, r.max_speed,

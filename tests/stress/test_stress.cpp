@@ -37,6 +37,7 @@ constexpr double kPenetrationLimit = 0.1;
 WorldSettings world_settings(const Case& c, const Vec3& gravity) {
   WorldSettings ws;
   ws.solver = c.solver;
+  ws.mica_sweep = c.sweep;
   ws.tolerance = c.tol;
   ws.max_iterations = c.max_iter;
   ws.gravity = gravity;
@@ -532,13 +533,14 @@ const double kSteps[] = {1e-4, 1e-3, 1e-2, 5e-2};
 
 std::vector<Case> cases_for(const Scenario& s) {
   std::vector<Case> out;
-  auto add = [&](double E, double nu, double h, SolverKind solver) {
+  auto add = [&](double E, double nu, double h, SolverKind solver, MicaSweep sweep = MicaSweep::GaussSeidel) {
     Case c;
     c.scenario = s.letter;
     c.E = E;
     c.nu = nu;
     c.h = h;
     c.solver = solver;
+    c.sweep = sweep;
     c.tol = 1e-6;
     c.max_iter = solver == SolverKind::Mica ? s.max_iter : 1;
     if (g_options.direct_only && solver != SolverKind::Direct) return;
@@ -560,6 +562,9 @@ std::vector<Case> cases_for(const Scenario& s) {
     add(1e6, 0, 5e-2, SolverKind::Mica);      // stiff, compressible, long step
     add(1e3, 0.49, 1e-4, SolverKind::Mica);   // soft, nearly incompressible, the smallest step
     add(1e6, 0.49, 1e-2, SolverKind::Direct); // the exact reference
+    // MICA's factored sweep (with its refactor on demand) at both ends of the stiffness range.
+    add(1e4, 0.3, 1e-2, SolverKind::Mica, MicaSweep::Factored);
+    add(1e9, 0.499, 5e-2, SolverKind::Mica, MicaSweep::Factored);
   }
   return out;
 }
