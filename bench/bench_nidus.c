@@ -29,8 +29,8 @@
  * Run it with CHOLMOD's BLAS and OpenMP kept to one thread (the step runs on the calling thread;
  * the refreshed variant adds one background thread, so leave it a second core; pin the scaling
  * curve to one):
- *   OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 build/bench/bench_nidus
- *   OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 taskset -c 1 build/bench/bench_nidus --scaling out/scaling.csv
+ *   OMP_THREAD_LIMIT=1 OPENBLAS_NUM_THREADS=1 build/bench/bench_nidus
+ *   OMP_THREAD_LIMIT=1 OPENBLAS_NUM_THREADS=1 taskset -c 1 build/bench/bench_nidus --scaling out/scaling.csv
  */
 #define _GNU_SOURCE
 #include <math.h>
@@ -268,7 +268,7 @@ static int scaling(const char* csv_path, int max_tets, int32_t sweep) {
   fprintf(csv, "# bench_nidus --scaling: %s; MICA %s sweep\n", m, sweep_name(sweep));
   fprintf(csv, "cells,nodes,tets,ms_median,ms_p95,iterations,ms_per_iteration,mem_B_per_tet,force_N\n");
   printf("# bench_nidus --scaling: %s\n", m);
-  printf("# command: OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 taskset -c 1 build/bench/bench_nidus --scaling %s %d %s\n", csv_path, max_tets,
+  printf("# command: OMP_THREAD_LIMIT=1 OPENBLAS_NUM_THREADS=1 taskset -c 1 build/bench/bench_nidus --scaling %s %d %s\n", csv_path, max_tets,
          sweep_name(sweep));
   printf("%6s %8s %8s %10s %10s %10s %12s %10s\n", "cells", "nodes", "tets", "median ms", "p95 ms", "iters",
          "ms/iter", "B/tet");
@@ -353,7 +353,7 @@ int main(int argc, char** argv) {
                     "[refactor interval] [linear]\n");
     return 2;
   }
-  printf("# command: OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 build/bench/bench_nidus %s %g %d %d %g %g %d %d%s\n", path,
+  printf("# command: OMP_THREAD_LIMIT=1 OPENBLAS_NUM_THREADS=1 build/bench/bench_nidus %s %g %d %d %g %g %d %d%s\n", path,
          tol, steps, warmup, E, dt, gs_steps, refactor, linear ? " linear" : "");
   /* The MICA sweeps on the same scene, one after the other in this process: the factored one
    * with the factor of the first step, then with a background refresh every `refactor` steps

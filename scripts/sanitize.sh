@@ -17,6 +17,9 @@ cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMICA_SANITIZE="
 cmake --build "$build" -j "$(nproc 2>/dev/null || echo 2)"
 # Leaks count as failures; UBSan stops at the first report (the build sets -fno-sanitize-recover).
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1 TSAN_OPTIONS=halt_on_error=1
+# OpenBLAS and OpenMP (under CHOLMOD) on the calling thread: their own worker threads are not
+# instrumented, and TSan reports their internal hand-offs as races.
+export OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1 OMP_THREAD_LIMIT=1
 export LSAN_OPTIONS="suppressions=$root/tests/lsan.supp"
 # The examples (demos at full size, already run by the main suite) would take minutes under ASan.
 ctest --test-dir "$build" --output-on-failure -j "$(nproc 2>/dev/null || echo 2)" "${select[@]}" -LE "packaging|examples"

@@ -16,7 +16,7 @@ build=${MICA_STUDY_BUILD:-$root/build-study}
 out=${MICA_STUDY_OUT:-$root/out/study}
 mkdir -p "$out/logs"
 rm -f "$out/logs/times.txt.new"
-export OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1 # CHOLMOD: BLAS and OpenMP on one thread, like the step
+export OPENBLAS_NUM_THREADS=1 OMP_THREAD_LIMIT=1 # CHOLMOD: BLAS and OpenMP on the calling thread, like the step
 start=$SECONDS
 
 # ---- build (libmica, bench_nidus, the study programs) when missing or out of date
