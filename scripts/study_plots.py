@@ -384,10 +384,10 @@ def scaling(rows, out):
     ax_i.loglog(tets, [num(r["iterations"]) for r in rows], "o-", color="tab:orange", label="iterations per step")
     ax_i2 = ax_i.twinx()
     ax_i2.loglog(tets, [1e3 * num(r["ms_per_iteration"]) / num(r["tets"]) for r in rows], "s--", color="tab:green",
-                 label="microseconds per iteration per 1000 tets")
+                 label="microseconds per iteration per tet")
     ax_i.set_xlabel("tets")
     ax_i.set_ylabel("iterations per step", color="tab:orange")
-    ax_i2.set_ylabel("us per iteration per 1000 tets", color="tab:green")
+    ax_i2.set_ylabel("us per iteration per tet", color="tab:green")
     ax_i.set_title("Where the time goes: iterations per step, cost per iteration")
     for a in (ax_t, ax_i):
         a.grid(alpha=0.3, which="both")
