@@ -175,8 +175,8 @@ MicaReport FactoredMicaSolver::solve(std::vector<MicaBody>& bodies, const std::v
   }
   lambda.resize(nr, 0.0);
   start_compliance(bodies, factored, rows, lambda);
-  bool may_refactor = settings.refactor_after > 0;
-  for (const FactoredBody& f : factored) may_refactor = may_refactor && f.node_rotation;  // else the factor is A's
+  bool may_refactor = false;  // only co-rotational bodies: a linear body's factor is its A
+  for (const FactoredBody& f : factored) may_refactor = may_refactor || (f.node_rotation && settings.refactor_after > 0);
 
   MicaReport report;
   report.converged = false;
@@ -195,8 +195,9 @@ MicaReport FactoredMicaSolver::solve(std::vector<MicaBody>& bodies, const std::v
     // then ends in a few rounds. Once per solve; the secant history belongs to the old factor.
     if (may_refactor && report.iterations >= settings.refactor_after) {
       for (size_t bi = 0; bi < nb; ++bi)
-        factored[bi].factor->refactor_now(*bodies[bi].pattern, *bodies[bi].A, *bodies[bi].projection,
-                                          factored[bi].node_rotation);
+        if (factored[bi].node_rotation)
+          factored[bi].factor->refactor_now(*bodies[bi].pattern, *bodies[bi].A, *bodies[bi].projection,
+                                            factored[bi].node_rotation);
       start_compliance(bodies, factored, rows, lambda);
       previous_inner_tolerance = 1;
       may_refactor = false;
