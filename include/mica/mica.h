@@ -174,7 +174,7 @@ typedef struct mica_world_def {
    *  that many solves later (in lockstep: the step waits for a late factorization, so results do
    *  not depend on timing). Meant for bodies that keep turning far from the factor's shape; on the
    *  nidus benchmark (a tool crushing a few elements) it did not pay reliably (0.83-1.29x in
-   *  four runs, docs/performance.md).
+   *  five runs, docs/performance.md).
    *  Default 0: factor when the time step, damping or constraint set changes, and when a solve
    *  drags on. Costs a second core while it runs, and a second factor's memory. */
   int32_t refactor_interval;
