@@ -198,6 +198,7 @@ MicaReport FactoredMicaSolver::solve(std::vector<MicaBody>& bodies, const std::v
         if (factored[bi].node_rotation)
           factored[bi].factor->refactor_now(*bodies[bi].pattern, *bodies[bi].A, *bodies[bi].projection,
                                             factored[bi].node_rotation);
+      for (size_t bi = 0; bi < nb; ++bi) warp_[bi].bind(factored[bi].factor, factored[bi].node_rotation);
       start_compliance(bodies, factored, rows, lambda);
       previous_inner_tolerance = 1;
       may_refactor = false;

@@ -44,7 +44,7 @@ void LaggedFactor::adopt() {
   columns_.clear();
 }
 
-bool LaggedFactor::update(const FemModel& fem, const Key& key, const BlockValues& A, const Projection& projection,
+void LaggedFactor::update(const FemModel& fem, const Key& key, const BlockValues& A, const Projection& projection,
                           const std::vector<Mat3>* node_rotation, int32_t interval) {
   ++step_;
   node_count_ = fem.node_count();
@@ -58,14 +58,10 @@ bool LaggedFactor::update(const FemModel& fem, const Key& key, const BlockValues
     key_ = key;
     launched_at_ = step_;  // the next refresh starts from a later step
     columns_.clear();
-    return true;
+    return;
   }
-  if (interval <= 0) return false;
-  bool changed = false;
-  if (job_.valid() && step_ - launched_at_ >= interval) {
-    adopt();
-    changed = true;
-  }
+  if (interval <= 0) return;
+  if (job_.valid() && step_ - launched_at_ >= interval) adopt();
   if (!job_.valid() && step_ > launched_at_) {
     Slot& slot = *pending_;
     if (!slot.direct.analyzed()) slot.direct.analyze(fem.pattern);
@@ -81,23 +77,12 @@ bool LaggedFactor::update(const FemModel& fem, const Key& key, const BlockValues
     ++factorizations_;
     launched_at_ = step_;
   }
-  return changed;
 }
 
 void LaggedFactor::solve(const Vec3List& in, Vec3List& out) const {
   active_->direct.solve_raw(flat(in), x_);
   out.resize(in.size());
   flat(out) = x_.col(0);
-}
-
-const Eigen::MatrixXd& LaggedFactor::columns(int32_t node) {
-  auto it = columns_.find(node);
-  if (it != columns_.end()) return it->second;
-  Eigen::MatrixXd unit = Eigen::MatrixXd::Zero(3 * node_count_, 3);
-  unit.block<3, 3>(3 * node, 0).setIdentity();
-  Eigen::MatrixXd& X = columns_[node];
-  active_->direct.solve_raw(unit, X);
-  return X;
 }
 
 void LaggedFactor::prepare_columns(const std::vector<int32_t>& nodes) {
@@ -113,18 +98,22 @@ void LaggedFactor::prepare_columns(const std::vector<int32_t>& nodes) {
   for (Eigen::Index q = 0; q < k; ++q) columns_[missing_[q]] = batch_.middleCols<3>(3 * q);
 }
 
+void WarpedFactorPreconditioner::bind(LaggedFactor* factor, const std::vector<Mat3>* node_rotation) {
+  factor_ = factor;
+  turn_.clear();
+  if (!node_rotation) return;
+  turn_.resize(node_rotation->size());
+  for (size_t i = 0; i < turn_.size(); ++i) turn_[i] = factor->turn(node_rotation, int32_t(i));
+}
+
 void WarpedFactorPreconditioner::apply(const Vec3List& r, Vec3List& z) {
-  if (!rotation_) {
+  if (turn_.empty()) {
     factor_->solve(r, z);
     return;
   }
   const size_t n = r.size();
-  turn_.resize(n);
   rotated_.resize(n);
-  for (size_t i = 0; i < n; ++i) {
-    turn_[i] = factor_->turn(rotation_, int32_t(i));
-    rotated_[i] = turn_[i].transpose() * r[i];
-  }
+  for (size_t i = 0; i < n; ++i) rotated_[i] = turn_[i].transpose() * r[i];
   factor_->solve(rotated_, z);
   for (size_t i = 0; i < n; ++i) z[i] = turn_[i] * z[i];
 }

@@ -38,8 +38,8 @@ class LaggedFactor {
   // Once per step, with this step's system A (M + h C + h^2 K of the current rotations), its
   // projection and node rotations (null: a linear body, no warping). Factors A at once when the
   // key changed; otherwise adopts and launches background factorizations every `interval` steps
-  // (0: never). Returns true if the factor in use changed.
-  bool update(const FemModel& fem, const Key& key, const BlockValues& A, const Projection& projection,
+  // (0: never).
+  void update(const FemModel& fem, const Key& key, const BlockValues& A, const Projection& projection,
               const std::vector<Mat3>* node_rotation, int32_t interval);
   // Factors the given system now, on the calling thread (the factored sweep's remedy when a solve
   // with the current factor drags on). A background factorization in flight goes on, and is
@@ -48,12 +48,12 @@ class LaggedFactor {
                     const std::vector<Mat3>* node_rotation);
   // out = K_f^-1 in (the factor's frame, no warping).
   void solve(const Vec3List& in, Vec3List& out) const;
-  // The three columns of K_f^-1 belonging to `node` (3n x 3), kept until the factor changes: the
-  // response of every node to a unit force on `node`.
-  const Eigen::MatrixXd& columns(int32_t node);
-  // Computes the columns of all these nodes not yet cached, in one solve (many right-hand sides
-  // cost far less than one solve each with a supernodal factor).
+  // Computes the columns of K_f^-1 of all these nodes not yet cached, in one solve (many
+  // right-hand sides cost far less than one solve each with a supernodal factor).
   void prepare_columns(const std::vector<int32_t>& nodes);
+  // The three columns of K_f^-1 belonging to a prepared `node` (3n x 3), kept until the factor
+  // changes: the response of every node to a unit force on `node`.
+  const Eigen::MatrixXd& columns(int32_t node) const { return columns_.at(node); }
   // Q_i = R_i R_f,i^T: how far node i turned since the factor's step (R_i: now).
   Mat3 turn(const std::vector<Mat3>* node_rotation, int32_t i) const {
     if (!node_rotation) return Mat3::Identity();
@@ -89,17 +89,14 @@ class LaggedFactor {
 // The warped preconditioner z = Q K_f^-1 Q^T r (Q per node, see LaggedFactor::turn).
 class WarpedFactorPreconditioner : public Preconditioner {
  public:
-  void bind(LaggedFactor* factor, const std::vector<Mat3>* node_rotation) {
-    factor_ = factor;
-    rotation_ = node_rotation;
-  }
+  // Takes the turns Q of the factor now in use; bind again after the factor changes.
+  void bind(LaggedFactor* factor, const std::vector<Mat3>* node_rotation);
   void apply(const Vec3List& r, Vec3List& z) override;
 
  private:
   LaggedFactor* factor_ = nullptr;
-  const std::vector<Mat3>* rotation_ = nullptr;
   Vec3List rotated_;
-  std::vector<Mat3> turn_;
+  std::vector<Mat3> turn_;  // empty: no warping (a linear body)
 };
 
 // Per node, the rotation nearest the sum of its elements' rotations (identity for a node in no
