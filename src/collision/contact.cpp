@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "collision/closest_point.hpp"
+#include "collision/core_features.hpp"
 #include "collision/tool_sweep.hpp"
 #include "collision/triangle_contact.hpp"
 
@@ -10,11 +11,20 @@ namespace mica {
 
 namespace {
 
-// Feature numbers in contact keys: nodes as they are, triangles above 2^40, edges (node pairs) with bit 63.
+// Feature numbers in contact keys: nodes as they are, triangles above 2^40, edges (node pairs,
+// smaller first) with bit 63, the swept edges of a fast tool with bit 62.
 constexpr uint64_t kTriangleFeature = uint64_t(1) << 40;
 constexpr uint64_t kEdgeFeature = uint64_t(1) << 63;
-// A triangle point this close to an edge is left to the node contacts.
-constexpr double kInteriorWeight = 1e-3;
+constexpr uint64_t kSweptEdgeFeature = uint64_t(1) << 62;
+// A pair of a body feature and of a feature of the tool's core: corners count from 0, edges from this.
+constexpr uint64_t kCoreEdgeFeatures = 1 << 16;
+
+uint64_t pair_id(uint64_t body_feature, uint64_t core_feature) {
+  return body_feature ^ (core_feature * 0x9E3779B97F4A7C15ull);  // 0 for a sphere: the body feature alone
+}
+// A barycentric weight at or below this puts a triangle's point on the edge (or corner) opposite.
+// The closest-point queries give exact zeros there; this only absorbs their rounding.
+constexpr double kOnFeature = 1e-12;
 
 BodyPoint triangle_point(int32_t body, const Tri& t, const Vec3& w) {
   BodyPoint p;
@@ -39,6 +49,47 @@ BodyPoint edge_point(int32_t body, int32_t i, int32_t j, double wi, double wj) {
   return p;
 }
 
+// The feature of triangle t (of surface triangle index tri) that the point with weights w lies
+// on: a corner (a node), an edge (its two nodes) or the face; its key feature and body point.
+struct Feature {
+  uint64_t id;
+  BodyPoint point;
+};
+
+Feature feature_of(int32_t body, int32_t tri, const Tri& t, const Vec3& w) {
+  int on[3], count = 0;  // corners with a weight
+  for (int k = 0; k < 3; ++k)
+    if (w[k] > kOnFeature) on[count++] = k;
+  if (count == 1) return {uint64_t(t[on[0]]), node_point(body, t[on[0]])};
+  if (count == 2) {
+    const int32_t i = std::min(t[on[0]], t[on[1]]), j = std::max(t[on[0]], t[on[1]]);
+    const double wi = t[on[0]] == i ? w[on[0]] : w[on[1]];
+    return {kEdgeFeature | uint64_t(j) << 32 | uint64_t(i), edge_point(body, i, j, wi, 1 - wi)};
+  }
+  return {kTriangleFeature + uint64_t(tri), triangle_point(body, t, w)};
+}
+
+// Contacts from first on that share a key (a node, an edge or a face reached from several
+// triangles, or from the node loop and a triangle) are merged into the deepest; order is kept.
+void merge_duplicate_features(std::vector<Contact>& out, size_t first) {
+  thread_local std::vector<std::pair<uint64_t, size_t>> order;  // kept: a step allocates nothing here
+  thread_local std::vector<char> drop;
+  order.clear();
+  for (size_t k = first; k < out.size(); ++k) order.push_back({out[k].key, k});
+  std::sort(order.begin(), order.end());
+  drop.assign(out.size() - first, 0);
+  for (size_t a = 0, b = 0; a < order.size(); a = b) {
+    size_t deepest = order[a].second;
+    for (b = a; b < order.size() && order[b].first == order[a].first; ++b)
+      if (out[order[b].second].gap < out[deepest].gap) deepest = order[b].second;
+    for (size_t k = a; k < b; ++k) drop[order[k].second - first] = order[k].second != deepest;
+  }
+  size_t kept = first;
+  for (size_t k = first; k < out.size(); ++k)
+    if (!drop[k - first]) out[kept++] = out[k];
+  out.resize(kept);
+}
+
 Vec3 tool_point_velocity(const Tool& tool, const Vec3& p) {
   return tool.velocity + tool.angular_velocity.cross(p - tool.position);
 }
@@ -56,6 +107,14 @@ void collide_tool(const Tool& tool, int32_t tool_index, uint64_t tool_key, const
   const ToolSweep sweep(tool);
   const bool swept = sweep.moved() && tool.shape != ToolShape::Plane;
   const Vec3List& x = *body.x;
+  const size_t first = out.size();
+  const bool rounded = tool.shape == ToolShape::Sphere || tool.shape == ToolShape::Capsule;
+  // A contact of the body point p; pair is the feature pair's id (the contact's key).
+  auto emit = [&](uint64_t pair, const BodyPoint& p, const Vec3& normal, const Vec3& point, double gap) -> Contact& {
+    out.push_back(Contact{contact_key(tool_key, body.key, pair), tool_index, p, BodyPoint{}, normal, point, gap,
+                          tool.friction, tool_point_velocity(tool, point)});
+    return out.back();
+  };
   // The nodes the tool went past (their start side and the nearest-point normal disagree), in
   // ascending order as body.nodes; kept between calls so that a step allocates nothing here.
   thread_local std::vector<int32_t> passed_nodes;
@@ -73,9 +132,11 @@ void collide_tool(const Tool& tool, int32_t tool_index, uint64_t tool_key, const
       if (met && side.normal.dot(s.normal) < 0) passed_nodes.push_back(node);
       if (side.gap >= margin) continue;
     }
-    out.push_back(Contact{contact_key(tool_key, body.key, uint64_t(node)), tool_index, node_point(body.index, node),
-                          BodyPoint{}, side.normal, x[node], side.gap, tool.friction,
-                          tool_point_velocity(tool, x[node])});
+    // A rounded core (sphere, capsule) has no face for a node to meet: a node that is a
+    // triangle's closest point gets that pair's contact below, and one that is not lies behind
+    // its triangles' contacts. Only a node kept on its start side needs its own.
+    if (rounded && side.normal == s.normal && side.gap == s.distance) continue;
+    emit(uint64_t(node), node_point(body.index, node), side.normal, x[node], side.gap);
   }
   if (tool.shape == ToolShape::Plane) return;  // a plane's deepest point on a triangle is a node
   auto passed = [&](int32_t n) { return std::binary_search(passed_nodes.begin(), passed_nodes.end(), n); };
@@ -84,6 +145,8 @@ void collide_tool(const Tool& tool, int32_t tool_index, uint64_t tool_key, const
     SideContact side;
     return !node_start_side(tool, sweep, x[n], side);
   };
+  thread_local ToolCore core;  // kept: a step allocates nothing here
+  tool_core(tool, core);
   body.bvh->query(reach, [&](int32_t tri) {
     const Tri& t = (*body.triangles)[tri];
     // Edges from a node the tool went past to one beside its path (each edge once: from the
@@ -98,47 +161,59 @@ void collide_tool(const Tool& tool, int32_t tool_index, uint64_t tool_key, const
       double wj = 0;
       SideContact side;
       if (!edge_start_side(tool, sweep, x[i], x[j], wj, side) || side.gap >= margin) continue;
-      const Vec3 point = (1 - wj) * x[i] + wj * x[j];
-      out.push_back(Contact{contact_key(tool_key, body.key, kEdgeFeature | uint64_t(j) << 32 | uint64_t(i)),
-                            tool_index, edge_point(body.index, i, j, 1 - wj, wj), BodyPoint{}, side.normal, point,
-                            side.gap, tool.friction, tool_point_velocity(tool, point)});
+      emit(kSweptEdgeFeature | uint64_t(j) << 32 | uint64_t(i), edge_point(body.index, i, j, 1 - wj, wj), side.normal,
+           (1 - wj) * x[i] + wj * x[j], side.gap);
     }
-    TriangleHit hit;
-    if (!collide_triangle(tool, x[t[0]], x[t[1]], x[t[2]], margin, hit)) return;
-    bool swept_through = false;  // the tool met the triangle in the step, or now lies across it
-    if (swept && hit.normal.dot(hit.point - sweep.start_relative(hit.point)) > 0) {
-      // As for the nodes; a triangle whose start side is undecided is left to its nodes.
-      TriangleHit side;
-      double t_touch = 0;
-      if (triangle_start_side(tool, sweep, x[t[0]], x[t[1]], x[t[2]], side, t_touch)) {
-        swept_through = t_touch > 0 || side.normal.dot(hit.normal) < 0;
-        hit = side;
-      } else if (hit.gap < 0) {
-        return;
+    const Vec3 corner[3] = {x[t[0]], x[t[1]], x[t[2]]};
+    const Vec3 face = (corner[1] - corner[0]).cross(corner[2] - corner[0]).normalized();
+    int side_known = 0;  // the triangle's side at the step's start: 0 not looked for, 1 found, -1 undecided
+    TriangleHit side;
+    // A feature pair's hit (weights over the triangle's corners) as a contact of body point p.
+    auto add = [&](FeatureHit hit, uint64_t pair, const BodyPoint& p, int32_t core_corner, int32_t core_edge) {
+      orient_by_surface(body.normals->at(tri, t, hit.weights, face), core.radius, body.depth, hit);
+      if (!(hit.gap < margin)) return;
+      if (swept && hit.normal.dot(hit.point - sweep.start_relative(hit.point)) > 0) {
+        // As for the nodes: keep the body point on the side of the tool it was on at the start.
+        if (side_known == 0) {
+          double t_touch = 0;
+          side_known = triangle_start_side(tool, sweep, corner[0], corner[1], corner[2], side, t_touch) ? 1 : -1;
+        }
+        if (side_known < 0 && hit.gap < 0) return;  // undecided: left to the nodes
+        if (side_known > 0) {
+          hit.normal = side.normal;
+          hit.gap = side.gap + side.normal.dot(hit.point - side.point);
+        }
+        if (!(hit.gap < margin)) return;
       }
-      if (hit.gap >= margin) return;
+      Contact& c = emit(pair, p, hit.normal, hit.point, hit.gap);
+      c.triangle = tri;
+      c.core_corner = core_corner;
+      c.core_edge = core_edge;
+    };
+    // Orienting a hit by the surface may only lower its gap: a pair farther than margin plus the
+    // rounding is out of reach either way.
+    const double out_of_reach = margin + core.radius;
+    for (int32_t k = 0; k < int32_t(core.corners.size()); ++k) {
+      FeatureHit hit;
+      if (!corner_triangle(core.corners[k], core.radius, corner[0], corner[1], corner[2], hit) ||
+          !(hit.gap < out_of_reach))
+        continue;
+      const Feature f = feature_of(body.index, tri, t, hit.weights);
+      add(hit, pair_id(f.id, k), f.point, k, -1);
     }
-    int corner = 0;  // of the smallest weight
-    hit.weights.minCoeff(&corner);
-    if (hit.weights[corner] > kInteriorWeight) {
-      out.push_back(Contact{contact_key(tool_key, body.key, kTriangleFeature + uint64_t(tri)), tool_index,
-                            triangle_point(body.index, t, hit.weights), BodyPoint{}, hit.normal, hit.point, hit.gap,
-                            tool.friction, tool_point_velocity(tool, hit.point)});
-      return;
-    }
-    // On an edge the tool swept into (or now lies across): the edge's nodes may lie on either side
-    // of the tool's path, and the edge between them must not end across it (otherwise, as at
-    // rest, an edge is left to its nodes). The two nodes share the contact, made once: by the
-    // triangle that has the edge as (i, j) with i < j (each edge of a closed surface appears once
-    // each way round).
-    const int32_t i = t[(corner + 1) % 3], j = t[(corner + 2) % 3];
-    const double wi = hit.weights[(corner + 1) % 3], wj = hit.weights[(corner + 2) % 3];
-    if (!swept_through || i > j || std::min(wi, wj) <= kInteriorWeight) return;
-    out.push_back(Contact{contact_key(tool_key, body.key, kEdgeFeature | uint64_t(i) << 32 | uint64_t(j)), tool_index,
-                          edge_point(body.index, i, j, wi, wj), BodyPoint{}, hit.normal, hit.point, hit.gap,
-                          tool.friction, tool_point_velocity(tool, hit.point)});  // key (i, j), i < j: the
-                                                                                   // edge's other contact has (j, i)
+    for (int32_t k = 0; k < int32_t(core.edges.size()); ++k)
+      for (int e = 0; e < 3; ++e) {
+        const int32_t i = std::min(t[e], t[(e + 1) % 3]), j = std::max(t[e], t[(e + 1) % 3]);
+        FeatureHit hit;
+        if (!edge_edge(core.corners[core.edges[k][0]], core.corners[core.edges[k][1]], core.radius, x[i], x[j], hit) ||
+            !(hit.gap < out_of_reach))
+          continue;
+        const BodyPoint p = edge_point(body.index, i, j, hit.weights[0], hit.weights[1]);
+        for (int c = 0; c < 3; ++c) hit.weights[c] = t[c] == i ? p.weights[0] : t[c] == j ? p.weights[1] : 0.0;
+        add(hit, pair_id(kEdgeFeature | uint64_t(j) << 32 | uint64_t(i), kCoreEdgeFeatures + k), p, -1, k);
+      }
   });
+  merge_duplicate_features(out, first);
 }
 
 void collide_bodies(const SurfaceView& a, const SurfaceView& b, double margin_at_rest, double friction,

@@ -28,6 +28,12 @@ struct Contact {
   double gap;        // m, signed distance at the start of the step (negative: penetrating)
   double friction;   // Coulomb coefficient, 0 for none
   Vec3 other_velocity = Vec3::Zero();  // m/s: a tool's velocity at the point (friction sticks to it)
+  // A tool's contact between a feature of its core and of a body triangle (core_features.hpp):
+  // the triangle, and the core's corner (against the triangle) or edge (against a triangle edge,
+  // the body point's two nodes); -1 for a node's contact and between bodies.
+  int32_t triangle = -1;
+  int32_t core_corner = -1;
+  int32_t core_edge = -1;
 };
 
 inline BodyPoint node_point(int32_t body, int32_t node) {
@@ -57,9 +63,10 @@ struct SurfaceView {
   double travel;                    // m, how far a node may move this step (h times the top speed; 0 when static)
 };
 
-// Tool against a body: a contact for each surface node closer to the tool than its margin,
-// and one for each triangle whose closest point to the tool lies inside the face (there the
-// nodes alone would let the tool slip between them). Speculative: the margin grows by how
+// Tool against a body: a contact for each surface node closer to the tool than its margin, and
+// one for each pair of a feature of the tool's core and of a surface triangle closer than that
+// (core_features.hpp: core corners against triangles, core edges against triangle edges), so
+// that no point of the surface goes uncovered; a pair reached from two triangles is made once. Speculative: the margin grows by how
 // far the tool and the body can travel in the step (h), so a fast approach is caught before it
 // crosses; the constraint keeps the true gap, so the sides may close it but not cross it.
 // Swept: the tool is at its new pose, and where it moved past a node or a triangle in the step

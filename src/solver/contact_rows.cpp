@@ -33,7 +33,7 @@ void ContactRows::build(const std::vector<Contact>& contacts, double h, double m
     normal_of.push_back(normal_row);
     mu.push_back(friction);
     contact.push_back(int32_t(c));
-    key.push_back(ct.key * 3 + kind);
+    key.push_back(normal_row_key(ct.key) + kind);
   };
   for (size_t c = 0; c < contacts.size(); ++c) {
     const Contact& ct = contacts[c];

@@ -24,6 +24,8 @@ struct ContactRows {
   std::vector<uint64_t> key;      // persistent key of the row (contact key and row kind)
 
   size_t size() const { return direction.size(); }
+  // The key of a contact's normal row (its friction rows follow with + 1 and + 2).
+  static uint64_t normal_row_key(uint64_t contact_key) { return contact_key * 3; }
   void clear();
   // Rows of all contacts; normal rows get normal_bias.
   void build(const std::vector<Contact>& contacts, double h, double max_recovery_speed);

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "collision/contact_curvature.hpp"
 #include "world/world.hpp"
 
 namespace mica {
@@ -165,6 +166,33 @@ void World::assemble_elements(Body& b, double h, bool damping) const {
     b.factor_current = false;
   }
   b.matrix_rebuilt = rebuild;
+  add_contact_stiffness(b, h);
+}
+
+void World::add_contact_stiffness(Body& b, double h) const {
+  // h^2 K_c with K_c = F (-H)+ per contact of a rounded tool on a triangle, F the contact's force
+  // in the last step (this step's force is the unknown: the lag keeps the system linear).
+  const auto it = std::find(dynamic_.begin(), dynamic_.end(), &b);
+  if (it == dynamic_.end()) return;
+  const int32_t index = int32_t(it - dynamic_.begin());
+  thread_local ToolCore core;  // kept: a step allocates nothing here
+  int32_t core_of = -1;
+  for (const Contact& c : contacts_) {
+    if (c.tool < 0 || c.triangle < 0 || c.a.body != index) continue;
+    const auto last = warm_start_.find(ContactRows::normal_row_key(c.key));
+    if (last == warm_start_.end() || !(last->second > 0)) continue;
+    if (core_of != c.tool) tool_core(*step_tools_[size_t(c.tool)], core);
+    core_of = c.tool;
+    const Tri& t = b.surface[size_t(c.triangle)];
+    Mat9 K;
+    if (!contact_curvature(core, c, t, b.x, K)) continue;
+    K *= h * last->second;  // h^2 F
+    for (int r = 0; r < 3; ++r)
+      for (int s = 0; s < 3; ++s) b.A[size_t(b.fem.pattern.find(t[r], t[s]))] += K.block<3, 3>(3 * r, 3 * s);
+    // A linear body keeps A between steps: this one is not its plain matrix any more.
+    b.matrix_current = false;
+    b.factor_current = false;
+  }
 }
 
 void World::add_damping(Body& b, double h) const {

@@ -172,6 +172,7 @@ class World {
   void apply_loads(Body& b) const;
   void assemble_elements(Body& b, double h, bool damping) const;
   void add_damping(Body& b, double h) const;
+  void add_contact_stiffness(Body& b, double h) const;
   void build_projection(Body& b, double h) const;
   void form_rhs(Body& b, double h) const;
   void solve_velocities(Body& b, double h);
