@@ -2,8 +2,9 @@
 // gravity slides with the textbook acceleration g (sin theta - mu cos theta) whichever tangent
 // direction it slides along (a box bound per tangent row gave mu sqrt 2 on the diagonal: 41 %
 // too slow), and sticks when tan theta <= mu. Then the cases the box-bounded exact solver failed
-// (sweep limit, MICA_ERR_NUMERICAL): a one-tet body under a sphere with friction 1 and 10, and a
-// sphere pressed into and pulled out of a soft cube with friction 0.3 (sphere_indent's scene).
+// (sweep limit, MICA_ERR_NUMERICAL) or that need the cone on redundant contacts: a one-tet body
+// under a sphere with friction 1 and 10, and a sphere pressed into and pulled out of a soft cube
+// with friction 0.3 (sphere_indent's scene).
 #include "test_util.hpp"
 
 using namespace mica;
@@ -116,35 +117,40 @@ static void test_incline_sticks_below_the_friction_angle(void**) {
     }
 }
 
-// One tet (E = 1e5 Pa) fixed at its base, a sphere pressing its apex and dragging sideways, with
-// friction 1 and 10: the box-bounded exact solve hit its 1e6-sweep limit in 3 of 5 steps (every
-// step with 10). Every solver converges in every step.
+// One tet (E = 1e5 Pa) held at its lower apex, a large sphere pressing its horizontal top face
+// and dragging sideways, with friction 1 and 10: a face contact and the three corner contacts on
+// the same three nodes (W singular). The exact solve and the factored sweep converge in every
+// step. (The paper's Gauss-Seidel MICA does not converge on this scene, with the box as with
+// the cone: its residual stays at 0.3 after 1e5 iterations; not asserted here.)
 static void test_one_tet_under_a_sphere(void**) {
-  for (const SolverCase& solver : kSolvers)
+  for (const SolverCase& solver : {kSolvers[2], kSolvers[1]})
     for (double friction : {1.0, 10.0}) {
       WorldSettings ws = world_settings(solver);
       ws.gravity = Vec3(0, -9.81, 0);
       World world(ws);
+      // The top face horizontal at y = 0.02 under the sphere, the apex below it held.
       TetMesh tet;
-      tet.nodes = {Vec3(0, 0, 0), Vec3(0.02, 0, 0), Vec3(0, 0, 0.02), Vec3(0.005, 0.02, 0.005)};
-      tet.tets = {{0, 2, 1, 3}};
-      if (signed_volume(tet.nodes[0], tet.nodes[2], tet.nodes[1], tet.nodes[3]) < 0) tet.tets = {{0, 1, 2, 3}};
+      tet.nodes = {Vec3(0, 0.02, 0), Vec3(0.02, 0.02, 0), Vec3(0, 0.02, 0.02), Vec3(0.005, 0, 0.005)};
+      tet.tets = {{0, 1, 2, 3}};
+      if (signed_volume(tet.nodes[0], tet.nodes[1], tet.nodes[2], tet.nodes[3]) < 0) tet.tets = {{0, 2, 1, 3}};
       BodySettings bs;
       bs.material = {1e5, 0.3, 1000};
       const Id body = world.add_body(tet, bs, Vec3::Zero(), Vec3::Zero());
-      world.add_lpc(body, {0, 1, 2}, LpcSpec{});
+      world.add_lpc(body, {3}, LpcSpec{});
       Tool sphere;
-      sphere.radius = 0.01;
+      sphere.radius = 0.05;
       sphere.margin = 1e-3;
       sphere.friction = friction;
-      sphere.position = Vec3(0.005, 0.02 + 0.01 - 0.001, 0.005);
+      sphere.position = Vec3(0.007, 0.02 + 0.05 + 0.0005, 0.007);
       const Id tool = world.add_tool(sphere);
       int active = 0, sweeps = 0;
       for (int k = 0; k < 5; ++k) {
-        const Vec3 p = world.tool(tool).position + Vec3(0.002, -0.0005, 0.001);
+        const Vec3 p = world.tool(tool).position + Vec3(0.001, -0.001, 0.0005);
         world.set_tool_pose(tool, p, Eigen::Quaterniond::Identity());
         world.step(0.01);
-        if (!world.stats().converged) fail_msg("%s, friction %g: step %d did not converge", solver.name, friction, k);
+        if (!world.stats().converged)
+          fail_msg("%s, friction %g: step %d did not converge (%d iterations, residual %.3g)", solver.name, friction, k,
+                   int(world.stats().solver_iterations), world.stats().solver_residual);
         active += world.tool(tool).contact_count;
         sweeps += world.stats().solver_iterations;
         assert_true(world.tool(tool).force.allFinite());
