@@ -40,7 +40,8 @@ void ContactRows::build(const std::vector<Contact>& contacts, double h, double m
     const int32_t normal_row = int32_t(direction.size());
     add_row(c, ct.normal, normal_bias(ct, h, max_recovery_speed), -1, 0.0, 0);
     if (ct.friction <= 0) continue;
-    // Any orthonormal tangent pair: the box bounds make friction isotropic enough for PGS.
+    // Any orthonormal tangent pair: the cone is isotropic. Right after the normal row, t1 then t2
+    // (the layout the solvers rely on, contact_rows.hpp).
     const Vec3 t1 = ct.normal.unitOrthogonal(), t2 = ct.normal.cross(t1);
     // Sticking moves the body point with the tool: t . v = t . v_tool.
     add_row(c, t1, -t1.dot(ct.other_velocity), normal_row, ct.friction, 1);

@@ -1,5 +1,8 @@
 // The rows of G: each contact's normal row and, with friction, two tangent rows. A row is a
 // velocity component  sum_k coef_k d . v(body_k, node_k)  over the nodes of the touching points.
+// Layout the solvers rely on: a contact's normal row comes first, its two tangent rows (if any)
+// right after it, t1 then t2; the tangent pair is projected together onto the friction disk
+// |(lambda_t1, lambda_t2)| <= mu lambda_n (friction_cone.hpp).
 #pragma once
 #include <vector>
 
@@ -26,6 +29,8 @@ struct ContactRows {
   size_t size() const { return direction.size(); }
   // The key of a contact's normal row (its friction rows follow with + 1 and + 2).
   static uint64_t normal_row_key(uint64_t contact_key) { return contact_key * 3; }
+  // Row r is the first tangent row of its contact (its pair is r, r + 1).
+  bool first_tangent(size_t r) const { return normal_of[r] >= 0 && size_t(normal_of[r]) + 1 == r; }
   void clear();
   // Rows of all contacts; normal rows get normal_bias.
   void build(const std::vector<Contact>& contacts, double h, double max_recovery_speed);

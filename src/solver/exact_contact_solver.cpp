@@ -4,13 +4,14 @@
 #include <cmath>
 
 #include "core/error.hpp"
-#include "solver/lcp.hpp"
+#include "solver/frictional_contact.hpp"
 
 namespace mica {
 
-
 SolveReport solve_contact_delassus(std::vector<ExactBody>& bodies, const ContactRows& rows, std::vector<double>& lambda,
-                                   std::vector<double>& diagonal) {
+                                   std::vector<double>& diagonal, const ExactContactSettings& settings) {
+  if (settings.warm_start && settings.warm_start->size() != rows.size())
+    fail(Errc::InvalidArgument, "solve_contact_delassus: the warm start needs one impulse per row");
   const size_t nb = bodies.size(), nr = rows.size();
   SolveReport linear;
   auto record = [&linear](const SolveReport& r) {
@@ -65,7 +66,7 @@ SolveReport solve_contact_delassus(std::vector<ExactBody>& bodies, const Contact
   }
   const Eigen::Index nk = Eigen::Index(kept.size());
   Eigen::MatrixXd Wk(nk, nk);
-  Eigen::VectorXd qk(nk), mu(nk);
+  Eigen::VectorXd qk(nk), mu(nk), warm(settings.warm_start ? nk : 0);
   std::vector<int32_t> normal_of(kept.size());
   bool friction = false;
   for (Eigen::Index i = 0; i < nk; ++i) {
@@ -75,18 +76,33 @@ SolveReport solve_contact_delassus(std::vector<ExactBody>& bodies, const Contact
     const int32_t n = rows.normal_of[kept[i]];
     normal_of[i] = n < 0 ? -1 : kept_at[n];
     friction = friction || normal_of[i] >= 0;
+    if (settings.warm_start) warm[i] = (*settings.warm_start)[size_t(kept[i])];
   }
-  // Without friction the LCP is solved exactly by Lemke's pivoting; friction's box bounds by
-  // projected Gauss-Seidel on the exact W, to round-off.
-  const LcpSolution sol = friction ? solve_box_lcp_pgs(Wk, qk, mu, normal_of, 1e-14, 1000000) : solve_lcp_lemke(Wk, qk);
-  if (!sol.solved || !sol.z.allFinite())
-    fail(Errc::Numerical, "the exact contact solve failed: " + sol.message);
-  Eigen::VectorXd l = Eigen::VectorXd::Zero(Eigen::Index(nr));
-  for (Eigen::Index i = 0; i < nk; ++i) l[kept[i]] = sol.z[i];
+  // Without friction the LCP is solved exactly by Lemke's pivoting; with friction (not an LCP:
+  // the cone's radius moves with the normal impulse) by block Gauss-Seidel over the contacts,
+  // each contact's Coulomb problem solved exactly, to round-off.
   SolveReport report = linear;
-  const double complementarity =
-      friction ? box_lcp_error(Wk, qk, mu, normal_of, sol.z) : complementarity_error(Wk, qk, sol.z);
-  if (!(complementarity <= report.residual)) report.residual = complementarity;
+  Eigen::VectorXd z;
+  double error = 0;
+  if (friction) {
+    FrictionalSettings fs;
+    fs.deadline = settings.deadline;
+    const FrictionalSolution sol = solve_frictional_contact(Wk, qk, mu, normal_of, warm, fs);
+    if (!sol.z.allFinite()) fail(Errc::Numerical, "the exact frictional contact solve failed: " + sol.message);
+    z = sol.z;
+    error = sol.scale > 0 ? sol.error / sol.scale : sol.error;
+    report.iterations += sol.sweeps;
+    report.converged = report.converged && sol.solved;  // unsolved: reported, not thrown
+    report.out_of_time = report.out_of_time || sol.out_of_time;
+  } else {
+    const LcpSolution sol = solve_lcp_lemke(Wk, qk);
+    if (!sol.solved || !sol.z.allFinite()) fail(Errc::Numerical, "the exact contact solve failed: " + sol.message);
+    z = sol.z;
+    error = complementarity_error(Wk, qk, z);
+  }
+  Eigen::VectorXd l = Eigen::VectorXd::Zero(Eigen::Index(nr));
+  for (Eigen::Index i = 0; i < nk; ++i) l[kept[i]] = z[i];
+  if (!(error <= report.residual)) report.residual = error;
   lambda.assign(l.data(), l.data() + l.size());
   // v = v_free + A^-1 G^T lambda, and the impulses per node.
   for (size_t bi = 0; bi < nb; ++bi) bodies[bi].contact_impulse.assign(bodies[bi].v->size(), Vec3::Zero());

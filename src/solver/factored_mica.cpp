@@ -1,6 +1,7 @@
 #include "solver/factored_mica.hpp"
 
-#include "solver/lcp.hpp"
+#include "solver/friction_cone.hpp"
+#include "solver/frictional_contact.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -19,15 +20,6 @@ const Mat3& projector(const MicaBody& body, int32_t i) {
 Mat3 rotation(const FactoredBody& f, int32_t i) { return f.factor->turn(f.node_rotation, i); }
 
 }  // namespace
-
-void FactoredMicaSolver::project(const ContactRows& rows, size_t r, std::vector<double>& lambda) const {
-  if (rows.normal_of[r] < 0) {
-    lambda[r] = std::max(0.0, lambda[r]);
-  } else {
-    const double bound = rows.mu[r] * lambda[rows.normal_of[r]];
-    lambda[r] = std::clamp(lambda[r], -bound, bound);
-  }
-}
 
 void FactoredMicaSolver::build_compliance(const std::vector<MicaBody>& bodies,
                                           const std::vector<FactoredBody>& factored, const ContactRows& rows) {
@@ -71,8 +63,10 @@ void FactoredMicaSolver::start_compliance(const std::vector<MicaBody>& bodies,
   for (size_t r = 0; r < nr; ++r) {
     if (W_(r, r) > 1e-12 * w_max) diag_[r] = warped_diag_[r] = W_(r, r);
     else lambda[r] = 0;  // nothing can move along this row
-    project(rows, r, lambda);
   }
+  for (size_t r = 0; r < nr; ++r)  // the warm start onto the cones
+    if (rows.normal_of[r] < 0) lambda[r] = std::max(lambda[r], 0.0);
+    else if (rows.first_tangent(r)) project_onto_disk(rows.mu[r] * lambda[rows.normal_of[r]], lambda[r], lambda[r + 1]);
 }
 
 void FactoredMicaSolver::apply_impulse_change(std::vector<MicaBody>& bodies,
@@ -96,62 +90,76 @@ void FactoredMicaSolver::apply_impulse_change(std::vector<MicaBody>& bodies,
   }
 }
 
-void FactoredMicaSolver::solve_small_lcp(const ContactRows& rows, double tolerance, const std::vector<double>& lambda) {
+void FactoredMicaSolver::solve_small_lcp(const ContactRows& rows, double tolerance, const std::vector<double>& lambda,
+                                         const std::optional<std::chrono::steady_clock::time_point>& deadline) {
   const size_t nr = rows.size();
   lambda_next_ = lambda;
-  // Frictionless: Lemke's pivoting on the rows something can move along, exact (PGS on a few
-  // strongly coupled rows, contacts sharing nodes, would crawl and stop far from the answer).
+  // The rows something can move along; a tangent row only with its normal row.
+  live_.clear();
+  live_at_.assign(nr, -1);
   bool friction = false;
-  for (size_t r = 0; r < nr; ++r) friction = friction || rows.normal_of[r] >= 0;
-  if (!friction) {
-    live_.clear();
-    for (size_t r = 0; r < nr; ++r)
-      if (diag_[r] > 0) live_.push_back(int32_t(r));
-    const Eigen::Index n = Eigen::Index(live_.size());
-    Eigen::MatrixXd M(n, n);
-    Eigen::VectorXd q(n);
-    for (Eigen::Index a = 0; a < n; ++a) {
-      q(a) = w_[live_[a]];
-      for (Eigen::Index b = 0; b < n; ++b) {
-        M(a, b) = W_(live_[a], live_[b]);
-        q(a) -= M(a, b) * lambda[live_[b]];
-      }
+  for (size_t r = 0; r < nr; ++r)
+    if (diag_[r] > 0 && (rows.normal_of[r] < 0 || live_at_[rows.normal_of[r]] >= 0)) {
+      live_at_[r] = int32_t(live_.size());
+      live_.push_back(int32_t(r));
+      friction = friction || rows.normal_of[r] >= 0;
     }
-    const LcpSolution sol = solve_lcp_lemke(M, q);
+  const Eigen::Index n = Eigen::Index(live_.size());
+  small_M_.resize(n, n);
+  small_q_.resize(n);
+  for (Eigen::Index a = 0; a < n; ++a) {
+    small_q_(a) = w_[live_[a]];
+    for (Eigen::Index b = 0; b < n; ++b) {
+      small_M_(a, b) = W_(live_[a], live_[b]);
+      small_q_(a) -= small_M_(a, b) * lambda[live_[b]];
+    }
+  }
+  // Frictionless: Lemke's pivoting, exact (PGS on a few strongly coupled rows, contacts sharing
+  // nodes, would crawl and stop far from the answer).
+  if (!friction) {
+    const LcpSolution sol = solve_lcp_lemke(small_M_, small_q_);
     if (sol.solved) {
       for (Eigen::Index a = 0; a < n; ++a) lambda_next_[live_[a]] = sol.z(a);
       return;
     }
   }
-  // With friction (a box LCP whose bounds move with the normal impulses), or if pivoting failed:
-  // projected Gauss-Seidel, to well below the tolerance.
-  for (int sweep = 0; sweep < 10000; ++sweep) {
-    double change = 0, size = 0;
-    for (size_t r = 0; r < nr; ++r) {
-      if (diag_[r] == 0) continue;
-      double res = w_[r];
-      for (size_t s = 0; s < nr; ++s) res += W_(r, s) * (lambda_next_[s] - lambda[s]);
-      const double before = lambda_next_[r];
-      lambda_next_[r] -= res / W_(r, r);
-      project(rows, r, lambda_next_);
-      change = std::max(change, std::abs(lambda_next_[r] - before));
-      size = std::max(size, std::abs(lambda_next_[r]));
-    }
-    if (change <= 1e-3 * tolerance * size || size == 0) break;
+  // With friction (or if pivoting failed): block Gauss-Seidel over the contacts with the exact
+  // local Coulomb solve, from lambda, to well below the tolerance.
+  small_mu_.resize(n);
+  small_normal_.resize(size_t(n));
+  small_start_.resize(n);
+  for (Eigen::Index a = 0; a < n; ++a) {
+    const int32_t r = live_[a];
+    small_mu_(a) = rows.mu[r];
+    small_normal_[size_t(a)] = rows.normal_of[r] < 0 ? -1 : live_at_[rows.normal_of[r]];
+    small_start_(a) = lambda[r];
   }
+  FrictionalSettings fs;
+  fs.tolerance = std::max(1e-3 * tolerance, 1e-13);
+  fs.deadline = deadline;
+  const FrictionalSolution sol = solve_frictional_contact(small_M_, small_q_, small_mu_, small_normal_, small_start_, fs);
+  for (Eigen::Index a = 0; a < n; ++a) lambda_next_[live_[a]] = sol.z(a);
 }
 
 double FactoredMicaSolver::complementarity_error(const ContactRows& rows, const std::vector<double>& lambda) {
-  // Per row the natural residual lambda - proj(lambda - w / W0_rr), with the warped compliance's
-  // own diagonal W0 (not the secant-updated one): the test does not trust what it learned.
+  // Per contact the natural residual lambda - P(lambda - rho w) (the normal row onto lambda_n >= 0,
+  // the tangent pair onto the disk of mu lambda_n), rho = 1 / the warped compliance's own diagonal
+  // W0 (not the secant-updated one: the test does not trust what it learned), one rho for both
+  // tangent rows (a step per row would bend the slip direction the test accepts).
   double e2 = 0;
-  probe_ = lambda;
   for (size_t r = 0; r < rows.size(); ++r) {
-    if (diag_[r] == 0) continue;
-    probe_[r] = lambda[r] - w_[r] / warped_diag_[r];
-    project(rows, r, probe_);
-    e2 += (probe_[r] - lambda[r]) * (probe_[r] - lambda[r]);
-    probe_[r] = lambda[r];
+    if (rows.normal_of[r] < 0) {
+      if (diag_[r] == 0) continue;
+      const double next = std::max(0.0, lambda[r] - w_[r] / warped_diag_[r]);
+      e2 += (next - lambda[r]) * (next - lambda[r]);
+    } else if (rows.first_tangent(r)) {
+      const double largest = std::max(diag_[r] > 0 ? warped_diag_[r] : 0.0, diag_[r + 1] > 0 ? warped_diag_[r + 1] : 0.0);
+      if (largest == 0) continue;
+      double t[2];
+      for (int k = 0; k < 2; ++k) t[k] = diag_[r + k] > 0 ? lambda[r + k] - w_[r + k] / largest : lambda[r + k];
+      project_onto_disk(rows.mu[r] * std::max(lambda[rows.normal_of[r]], 0.0), t[0], t[1]);
+      for (int k = 0; k < 2; ++k) e2 += (t[k] - lambda[r + k]) * (t[k] - lambda[r + k]);
+    }
   }
   return std::sqrt(e2);
 }
@@ -268,7 +276,7 @@ MicaReport FactoredMicaSolver::solve(std::vector<MicaBody>& bodies, const std::v
     }
     w_prev_ = w_;
     previous_inner_tolerance = inner_tolerance;
-    solve_small_lcp(rows, settings.tolerance, lambda);
+    solve_small_lcp(rows, settings.tolerance, lambda, deadline);
     dlambda_.resize(nr);
     double dl2 = 0, l2 = 0;
     for (size_t r = 0; r < nr; ++r) {

@@ -10,6 +10,8 @@
 //    velocities then follow the impulse change through the same columns.
 // With P = A the loop would end after one correction; the rotations' mismatch costs a few more.
 #pragma once
+#include <chrono>
+#include <optional>
 #include <vector>
 
 #include "solver/mica_solver.hpp"
@@ -40,10 +42,10 @@ class FactoredMicaSolver {
   // v += S Q K_f^-1 Q^T S G^T dlambda, through the cached columns.
   void apply_impulse_change(std::vector<MicaBody>& bodies, const std::vector<FactoredBody>& factored,
                             const ContactRows& rows, const std::vector<double>& dlambda);
-  void project(const ContactRows& rows, size_t r, std::vector<double>& lambda) const;
-  // lambda_next_ solves the LCP on W around lambda: 0 <= lambda_next _|_ w + W (lambda_next - lambda) >= 0
-  // (box bounds on friction rows).
-  void solve_small_lcp(const ContactRows& rows, double tolerance, const std::vector<double>& lambda);
+  // lambda_next_ solves the contact problem on W around lambda: 0 <= lambda_next _|_ w + W (lambda_next - lambda) >= 0
+  // on normal rows, Coulomb's cone on tangent pairs (frictional_contact.hpp).
+  void solve_small_lcp(const ContactRows& rows, double tolerance, const std::vector<double>& lambda,
+                       const std::optional<std::chrono::steady_clock::time_point>& deadline);
 
   std::vector<PcgSolver> pcg_;
   std::vector<WarpedFactorPreconditioner> warp_;
@@ -51,8 +53,11 @@ class FactoredMicaSolver {
   std::vector<Vec3> term_force_;                      // per row term: coef Q_i^T S_i d (the factor's frame)
   Eigen::MatrixXd W_;                                 // G P^-1 G^T
   std::vector<double> w_, w_prev_, lambda_next_, dlambda_, diag_;
-  std::vector<int32_t> live_, contact_nodes_;
-  std::vector<double> warped_diag_, probe_;  // W_rr before the secant updates; scratch
+  std::vector<int32_t> live_, live_at_, contact_nodes_;
+  Eigen::MatrixXd small_M_;                           // W on the live rows
+  Eigen::VectorXd small_q_, small_mu_, small_start_;
+  std::vector<int32_t> small_normal_;
+  std::vector<double> warped_diag_;  // W_rr before the secant updates
   // Of the current lambda against the current row velocities w_ (N s).
   double complementarity_error(const ContactRows& rows, const std::vector<double>& lambda);
   std::vector<Vec3List> rhs_;

@@ -7,6 +7,7 @@
 #include <limits>
 
 #include "core/error.hpp"
+#include "solver/friction_cone.hpp"
 
 namespace mica {
 
@@ -268,14 +269,21 @@ LcpSolution solve_lcp_pgs(const Eigen::MatrixXd& M, const Eigen::VectorXd& q, do
   return s;
 }
 
-namespace {
-
-void check_box(const Eigen::MatrixXd& M, const Eigen::VectorXd& q, const Eigen::VectorXd& mu,
-               const std::vector<int32_t>& normal_index, const char* who) {
+std::vector<ConeContact> cone_contacts(const Eigen::MatrixXd& M, const Eigen::VectorXd& q, const Eigen::VectorXd& mu,
+                                       const std::vector<int32_t>& normal_index, const char* who) {
   check_problem(M, q, who);
   const Eigen::Index n = q.size();
   if (mu.size() != n || Eigen::Index(normal_index.size()) != n)
     fail(Errc::InvalidArgument, std::string(who) + ": mu and normal_index need one entry per row");
+  std::vector<ConeContact> contacts;
+  std::vector<int32_t> contact_of(size_t(n), -1);
+  for (Eigen::Index r = 0; r < n; ++r) {
+    if (!(M(r, r) > 0))
+      fail(Errc::InvalidArgument, std::string(who) + ": row " + std::to_string(r) + " has no positive diagonal");
+    if (normal_index[size_t(r)] >= 0) continue;
+    contact_of[size_t(r)] = int32_t(contacts.size());
+    contacts.push_back({int32_t(r), {-1, -1}, 0.0});
+  }
   for (Eigen::Index r = 0; r < n; ++r) {
     const int32_t nr = normal_index[size_t(r)];
     if (nr < 0) continue;
@@ -284,60 +292,45 @@ void check_box(const Eigen::MatrixXd& M, const Eigen::VectorXd& q, const Eigen::
                                       " must name a normal row, not " + std::to_string(nr));
     if (!(mu(r) >= 0.0) || !std::isfinite(mu(r)))
       fail(Errc::InvalidArgument, std::string(who) + ": mu of row " + std::to_string(r) + " must be finite and >= 0");
+    ConeContact& c = contacts[size_t(contact_of[size_t(nr)])];
+    if (c.tangent[1] >= 0)
+      fail(Errc::InvalidArgument, std::string(who) + ": normal row " + std::to_string(nr) + " has a third friction row");
+    if (c.tangent[0] >= 0 && mu(r) != c.mu)
+      fail(Errc::InvalidArgument, std::string(who) + ": the friction rows of normal row " + std::to_string(nr) +
+                                      " have different mu");
+    c.tangent[c.tangent[0] >= 0 ? 1 : 0] = int32_t(r);
+    c.mu = mu(r);
   }
+  return contacts;
 }
 
-// Bounds of row r at the current z: [0, inf) for a normal row, +-mu z_n for a friction row
-// (z_n below 0 only occurs in foreign iterates; it counts as 0).
-std::pair<double, double> row_bounds(const Eigen::VectorXd& mu, const std::vector<int32_t>& normal_index,
-                                     const Eigen::VectorXd& z, Eigen::Index r) {
-  const int32_t nr = normal_index[size_t(r)];
-  if (nr < 0) return {0.0, std::numeric_limits<double>::infinity()};
-  const double b = mu(r) * std::max(0.0, z(nr));
-  return {-b, b};
-}
-
-}  // namespace
-
-double box_lcp_error(const Eigen::MatrixXd& M, const Eigen::VectorXd& q, const Eigen::VectorXd& mu,
-                     const std::vector<int32_t>& normal_index, const Eigen::VectorXd& z) {
-  check_box(M, q, mu, normal_index, "box_lcp_error");
-  if (z.size() != q.size()) fail(Errc::InvalidArgument, "box_lcp_error: z needs one entry per row");
-  const Eigen::VectorXd w = M * z + q;
+double cone_error(const Eigen::MatrixXd& M, const std::vector<ConeContact>& contacts, const Eigen::VectorXd& z,
+                  const Eigen::VectorXd& w) {
   double error = 0.0;
-  for (Eigen::Index r = 0; r < z.size(); ++r) {
-    const auto [lo, hi] = row_bounds(mu, normal_index, z, r);
-    error = std::max(error, std::fabs(z(r) - std::clamp(z(r) - w(r), lo, hi)));
+  for (const ConeContact& c : contacts) {
+    double rho_inv = M(c.normal, c.normal);
+    for (int32_t t : c.tangent)
+      if (t >= 0) rho_inv = std::max(rho_inv, M(t, t));
+    const double rho = 1.0 / rho_inv;
+    double n = z(c.normal) - rho * w(c.normal);
+    double t[2] = {0, 0};
+    for (int k = 0; k < 2; ++k)
+      if (c.tangent[k] >= 0) t[k] = z(c.tangent[k]) - rho * w(c.tangent[k]);
+    n = std::max(n, 0.0);
+    project_onto_disk(c.mu * std::max(z(c.normal), 0.0), t[0], t[1]);  // the disk of z, not of the step
+    double e2 = std::pow(z(c.normal) - n, 2);
+    for (int k = 0; k < 2; ++k)
+      if (c.tangent[k] >= 0) e2 += std::pow(z(c.tangent[k]) - t[k], 2);
+    if (!(std::sqrt(e2) <= error)) error = std::sqrt(e2);  // a NaN shows
   }
   return error;
 }
 
-LcpSolution solve_box_lcp_pgs(const Eigen::MatrixXd& M, const Eigen::VectorXd& q, const Eigen::VectorXd& mu,
-                              const std::vector<int32_t>& normal_index, double tol, int32_t max_sweeps) {
-  check_box(M, q, mu, normal_index, "solve_box_lcp_pgs");
-  if (!(tol >= 0.0) || max_sweeps < 0)
-    fail(Errc::InvalidArgument, "solve_box_lcp_pgs: need tol >= 0 and max_sweeps >= 0");
-  const Eigen::Index n = q.size();
-  const Eigen::MatrixXd Mt = M.transpose();
-
-  LcpSolution s;
-  s.z = Eigen::VectorXd::Zero(n);
-  double error = box_lcp_error(M, q, mu, normal_index, s.z);
-  while (error > tol && s.pivots < max_sweeps) {
-    for (Eigen::Index r = 0; r < n; ++r) {
-      const double d = M(r, r);
-      if (!(d > 0.0)) continue;
-      const double w_r = Mt.col(r).dot(s.z) + q(r);
-      const auto [lo, hi] = row_bounds(mu, normal_index, s.z, r);
-      s.z(r) = std::clamp(s.z(r) - w_r / d, lo, hi);
-    }
-    ++s.pivots;
-    error = box_lcp_error(M, q, mu, normal_index, s.z);
-  }
-  s.w = M * s.z + q;
-  s.solved = error <= tol;
-  s.message = sweep_message(s.solved, s.pivots, "box complementarity error", error);
-  return s;
+double cone_error(const Eigen::MatrixXd& M, const Eigen::VectorXd& q, const Eigen::VectorXd& mu,
+                  const std::vector<int32_t>& normal_index, const Eigen::VectorXd& z) {
+  const std::vector<ConeContact> contacts = cone_contacts(M, q, mu, normal_index, "cone_error");
+  if (z.size() != q.size()) fail(Errc::InvalidArgument, "cone_error: z needs one entry per row");
+  return cone_error(M, contacts, z, M * z + q);
 }
 
 }  // namespace mica

@@ -3,8 +3,9 @@
 //     z >= 0,   w = M z + q >= 0,   z_r w_r = 0 for every row r.
 // Lemke's method is the exact reference (a finite pivoting method, lexicographic so that
 // degenerate problems such as redundant contacts do not cycle); projected Gauss-Seidel is the
-// iterative one, also for the box LCP of contacts with Coulomb friction. Meant for small
-// problems (tens to a few hundred rows): everything is dense.
+// iterative one. Meant for small problems (tens to a few hundred rows): everything is dense.
+// Contact with Coulomb friction is not an LCP; its residual is here (cone_error), its solver in
+// frictional_contact.hpp.
 #pragma once
 #include <Eigen/Dense>
 #include <cstdint>
@@ -33,25 +34,37 @@ LcpSolution solve_lcp_lemke(const Eigen::MatrixXd& M, const Eigen::VectorXd& q, 
 // solved, once complementarity_error(M, q, z) <= tol; else after max_sweeps.
 LcpSolution solve_lcp_pgs(const Eigen::MatrixXd& M, const Eigen::VectorXd& q, double tol, int32_t max_sweeps);
 
-// Box LCP of frictional contact. Row r is a normal row when normal_index[r] < 0, with
-//     z_r >= 0, w_r >= 0, z_r w_r = 0;
-// otherwise a friction row bounded by its normal row n = normal_index[r] (itself a normal row):
-//     -mu[r] z_n <= z_r <= mu[r] z_n, and
-//     w_r = 0 when z_r is strictly inside the bounds, w_r >= 0 at the lower bound,
-//     w_r <= 0 at the upper bound (when the bounds meet, z_r = 0 and w_r is free).
-// mu is read on friction rows only (mu[r] >= 0). The bounds move with z_n, so this is not a
-// plain LCP; PGS uses the current z_n for each friction row. Stops, solved, once
-// box_lcp_error <= tol; else after max_sweeps. Rows with M_rr <= 0 are skipped.
-LcpSolution solve_box_lcp_pgs(const Eigen::MatrixXd& M, const Eigen::VectorXd& q, const Eigen::VectorXd& mu,
-                              const std::vector<int32_t>& normal_index, double tol, int32_t max_sweeps);
-
 // Plain LCP: max over rows of max(-z_r, -w_r, |z_r w_r|) with w = M z + q; 0 for n = 0.
 double complementarity_error(const Eigen::MatrixXd& M, const Eigen::VectorXd& q, const Eigen::VectorXd& z);
 
-// Box LCP: max over rows of the natural residual |z_r - mid(lo_r, z_r - w_r, hi_r)|, with
-// lo = 0, hi = +inf on normal rows and lo = -mu z_n, hi = mu z_n on friction rows; it is 0
-// exactly when the conditions of solve_box_lcp_pgs hold.
-double box_lcp_error(const Eigen::MatrixXd& M, const Eigen::VectorXd& q, const Eigen::VectorXd& mu,
-                     const std::vector<int32_t>& normal_index, const Eigen::VectorXd& z);
+// Frictional contact with the isotropic Coulomb cone (friction_cone.hpp). Row r is a normal row
+// when normal_index[r] < 0; otherwise a friction row of the contact whose normal row is
+// n = normal_index[r] (itself a normal row); a contact has at most two friction rows, its
+// tangents, which carry the same mu (mu is read on friction rows only, mu >= 0). With w = M z + q
+// the conditions are, per contact c:
+//     0 <= z_n  _|_  w_n >= 0,   |z_t| <= mu z_n,   and w_t = -beta z_t with beta >= 0 when
+//     |z_t| = mu z_n > 0, w_t = 0 when |z_t| < mu z_n (z_t: the pair of tangent impulses).
+// Returns the largest natural residual |z_c - P_c(z_c - rho_c w_c)| (2-norm over the contact's
+// rows), P_c the cone projection with the disk's radius mu max(z_n, 0) from z itself and
+// rho_c = 1 / the largest diagonal entry of M on the contact's rows (so the residual is an
+// impulse, N s for a Delassus matrix); it is 0 exactly when the conditions hold (for any
+// rho_c > 0). Throws Error(InvalidArgument) on mismatched sizes, a non-finite entry, a friction
+// row that does not name a normal row, a third friction row, unequal mu on one contact, or a
+// non-positive diagonal entry.
+double cone_error(const Eigen::MatrixXd& M, const Eigen::VectorXd& q, const Eigen::VectorXd& mu,
+                  const std::vector<int32_t>& normal_index, const Eigen::VectorXd& z);
+
+// The contacts of such a problem: per contact its normal row, its friction rows (-1: absent) and mu.
+// Validated as cone_error says (which throws on what this throws on).
+struct ConeContact {
+  int32_t normal;
+  int32_t tangent[2];
+  double mu;
+};
+std::vector<ConeContact> cone_contacts(const Eigen::MatrixXd& M, const Eigen::VectorXd& q, const Eigen::VectorXd& mu,
+                                       const std::vector<int32_t>& normal_index, const char* who);
+// cone_error on validated contacts; w = M z + q given.
+double cone_error(const Eigen::MatrixXd& M, const std::vector<ConeContact>& contacts, const Eigen::VectorXd& z,
+                  const Eigen::VectorXd& w);
 
 }  // namespace mica

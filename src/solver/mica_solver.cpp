@@ -5,6 +5,8 @@
 #include <cmath>
 #include <limits>
 
+#include "solver/friction_cone.hpp"
+
 namespace mica {
 
 namespace {
@@ -38,13 +40,27 @@ double MicaSolver::anticipated_velocity(const std::vector<MicaBody>& bodies, con
   return c;
 }
 
-// Normal rows: lambda >= 0; friction rows: |lambda| <= mu lambda_normal.
-void MicaSolver::project(const ContactRows& rows, size_t r, std::vector<double>& lambda) const {
-  if (rows.normal_of[r] < 0) {
-    lambda[r] = std::max(0.0, lambda[r]);
-  } else {
-    const double bound = rows.mu[r] * lambda[rows.normal_of[r]];
-    lambda[r] = std::clamp(lambda[r], -bound, bound);
+// The PGS update of a contact's tangent pair, rows r and r + 1 (ContactRows' layout): one
+// projected gradient step on the pair's quadratic, lambda_t <- P_disk(lambda_t - alpha w_t),
+// with one step length for both rows. Its fixed point is the Coulomb law (w_t opposes lambda_t
+// when on the rim); a step per row (1 / B_rr each) would bend the slip direction wherever
+// B_t1t1 != B_t2t2. alpha = 1 / (max B_tt + |B_t1t2|) is at most 1 / the pair's largest eigenvalue
+// (Gershgorin): each step lowers the pair's energy, as a row's PGS update does.
+void MicaSolver::update_tangents(const ContactRows& rows, size_t r, std::vector<double>& lambda) {
+  double before[2], w[2];
+  for (int k = 0; k < 2; ++k) {
+    const size_t row = r + size_t(k);
+    before[k] = lambda[row];
+    w[k] = c_[row];
+    for (int32_t t = rows.start[row]; t < rows.start[row + 1]; ++t)
+      w[k] += rows.terms[t].coef * rows.direction[row].dot(u_[rows.terms[t].body][rows.terms[t].node]);
+    if (diag_[row] > 0) lambda[row] -= pair_step_[r] * w[k];
+  }
+  project_onto_disk(rows.mu[r] * lambda[rows.normal_of[r]], lambda[r], lambda[r + 1]);
+  for (int k = 0; k < 2; ++k) {
+    const size_t row = r + size_t(k);
+    for (int32_t t = rows.start[row]; t < rows.start[row + 1]; ++t)
+      u_[rows.terms[t].body][rows.terms[t].node] += g_[t] * (lambda[row] - before[k]);
   }
 }
 
@@ -116,10 +132,23 @@ MicaReport MicaSolver::solve(std::vector<MicaBody>& bodies, const ContactRows& r
     // A row whose nodes cannot move along it (B_rr ~ 0: fixed nodes) carries no impulse.
     if (!(diag_[r] > 1e-12 * scale)) diag_[r] = 0;
   }
+  pair_step_.assign(nr, 0.0);
   for (size_t r = 0; r < nr; ++r) {
-    if (diag_[r] == 0) lambda[r] = 0;
-    project(rows, r, lambda);
+    if (!rows.first_tangent(r)) continue;
+    double coupling = 0;  // B_t1t2: the terms of the two rows on one node
+    for (int32_t t = rows.start[r]; t < rows.start[r + 1]; ++t)
+      for (int32_t u = rows.start[r + 1]; u < rows.start[r + 2]; ++u)
+        if (rows.terms[t].body == rows.terms[u].body && rows.terms[t].node == rows.terms[u].node)
+          coupling += rows.terms[t].coef * rows.direction[r].dot(g_[u]);
+    if (diag_[r] == 0 || diag_[r + 1] == 0) coupling = 0;  // a row nothing moves along takes no step
+    const double largest = std::max(diag_[r], diag_[r + 1]) + std::abs(coupling);
+    if (largest > 0) pair_step_[r] = 1 / largest;
   }
+  for (size_t r = 0; r < nr; ++r)
+    if (diag_[r] == 0) lambda[r] = 0;
+  for (size_t r = 0; r < nr; ++r)  // the warm start onto the cones
+    if (rows.normal_of[r] < 0) lambda[r] = std::max(lambda[r], 0.0);
+    else if (rows.first_tangent(r)) project_onto_disk(rows.mu[r] * lambda[rows.normal_of[r]], lambda[r], lambda[r + 1]);
   for (size_t r = 0; r < nr; ++r)
     for (int32_t t = rows.start[r]; t < rows.start[r + 1]; ++t)
       u_[rows.terms[t].body][rows.terms[t].node] += g_[t] * lambda[r];
@@ -153,16 +182,20 @@ MicaReport MicaSolver::solve(std::vector<MicaBody>& bodies, const ContactRows& r
     lambda_old_ = lambda;
     // Anticipate: each row's velocity from the current v, without contact.
     for (size_t r = 0; r < nr; ++r) c_[r] = anticipated_velocity(bodies, rows, r);
-    // Projected Gauss-Seidel on lambda with B = G Dt^-1 G^T (B couples rows sharing a node).
+    // Projected Gauss-Seidel on lambda with B = G Dt^-1 G^T (B couples rows sharing a node): a
+    // normal row onto lambda >= 0, a contact's tangent pair together onto its friction disk.
     for (int32_t sweep = 0; sweep < settings.pgs_sweeps; ++sweep)
       for (size_t r = 0; r < nr; ++r) {
+        if (rows.normal_of[r] >= 0) {
+          if (rows.first_tangent(r)) update_tangents(rows, r++, lambda);  // r + 1 done with it
+          continue;
+        }
         if (diag_[r] == 0) continue;
         double w = c_[r];
         for (int32_t t = rows.start[r]; t < rows.start[r + 1]; ++t)
           w += rows.terms[t].coef * rows.direction[r].dot(u_[rows.terms[t].body][rows.terms[t].node]);
         const double before = lambda[r];
-        lambda[r] -= w / diag_[r];
-        project(rows, r, lambda);
+        lambda[r] = std::max(0.0, lambda[r] - w / diag_[r]);
         for (int32_t t = rows.start[r]; t < rows.start[r + 1]; ++t)
           u_[rows.terms[t].body][rows.terms[t].node] += g_[t] * (lambda[r] - before);
       }

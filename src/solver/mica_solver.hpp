@@ -2,7 +2,7 @@
 // One loop resolves projection constraints and contact together:
 //
 //   A v = b + G^T lambda,   (I - S) v = z,   0 <= lambda_n  _|_  G_n v + gap / h >= 0,
-//   |lambda_t| <= mu lambda_n (Coulomb friction, box bounds per tangent row)
+//   |lambda_t| <= mu lambda_n (isotropic Coulomb friction: a contact's two tangent impulses on a disk)
 //
 // Each iteration anticipates the contact velocities from the current v with the filtered
 // block-diagonal inverse Dt^-1 = S (S D S + I - S)^-1 S, updates lambda by projected
@@ -76,11 +76,12 @@ class MicaSolver {
  private:
   void coloured_sweep(std::vector<MicaBody>& bodies, double relaxation, ThreadPool& pool, double& dv2, double& v2);
   double anticipated_velocity(const std::vector<MicaBody>& bodies, const ContactRows& rows, size_t r) const;
-  void project(const ContactRows& rows, size_t r, std::vector<double>& lambda) const;
+  void update_tangents(const ContactRows& rows, size_t r, std::vector<double>& lambda);
 
   std::vector<std::vector<Mat3>> inv_diag_;  // per body, per node: Dt_i^-1
   std::vector<Vec3> g_;                      // per row term: coef Dt^-1 d
   std::vector<double> diag_, c_;             // per row: B_rr, anticipated velocity
+  std::vector<double> pair_step_;            // per first tangent row: the tangent pair's step length
   std::vector<std::vector<Vec3>> u_;         // per body, per node: Dt^-1 G^T lambda
   std::vector<double> lambda_old_;
   std::vector<std::array<double, 2>> block_sums_;  // coloured sweep: |dv|^2 and |v|^2 per block, in sweep order

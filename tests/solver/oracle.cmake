@@ -1,8 +1,15 @@
-# Siconos numerics, the independent oracle of tests/solver/test_lcp_oracle.cpp: a test-only
-# dependency (Debian: libsiconos-numerics-dev). Included by tests/CMakeLists.txt after the
-# core test targets exist. Without Siconos the test still builds, exits with 77, and ctest
-# reports it as skipped instead of failing the build.
-if(NOT TARGET solver_test_lcp_oracle)
+# Siconos numerics, the independent oracle of tests/solver/test_lcp_oracle.cpp (Lemke) and
+# tests/solver/test_frictional_contact_oracle.cpp (fc3d): a test-only dependency (Debian:
+# libsiconos-numerics-dev). Included by tests/CMakeLists.txt after the core test targets exist.
+# Without Siconos the tests still build, exit with 77, and ctest reports them as skipped
+# instead of failing the build.
+set(MICA_ORACLE_TESTS)
+foreach(name lcp_oracle frictional_contact_oracle)
+  if(TARGET solver_test_${name})
+    list(APPEND MICA_ORACLE_TESTS ${name})
+  endif()
+endforeach()
+if(NOT MICA_ORACLE_TESTS)
   return()
 endif()
 
@@ -13,14 +20,20 @@ find_path(MICA_SICONOS_CONFIG_INCLUDE_DIR NAMES SiconosConfig.h PATH_SUFFIXES si
 find_library(MICA_SICONOS_NUMERICS_LIBRARY NAMES siconos_numerics)
 
 if(MICA_SICONOS_NUMERICS_INCLUDE_DIR AND MICA_SICONOS_CONFIG_INCLUDE_DIR AND MICA_SICONOS_NUMERICS_LIBRARY)
-  message(STATUS "LCP oracle test: Siconos numerics at ${MICA_SICONOS_NUMERICS_LIBRARY}")
-  target_include_directories(solver_test_lcp_oracle SYSTEM PRIVATE
-                             ${MICA_SICONOS_NUMERICS_INCLUDE_DIR} ${MICA_SICONOS_CONFIG_INCLUDE_DIR})
-  target_link_libraries(solver_test_lcp_oracle PRIVATE ${MICA_SICONOS_NUMERICS_LIBRARY})
-  target_compile_definitions(solver_test_lcp_oracle PRIVATE MICA_HAVE_SICONOS=1)
+  message(STATUS "Oracle tests: Siconos numerics at ${MICA_SICONOS_NUMERICS_LIBRARY}")
+  foreach(name ${MICA_ORACLE_TESTS})
+    target_include_directories(solver_test_${name} SYSTEM PRIVATE
+                               ${MICA_SICONOS_NUMERICS_INCLUDE_DIR} ${MICA_SICONOS_CONFIG_INCLUDE_DIR})
+    target_link_libraries(solver_test_${name} PRIVATE ${MICA_SICONOS_NUMERICS_LIBRARY})
+    target_compile_definitions(solver_test_${name} PRIVATE MICA_HAVE_SICONOS=1)
+  endforeach()
 else()
-  message(STATUS "LCP oracle test: Siconos numerics not found (install libsiconos-numerics-dev); "
-                 "solver/test_lcp_oracle will be skipped")
-  target_compile_definitions(solver_test_lcp_oracle PRIVATE MICA_HAVE_SICONOS=0)
+  message(STATUS "Oracle tests: Siconos numerics not found (install libsiconos-numerics-dev); "
+                 "solver/test_lcp_oracle and solver/test_frictional_contact_oracle will be skipped")
+  foreach(name ${MICA_ORACLE_TESTS})
+    target_compile_definitions(solver_test_${name} PRIVATE MICA_HAVE_SICONOS=0)
+  endforeach()
 endif()
-set_tests_properties(solver/test_lcp_oracle PROPERTIES SKIP_RETURN_CODE 77)
+foreach(name ${MICA_ORACLE_TESTS})
+  set_tests_properties(solver/test_${name} PROPERTIES SKIP_RETURN_CODE 77)
+endforeach()

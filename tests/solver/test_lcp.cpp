@@ -1,6 +1,6 @@
 // The dense LCP solvers: Lemke on hand-solved and random problems (positive definite,
 // positive semidefinite and singular as with redundant contacts, infeasible), projected
-// Gauss-Seidel against Lemke, and the box LCP of friction.
+// Gauss-Seidel against Lemke. (Friction, which is not an LCP: test_frictional_contact.cpp.)
 #include "solver/lcp.hpp"
 #include "solver/lcp_problems.hpp"
 #include "test_util.hpp"
@@ -215,77 +215,6 @@ static void test_bad_input_throws(void**) {
   assert_true(throws_invalid([] { solve_lcp_lemke(Eigen::MatrixXd::Identity(1, 1), vec({NAN})); }));
   assert_true(throws_invalid([] { solve_lcp_lemke(Eigen::MatrixXd::Identity(1, 1), vec({-1}), -1); }));
   assert_true(throws_invalid([] { solve_lcp_pgs(Eigen::MatrixXd::Identity(1, 1), vec({-1}), -1.0, 10); }));
-  // A friction row must name a normal row.
-  assert_true(throws_invalid([] {
-    solve_box_lcp_pgs(Eigen::MatrixXd::Identity(2, 2), vec({-1, 0}), vec({0, 0.5}), {1, 0}, 1e-12, 10);
-  }));
-  assert_true(throws_invalid([] {
-    solve_box_lcp_pgs(Eigen::MatrixXd::Identity(2, 2), vec({-1, 0}), vec({0, -0.5}), {-1, 0}, 1e-12, 10);
-  }));
-}
-
-// The box conditions checked row by row, with a tolerance, independently of box_lcp_error.
-void expect_box_conditions(const Eigen::MatrixXd& M, const Eigen::VectorXd& q, const Eigen::VectorXd& mu,
-                           const std::vector<int32_t>& normal, const Eigen::VectorXd& z, double tol) {
-  const Eigen::VectorXd w = M * z + q;
-  for (Eigen::Index r = 0; r < z.size(); ++r) {
-    if (normal[size_t(r)] < 0) {
-      assert_le(-z(r), tol);
-      assert_le(-w(r), tol);
-      assert_le(std::min(z(r), w(r)), tol);
-      continue;
-    }
-    const double b = mu(r) * z(normal[size_t(r)]);
-    assert_le(std::fabs(z(r)), b + tol);
-    if (z(r) > -b + tol && z(r) < b - tol) assert_le(std::fabs(w(r)), tol);
-    if (z(r) <= -b + tol && b > tol) assert_le(-w(r), tol);  // at the lower bound
-    if (z(r) >= b - tol && b > tol) assert_le(w(r), tol);    // at the upper bound
-  }
-}
-
-static void test_box_lcp_friction(void**) {
-  const std::vector<int32_t> normal = {-1, 0, 0};
-  const Eigen::VectorXd mu = vec({0, 0.5, 0.5});
-  {  // M = I: z_n = 1; a small tangential load sticks, a large one slides at mu z_n
-    const Eigen::VectorXd q = vec({-1, -0.2, 2});
-    const LcpSolution s = solve_box_lcp_pgs(Eigen::MatrixXd::Identity(3, 3), q, mu, normal, 1e-14, 100);
-    assert_true(s.solved);
-    expect_vector(s.z, vec({1, 0.2, -0.5}), 1e-14);
-    expect_vector(s.w, vec({0, 0, 1.5}), 1e-14);  // at the lower bound, w >= 0
-    assert_le(box_lcp_error(Eigen::MatrixXd::Identity(3, 3), q, mu, normal, s.z), 1e-14);
-  }
-  {  // separating contact: no normal impulse, so no friction either
-    const LcpSolution s =
-        solve_box_lcp_pgs(Eigen::MatrixXd::Identity(3, 3), vec({1, -3, 3}), mu, normal, 1e-14, 100);
-    assert_true(s.solved);
-    expect_vector(s.z, vec({0, 0, 0}), 0);
-  }
-  {  // only normal rows: the plain LCP, same answer as Lemke
-    const Problem p = spd(12, 99);
-    const LcpSolution box = solve_box_lcp_pgs(p.M, p.q, Eigen::VectorXd::Zero(12), std::vector<int32_t>(12, -1),
-                                              1e-14, 1000000);
-    assert_true(box.solved);
-    assert_le(relative_difference(box.z, lemke_solves(p.M, p.q).z), 1e-8);
-  }
-  // Random 3D contacts (normal, two tangents), coupled through an SPD M.
-  for (int32_t contacts : {1, 2, 5, 10})
-    for (uint32_t seed = 1; seed <= 3; ++seed) {
-      const int32_t n = 3 * contacts;
-      Problem p = spd(n, 300u * uint32_t(contacts) + seed);
-      Rng rng(seed);
-      std::vector<int32_t> normal_of(size_t(n), -1);
-      Eigen::VectorXd mus = Eigen::VectorXd::Zero(n);
-      for (int32_t c = 0; c < contacts; ++c) {
-        p.q(3 * c) = -std::fabs(p.q(3 * c)) - 0.1;  // pressing
-        for (int32_t t : {1, 2}) {
-          normal_of[size_t(3 * c + t)] = 3 * c;
-          mus(3 * c + t) = rng.uniform(0, 1);
-        }
-      }
-      const LcpSolution s = solve_box_lcp_pgs(p.M, p.q, mus, normal_of, 1e-12, 1000000);
-      if (!s.solved) fail_msg("%d contacts: %s", contacts, s.message.c_str());
-      expect_box_conditions(p.M, p.q, mus, normal_of, s.z, 1e-10);
-    }
 }
 
 int main(void) {
@@ -300,7 +229,6 @@ int main(void) {
       cmocka_unit_test(test_pgs_skips_rows_without_diagonal),
       cmocka_unit_test(test_no_solution_is_reported),
       cmocka_unit_test(test_bad_input_throws),
-      cmocka_unit_test(test_box_lcp_friction),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

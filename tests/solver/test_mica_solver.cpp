@@ -115,7 +115,9 @@ Vec3 compare_with_reference(const SceneSpec& spec, int steps, const Vec3& tool_v
       ldiff = std::max(ldiff, std::fabs(lm[r] - le[r]));
       const ContactRows& rows = mica.world.contact_rows();
       active += (rows.normal_of[r] < 0 && le[r] > 0);
-      if (rows.normal_of[r] >= 0) assert_le(std::fabs(lm[r]), rows.mu[r] * lm[rows.normal_of[r]] * (1 + 1e-12));
+      // The isotropic Coulomb cone: the tangent pair on the disk (a bound per row would be a box).
+      if (rows.first_tangent(r))
+        assert_le(std::hypot(lm[r], lm[r + 1]), rows.mu[r] * lm[rows.normal_of[r]] * (1 + 1e-12));
     }
     if (lmax > 0) worst_l = std::max(worst_l, ldiff / lmax);
   }

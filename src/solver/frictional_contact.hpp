@@ -1,0 +1,43 @@
+// Contact with isotropic Coulomb friction on a dense Delassus matrix M (rows as in lcp.hpp's
+// cone_error: per contact a normal row and up to two tangent rows):
+//     w = M z + q;  0 <= z_n _|_ w_n >= 0;  |z_t| <= mu z_n;  sliding opposes w_t.
+// Nonlinear (the disk's radius moves with z_n) and not an LCP. Solved by nonsmooth block
+// Gauss-Seidel over the contacts: each contact's 3x3 problem is solved exactly with the others
+// held (solve_contact_coulomb), sweep after sweep, with Newton steps on cone_error's natural map
+// between batches of sweeps, until cone_error is below the tolerance. Meant for tens to a few
+// hundred rows: everything is dense, O(rows^2) per sweep, O(rows^3) per Newton step.
+#pragma once
+#include <chrono>
+#include <optional>
+
+#include "solver/lcp.hpp"
+
+namespace mica {
+
+struct FrictionalSettings {
+  // Solved when cone_error <= tolerance * the impulse scale: the largest of |z| and, per
+  // contact, the impulse -q_n / M_nn its normal row alone asks for.
+  double tolerance = 1e-10;
+  int32_t max_sweeps = 5000;  // block Gauss-Seidel sweeps, then as many damped ones (see .cpp)
+  std::optional<std::chrono::steady_clock::time_point> deadline;  // stop (unsolved) once past it
+};
+
+struct FrictionalSolution {
+  Eigen::VectorXd z, w;  // the impulses and w = M z + q
+  bool solved = false;
+  bool out_of_time = false;  // stopped at the deadline
+  int32_t sweeps = 0;        // all sweeps done, damped ones included
+  int32_t newton_steps = 0;  // Newton steps tried on the natural map (see .cpp)
+  double error = 0;          // cone_error at z
+  double scale = 0;          // the impulse scale the tolerance is relative to
+  std::string message;       // what happened, for a person to read
+};
+
+// z0: the warm start, projected onto the cones (empty: zero). Throws Error(InvalidArgument) as
+// cone_error does, or if z0 has the wrong size or a non-finite entry. Allocates only before
+// the sweeps.
+FrictionalSolution solve_frictional_contact(const Eigen::MatrixXd& M, const Eigen::VectorXd& q,
+                                            const Eigen::VectorXd& mu, const std::vector<int32_t>& normal_index,
+                                            const Eigen::VectorXd& z0, const FrictionalSettings& settings);
+
+}  // namespace mica
