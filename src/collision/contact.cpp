@@ -16,8 +16,10 @@ namespace {
 constexpr uint64_t kTriangleFeature = uint64_t(1) << 40;
 constexpr uint64_t kEdgeFeature = uint64_t(1) << 63;
 constexpr uint64_t kSweptEdgeFeature = uint64_t(1) << 62;
-// A pair of a body feature and of a feature of the tool's core: corners count from 0, edges from this.
+// A pair of a body feature and of a feature of the tool's core: corners count from 0, edges from
+// kCoreEdgeFeatures; a node against the tool's surface (its nearest point) is a pair of its own.
 constexpr uint64_t kCoreEdgeFeatures = 1 << 16;
+constexpr uint64_t kToolSurface = 1 << 17;
 
 uint64_t pair_id(uint64_t body_feature, uint64_t core_feature) {
   return body_feature ^ (core_feature * 0x9E3779B97F4A7C15ull);  // 0 for a sphere: the body feature alone
@@ -136,7 +138,7 @@ void collide_tool(const Tool& tool, int32_t tool_index, uint64_t tool_key, const
     // triangle's closest point gets that pair's contact below, and one that is not lies behind
     // its triangles' contacts. Only a node kept on its start side needs its own.
     if (rounded && side.normal == s.normal && side.gap == s.distance) continue;
-    emit(uint64_t(node), node_point(body.index, node), side.normal, x[node], side.gap);
+    emit(pair_id(uint64_t(node), kToolSurface), node_point(body.index, node), side.normal, x[node], side.gap);
   }
   if (tool.shape == ToolShape::Plane) return;  // a plane's deepest point on a triangle is a node
   auto passed = [&](int32_t n) { return std::binary_search(passed_nodes.begin(), passed_nodes.end(), n); };

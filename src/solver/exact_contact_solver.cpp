@@ -80,25 +80,32 @@ SolveReport solve_contact_delassus(std::vector<ExactBody>& bodies, const Contact
   }
   // Without friction the LCP is solved exactly by Lemke's pivoting; with friction (not an LCP:
   // the cone's radius moves with the normal impulse) by block Gauss-Seidel over the contacts,
-  // each contact's Coulomb problem solved exactly, to round-off.
+  // each contact's Coulomb problem solved exactly, to round-off. The sweeps also take over where
+  // many redundant contacts (a flat punch: nodes, edges and faces in one plane) defeat the
+  // pivoting.
   SolveReport report = linear;
   Eigen::VectorXd z;
   double error = 0;
-  if (friction) {
+  std::string pivoting;
+  if (!friction) {
+    const LcpSolution sol = solve_lcp_lemke(Wk, qk);
+    if (sol.solved && sol.z.allFinite()) {
+      z = sol.z;
+      error = complementarity_error(Wk, qk, z);
+    } else {
+      pivoting = "pivoting failed (" + sol.message + "), then ";
+    }
+  }
+  if (z.size() != nk) {
     FrictionalSettings fs;
     fs.deadline = settings.deadline;
     const FrictionalSolution sol = solve_frictional_contact(Wk, qk, mu, normal_of, warm, fs);
-    if (!sol.z.allFinite()) fail(Errc::Numerical, "the exact frictional contact solve failed: " + sol.message);
+    if (!sol.z.allFinite()) fail(Errc::Numerical, "the exact contact solve failed: " + pivoting + sol.message);
     z = sol.z;
     error = sol.scale > 0 ? sol.error / sol.scale : sol.error;
     report.iterations += sol.sweeps;
     report.converged = report.converged && sol.solved;  // unsolved: reported, not thrown
     report.out_of_time = report.out_of_time || sol.out_of_time;
-  } else {
-    const LcpSolution sol = solve_lcp_lemke(Wk, qk);
-    if (!sol.solved || !sol.z.allFinite()) fail(Errc::Numerical, "the exact contact solve failed: " + sol.message);
-    z = sol.z;
-    error = complementarity_error(Wk, qk, z);
   }
   Eigen::VectorXd l = Eigen::VectorXd::Zero(Eigen::Index(nr));
   for (Eigen::Index i = 0; i < nk; ++i) l[kept[i]] = z[i];

@@ -336,17 +336,29 @@ void World::solve_delassus(const std::vector<Body*>& dynamic, double h) {
     exact_bodies_[k] = ExactBody{&b.fem.pattern, &b.A, &b.b, &b.projection, &linear_solver(b), &b.v_next, {}};
   }
   rows_.build(contacts_, h, settings_.max_recovery_speed);
-  record(solve_contact_delassus(exact_bodies_, rows_, lambda_, row_diagonal_));
+  // The sweeps (friction, or a degenerate frictionless problem) start from the last step's
+  // impulses and stop at the time budget.
+  exact_warm_start_.assign(rows_.size(), 0.0);
+  for (size_t r = 0; settings_.warm_start && r < rows_.size(); ++r) {
+    const auto it = warm_start_.find(rows_.key[r]);
+    if (it != warm_start_.end()) exact_warm_start_[r] = it->second;
+  }
+  ExactContactSettings es;
+  es.warm_start = &exact_warm_start_;
+  es.deadline = deadline();
+  record(solve_contact_delassus(exact_bodies_, rows_, lambda_, row_diagonal_, es));
   for (size_t k = 0; k < dynamic.size(); ++k) std::swap(dynamic[k]->contact_impulse, exact_bodies_[k].contact_impulse);
+}
+
+std::optional<std::chrono::steady_clock::time_point> World::deadline() const {
+  if (!(settings_.time_budget_ms > 0)) return std::nullopt;
+  return step_start_ + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                           std::chrono::duration<double, std::milli>(settings_.time_budget_ms));
 }
 
 LinearSolver& World::linear_solver(Body& b) {
   if (settings_.solver == SolverKind::Pcg) {
-    std::optional<std::chrono::steady_clock::time_point> deadline;
-    if (settings_.time_budget_ms > 0)
-      deadline = step_start_ + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                                   std::chrono::duration<double, std::milli>(settings_.time_budget_ms));
-    b.pcg.configure(settings_.tolerance, settings_.max_iterations, deadline);
+    b.pcg.configure(settings_.tolerance, settings_.max_iterations, deadline());
     return b.pcg;
   }
   // CHOLMOD: analysed once; factored when A or the constraint set changed (a linear body with

@@ -173,6 +173,8 @@ class World {
   void assemble_elements(Body& b, double h, bool damping) const;
   void add_damping(Body& b, double h) const;
   void add_contact_stiffness(Body& b, double h) const;
+  // The end of the step's time budget (none without one).
+  std::optional<std::chrono::steady_clock::time_point> deadline() const;
   void build_projection(Body& b, double h) const;
   void form_rhs(Body& b, double h) const;
   void solve_velocities(Body& b, double h);
@@ -205,6 +207,7 @@ class World {
   ContactRows rows_;                                // this step's rows of G
   std::vector<double> lambda_;                      // impulse per row, N s
   std::unordered_map<uint64_t, double> warm_start_; // last step's impulses by row key
+  std::vector<double> exact_warm_start_;            // the same per row of this step, for the exact solver
   MicaSolver mica_;
   FactoredMicaSolver factored_mica_;
   std::vector<MicaBody> mica_bodies_;
