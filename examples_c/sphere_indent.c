@@ -170,9 +170,9 @@ int main(int argc, char** argv) {
       peak_force = fy;
       peak_depth = depth;
     }
-    /* While the sphere goes deeper (after first touch) the force must not drop much. */
+    /* While the sphere goes deeper (after first touch) the force must not drop by more than 1 %. */
     if (k <= n_load && depth > 0.002) {
-      if (fy < 0.9 * last_load_force) ++not_growing;
+      if (fy < 0.99 * last_load_force) ++not_growing;
       last_load_force = fy;
     }
     if (k > n_load + n_hold + n_unload && (fabs(fy) > 1e-6 || contacts != 0)) ++not_released;

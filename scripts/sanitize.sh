@@ -22,4 +22,4 @@ export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktra
 export OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1 OMP_THREAD_LIMIT=1
 export LSAN_OPTIONS="suppressions=$root/tests/lsan.supp"
 # The examples (demos at full size, already run by the main suite) would take minutes under ASan.
-ctest --test-dir "$build" --output-on-failure -j "$(nproc 2>/dev/null || echo 2)" "${select[@]}" -LE "packaging|examples"
+ctest --test-dir "$build" --output-on-failure -j "$(nproc 2>/dev/null || echo 2)" "${select[@]}" -LE "packaging|examples|physics"

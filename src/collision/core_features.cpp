@@ -89,10 +89,10 @@ void orient_by_surface(const Vec3& outward, double radius, double depth, Feature
   if (hit.normal.isZero()) {  // touching: the body point moves in along the surface's normal
     hit.normal = -outward.normalized();
     hit.gap = -radius;
-  } else if (radius == 0 && dist <= depth && hit.normal.dot(outward) > 0) {
-    // A corner just behind the surface is inside the body: the body point must move past it.
+  } else if (dist + radius <= depth && hit.normal.dot(outward) > 0) {
+    // A core point just behind the surface is inside the body: the body point must move past it.
     hit.normal = -hit.normal;
-    hit.gap = -dist;
+    hit.gap = -dist - radius;
   }
 }
 

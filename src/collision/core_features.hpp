@@ -39,11 +39,12 @@ struct FeatureHit {
 // the rounded core, as if the core point were outside the body; false when undefined.
 bool corner_triangle(const Vec3& corner, double radius, const Vec3& a, const Vec3& b, const Vec3& c, FeatureHit& hit);
 bool edge_edge(const Vec3& p0, const Vec3& p1, double radius, const Vec3& e0, const Vec3& e1, FeatureHit& hit);
-// Orients a hit by the body's outward pseudo-normal at its point. A core point of a rounded core
-// is taken to be outside the body (deeper penetrations are the tool sweep's to sort out); a
-// sharp corner (radius 0) within `depth` behind the surface is inside, and the body point must
-// move past it. Touching pairs take the surface's normal. The sign test is the triangle's own,
-// not the surface's: it holds only near the triangle, hence `depth`.
+// Orients a hit by the body's outward pseudo-normal at its point. A core point behind the
+// surface is inside the body, and the body point must move past it, when the tool's penetration
+// there (the distance plus the rounding) is within `depth`; the sign test is the triangle's own,
+// not the whole surface's, and holds only that near it. Deeper, the core point is taken to be
+// outside (a tool that went that deep in a step is the tool sweep's to sort out). Touching
+// pairs take the surface's normal.
 void orient_by_surface(const Vec3& outward, double radius, double depth, FeatureHit& hit);
 
 }  // namespace mica
