@@ -56,6 +56,7 @@ int main(int argc, char** argv) {
   mica_world_def wdef = mica_world_def_default();
   wdef.gravity[0] = wdef.gravity[1] = wdef.gravity[2] = 0;
   wdef.solver = MICA_SOLVER_MICA;
+  wdef.mica_sweep = MICA_SWEEP_FACTORED; /* the sweep a haptic host should use (docs/solvers.md) */
   wdef.max_iterations = 2000;
   wdef.tolerance = 1e-6;
   if (mica_world_create(&wdef, &world) != MICA_OK) {

@@ -148,7 +148,7 @@ void collide_tool(const Tool& tool, int32_t tool_index, uint64_t tool_key, const
     return !node_start_side(tool, sweep, x[n], side);
   };
   thread_local ToolCore core;  // kept: a step allocates nothing here
-  tool_core(tool, core);
+  if (rounded) tool_core(tool, core);
   body.bvh->query(reach, [&](int32_t tri) {
     const Tri& t = (*body.triangles)[tri];
     // Edges from a node the tool went past to one beside its path (each edge once: from the
@@ -172,7 +172,6 @@ void collide_tool(const Tool& tool, int32_t tool_index, uint64_t tool_key, const
     TriangleHit side;
     // A feature pair's hit (weights over the triangle's corners) as a contact of body point p.
     auto add = [&](FeatureHit hit, uint64_t pair, const BodyPoint& p, int32_t core_corner, int32_t core_edge) {
-      orient_by_surface(body.normals->at(tri, t, hit.weights, face), core.radius, body.depth, hit);
       if (!(hit.gap < margin)) return;
       if (swept && hit.normal.dot(hit.point - sweep.start_relative(hit.point)) > 0) {
         // As for the nodes: keep the body point on the side of the tool it was on at the start.
@@ -192,16 +191,32 @@ void collide_tool(const Tool& tool, int32_t tool_index, uint64_t tool_key, const
       c.core_corner = core_corner;
       c.core_edge = core_edge;
     };
+    if (!rounded) {
+      // A box or a hull: the triangle's deepest point against the tool (collide_triangle: exact
+      // distance apart, separating axes in contact), on the feature it lies on. (Pairs of their
+      // sharp corners and edges were tried in 0.5: a 6 mm box between the nodes of a 1 cm mesh
+      // drove the body unstable; docs/stability.md, K8.)
+      TriangleHit deepest;
+      if (!collide_triangle(tool, corner[0], corner[1], corner[2], margin, deepest)) return;
+      const Feature f = feature_of(body.index, tri, t, deepest.weights);
+      add(FeatureHit{deepest.weights, deepest.point, deepest.normal, deepest.gap}, f.id, f.point, -1, -1);
+      return;
+    }
+    // A rounded core: its corners against the triangle, its edge against the triangle's edges.
     // Orienting a hit by the surface may only lower its gap: a pair farther than margin plus the
     // rounding is out of reach either way.
     const double out_of_reach = margin + core.radius;
+    auto oriented = [&](FeatureHit hit) {
+      orient_by_surface(body.normals->at(tri, t, hit.weights, face), core.radius, body.depth, hit);
+      return hit;
+    };
     for (int32_t k = 0; k < int32_t(core.corners.size()); ++k) {
       FeatureHit hit;
       if (!corner_triangle(core.corners[k], core.radius, corner[0], corner[1], corner[2], hit) ||
           !(hit.gap < out_of_reach))
         continue;
       const Feature f = feature_of(body.index, tri, t, hit.weights);
-      add(hit, pair_id(f.id, k), f.point, k, -1);
+      add(oriented(hit), pair_id(f.id, k), f.point, k, -1);
     }
     for (int32_t k = 0; k < int32_t(core.edges.size()); ++k)
       for (int e = 0; e < 3; ++e) {
@@ -212,7 +227,7 @@ void collide_tool(const Tool& tool, int32_t tool_index, uint64_t tool_key, const
           continue;
         const BodyPoint p = edge_point(body.index, i, j, hit.weights[0], hit.weights[1]);
         for (int c = 0; c < 3; ++c) hit.weights[c] = t[c] == i ? p.weights[0] : t[c] == j ? p.weights[1] : 0.0;
-        add(hit, pair_id(kEdgeFeature | uint64_t(j) << 32 | uint64_t(i), kCoreEdgeFeatures + k), p, -1, k);
+        add(oriented(hit), pair_id(kEdgeFeature | uint64_t(j) << 32 | uint64_t(i), kCoreEdgeFeatures + k), p, -1, k);
       }
   });
   merge_duplicate_features(out, first);

@@ -122,10 +122,7 @@ double deepest_surface_point(const Body& b, const Tool& t) {
 // 4 cm cube of `cells` a side: its nodes, its edges' middles, its centre and the points between,
 // each pressed `depth` deep and held. Every press must make contact and leave no surface point
 // inside the tool by more than its margin.
-// A box's sharp corners may still end up to 1.4 mm inside (docs/stability.md, K8): reported,
-// not asserted, for it (sharp_known_issue).
-std::vector<double> press_grid(const Shape& shape, int cells, double depth, double* deepest_of_all,
-                               bool sharp_known_issue) {
+std::vector<double> press_grid(const Shape& shape, int cells, double depth, double* deepest_of_all) {
   const double size = 0.04, cell = size / cells, margin = 1e-3, h = 0.01;
   std::vector<double> grid(25);
   for (int i = 0; i < 5; ++i)
@@ -138,7 +135,7 @@ std::vector<double> press_grid(const Shape& shape, int cells, double depth, doub
       if (tool.contact_count == 0) fail_msg("%s at (%d, %d)/4 of a cell: no contact", shape.name, i, j);
       const double deepest = deepest_surface_point(s.world.body(s.body), tool);
       *deepest_of_all = std::max(*deepest_of_all, deepest);
-      if (!(deepest <= margin) && !sharp_known_issue)
+      if (!(deepest <= margin))
         fail_msg("%s at (%d, %d)/4 of a cell: a surface point %.3g m inside", shape.name, i, j, deepest);
       if (!(f.back() > 0)) fail_msg("%s at (%d, %d)/4 of a cell: force %.3g N", shape.name, i, j, f.back());
       grid[size_t(5 * i + j)] = f.back();
@@ -167,11 +164,10 @@ double largest_neighbour_difference(const std::vector<double>& grid) {
 static void test_every_press_point_makes_contact(void**) {
   for (const Shape& shape : small_tools(0.004)) {
     double deepest = 0;
-    const bool box = shape.tool.shape == ToolShape::Box;
-    const std::vector<double> grid = press_grid(shape, 4, 0.002, &deepest, box);
-    print_message("%-8s (4 mm) touches at every point, %.4f..%.4f N over the cell, deepest surface point %.2f mm in%s\n",
+    const std::vector<double> grid = press_grid(shape, 4, 0.002, &deepest);
+    print_message("%-8s (4 mm) touches at every point, %.4f..%.4f N over the cell, deepest surface point %.2f mm in\n",
                   shape.name, *std::min_element(grid.begin(), grid.end()), *std::max_element(grid.begin(), grid.end()),
-                  1e3 * deepest, box && deepest > 1e-3 ? " (K8)" : "");
+                  1e3 * deepest);
   }
 }
 
@@ -182,7 +178,7 @@ static void test_force_is_even_over_a_cell(void**) {
   for (const Shape& shape : small_tools(0.01)) {
     if (shape.tool.shape != ToolShape::Sphere && shape.tool.shape != ToolShape::Capsule) continue;
     double deepest = 0;
-    const std::vector<double> grid = press_grid(shape, 8, 0.002, &deepest, false);
+    const std::vector<double> grid = press_grid(shape, 8, 0.002, &deepest);
     const double worst = largest_neighbour_difference(grid);
     print_message("%-8s (1 cm) %.4f..%.4f N over the cell, neighbours within %.1f %%\n", shape.name,
                   *std::min_element(grid.begin(), grid.end()), *std::max_element(grid.begin(), grid.end()),
@@ -195,8 +191,8 @@ static void test_force_is_even_over_a_cell(void**) {
 // than 3 steps in a row (changes below 1e-5 of the force are round-off), and after 0.5 s it is
 // below 0.1 % of the force. Mass damping only (alpha 2/s, beta 0), so nothing damps a
 // step-rate flip but the contact itself. (The sphere flipped 3.38/3.45 N every step at 10 ms.)
-// Rounded tools only: a box's or hull's sharp edges still jitter by up to a few percent (a
-// node's normal turns through 90 degrees as it passes an edge; docs/stability.md, K8).
+// Rounded tools only: a box's or hull's sharp edges still jitter (a node's normal turns through
+// 90 degrees as it passes an edge; docs/stability.md, K8).
 static void test_held_tool_force_settles(void**) {
   struct Case {
     const char* shape;
