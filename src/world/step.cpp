@@ -171,11 +171,7 @@ void World::assemble_elements(Body& b, double h, bool damping) const {
 
 void World::add_contact_stiffness(Body& b, double h) const {
   // h^2 K_c with K_c = F (-H)+ per contact of a rounded tool on a triangle, F the contact's force
-  // in the last step (this step's force is the unknown: the lag keeps the system linear). Not
-  // with MICA's block Gauss-Seidel sweep: K_c couples a triangle's nodes strongly, and the sweep
-  // then converged far more slowly (the stress matrix's g at E = 1e6 Pa, h = 50 ms: 4x the time,
-  // 4.8 mm of penetration at its cap of 300 iterations); docs/method.md.
-  if (settings_.solver == SolverKind::Mica && settings_.mica_sweep == MicaSweep::GaussSeidel) return;
+  // in the last step (this step's force is the unknown: the lag keeps the system linear).
   const auto it = std::find(dynamic_.begin(), dynamic_.end(), &b);
   if (it == dynamic_.end()) return;
   const int32_t index = int32_t(it - dynamic_.begin());
