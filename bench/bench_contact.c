@@ -26,6 +26,7 @@
  * three hold (the issue asks the loading one for the sphere; it is reported for every tool).
  *
  * usage: bench_contact [--quick | --full] [--gauss-seidel] [--no-nidus] [--csv FILE] [--tol T]
+ *                      [--cells LIST] [--dt LIST] [--shape NAME] [--trace] [--run-limit S] [--nidus-only] [--solver NAME]
  *   default  cells 8 at dt 1, 5, 10, 20 ms and cells 12 at dt 10, 20 ms; every tool; exact and
  *            MICA factored; the nidus (exact and MICA factored). About 10 minutes on one core.
  *   --full   cells 8, 12, 16 x dt 1, 5, 10, 20 ms (the issue's whole grid): hours on one core
@@ -83,6 +84,9 @@ static void machine(char* buf, size_t size) {
   snprintf(buf, size, "%s; this process may run on %d CPU(s); load average %.2f", model, cpus, load);
 }
 
+static int trace = 0;             /* --trace: one line per step */
+static double run_limit_s = 120;  /* --run-limit: wall-clock seconds for one run */
+
 typedef struct {
   int32_t shape, cells; /* cells 0: the nidus */
   double dt;
@@ -90,6 +94,7 @@ typedef struct {
 } config;
 
 typedef struct {
+  int32_t steps_done, steps; /* fewer done than planned: the run hit --run-limit */
   int32_t nodes, tets, alt_run, capped, contacts;
   double force, late, drop, ms_median, iterations;
   int pass_alt, pass_late, pass_drop;
@@ -102,6 +107,7 @@ static const char* solver_name(int32_t solver, int32_t sweep) {
 }
 
 static int run(const config* c, double tol, result* r) {
+  memset(r, 0, sizeof *r);
   press_scene_def def = press_scene_def_default();
   def.shape = c->shape;
   def.cells = c->cells;
@@ -123,14 +129,17 @@ static int run(const config* c, double tol, result* r) {
     fprintf(stderr, "%s\n", s.error);
     return 1;
   }
-  memset(r, 0, sizeof *r);
   r->nodes = s.nodes;
   r->tets = s.tets;
   double* f = malloc(sizeof(double) * (size_t)(s.steps + 1));
   double* ms = malloc(sizeof(double) * (size_t)s.steps);
   long iterations = 0;
   f[0] = 0;
+  r->steps = s.steps;
+  const double t_run = now_ms();
   for (int32_t k = 1; k <= s.steps; ++k) {
+    if (now_ms() - t_run > 1e3 * run_limit_s) break;
+    r->steps_done = k;
     double force[3];
     const double t0 = now_ms();
     const mica_status st = press_scene_step(&s, k, force, &r->contacts);
@@ -150,6 +159,22 @@ static int run(const config* c, double tol, result* r) {
     iterations += stats.solver_iterations;
     if (!stats.converged) ++r->capped;
     f[k] = force[1];
+    if (trace)
+      printf("#   step %4d %s depth %+.5f m  F %.6f N  dF %+.3e  contacts %d  iters %d%s\n", k, k > s.load_steps ? "hold" : "load",
+             press_scene_depth(&s, k), f[k], f[k] - f[k - 1], r->contacts, stats.solver_iterations,
+             stats.converged ? "" : "  (cap)");
+  }
+  if (r->steps_done < s.steps) { /* timed out: no figures but the time per step */
+    qsort(ms, (size_t)r->steps_done, sizeof ms[0], cmp);
+    r->ms_median = ms[r->steps_done / 2];
+    r->iterations = (double)iterations / r->steps_done;
+    r->force = f[r->steps_done];
+    r->late = r->drop = NAN;
+    r->alt_run = -1;
+    press_scene_destroy(&s);
+    free(f);
+    free(ms);
+    return 0;
   }
   const int32_t n = s.steps, nl = s.load_steps;
   r->force = f[n];
@@ -202,6 +227,7 @@ static int in_list(const char* list, double v) {
 static void usage(FILE* out) {
   fprintf(out,
           "usage: bench_contact [--quick | --full] [--gauss-seidel] [--no-nidus] [--csv FILE] [--tol T]\n"
+          "                     [--cells LIST] [--dt LIST] [--shape NAME] [--trace] [--run-limit S] [--nidus-only] [--solver NAME]\n"
           "  a tool pressed 10 mm into a 10 cm cube at constant speed over 1 s and held 1 s; per run:\n"
           "  the end force, the longest run of alternating step-to-step changes in the hold, the largest\n"
           "  relative change after 0.5 s of hold, the largest relative drop while loading, ms per step\n"
@@ -215,14 +241,21 @@ static void usage(FILE* out) {
           "  --cells LIST    only these cells per side (comma list, e.g. 8,16), from 8, 12, 16\n"
           "  --dt LIST       only these time steps in ms (comma list), from 1, 5, 10, 20\n"
           "                  (with --cells or --dt, the grid is every combination of the two lists)\n"
+          "  --shape NAME    only this tool: sphere, capsule, box or hull\n"
+          "  --trace         print every step (depth, force, change, contacts, iterations)\n"
+          "  --run-limit S   give up a run after S s of wall time (default 120): a TIMEOUT row\n"
+          "  --nidus-only    only the nidus case\n"
+          "  --solver NAME   only this solver: exact, MICA-F or MICA-GS (with --gauss-seidel)\n"
           "  every tool (sphere, capsule, box, hull), exact (DIRECT) and MICA factored\n");
 }
 
 int main(int argc, char** argv) {
-  int quick = 0, full = 0, gs = 0, nidus = 1;
+  int quick = 0, full = 0, gs = 0, nidus = 1, nidus_only = 0;
   const char* csv_path = NULL;
   const char* only_cells = NULL; /* comma lists: keep only these cells / dt (ms) */
   const char* only_dt = NULL;
+  const char* only_shape = NULL; /* one tool */
+  const char* only_solver = NULL; /* one solver */
   double tol = 1e-8;
   for (int i = 1; i < argc; ++i) {
     if (strcmp(argv[i], "--quick") == 0) quick = 1;
@@ -233,6 +266,11 @@ int main(int argc, char** argv) {
     else if (strcmp(argv[i], "--tol") == 0 && i + 1 < argc) tol = atof(argv[++i]);
     else if (strcmp(argv[i], "--cells") == 0 && i + 1 < argc) only_cells = argv[++i];
     else if (strcmp(argv[i], "--dt") == 0 && i + 1 < argc) only_dt = argv[++i];
+    else if (strcmp(argv[i], "--shape") == 0 && i + 1 < argc) only_shape = argv[++i];
+    else if (strcmp(argv[i], "--trace") == 0) trace = 1;
+    else if (strcmp(argv[i], "--run-limit") == 0 && i + 1 < argc) run_limit_s = atof(argv[++i]);
+    else if (strcmp(argv[i], "--nidus-only") == 0) nidus_only = 1;
+    else if (strcmp(argv[i], "--solver") == 0 && i + 1 < argc) only_solver = argv[++i];
     else if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
       usage(stdout);
       return 0;
@@ -245,7 +283,8 @@ int main(int argc, char** argv) {
     usage(stderr);
     return 2;
   }
-  if (quick) nidus = 0;
+  if (quick && !nidus_only) nidus = 0;
+  if (nidus_only) nidus = 1;
 
   const int32_t shapes[4] = {MICA_TOOL_SPHERE, MICA_TOOL_CAPSULE, MICA_TOOL_BOX, MICA_TOOL_HULL};
   const double dts[4] = {0.001, 0.005, 0.01, 0.02};
@@ -255,7 +294,8 @@ int main(int argc, char** argv) {
   const int nsolvers = gs ? 3 : 2;
   config* plan = malloc(sizeof(config) * 200);
   int np = 0;
-  for (int si = 0; si < 4; ++si)
+  for (int si = 0; si < 4; ++si) {
+    if (nidus_only || (only_shape && strcmp(only_shape, press_scene_shape_name(shapes[si])) != 0)) continue;
     for (int ci = 0; ci < 3; ++ci)
       for (int di = 0; di < 4; ++di) {
         const int32_t cells = cell_sizes[ci];
@@ -267,10 +307,14 @@ int main(int argc, char** argv) {
         if (only_cells || only_dt) take = in_list(only_cells, cells) && in_list(only_dt, 1e3 * dt);
         if (!take) continue;
         for (int so = 0; so < nsolvers; ++so)
+          if (!only_solver || strcmp(only_solver, solver_name(solvers[so][0], solvers[so][1])) == 0)
           plan[np++] = (config){shapes[si], cells, dt, solvers[so][0], solvers[so][1]};
       }
-  if (nidus)
-    for (int so = 0; so < nsolvers; ++so) plan[np++] = (config){MICA_TOOL_SPHERE, 0, 0.01, solvers[so][0], solvers[so][1]};
+  }
+  if (nidus && (!only_shape || strcmp(only_shape, "sphere") == 0))
+    for (int so = 0; so < nsolvers; ++so)
+      if (!only_solver || strcmp(only_solver, solver_name(solvers[so][0], solvers[so][1])) == 0)
+        plan[np++] = (config){MICA_TOOL_SPHERE, 0, 0.01, solvers[so][0], solvers[so][1]};
 
   char m[300];
   machine(m, sizeof m);
@@ -314,10 +358,13 @@ int main(int argc, char** argv) {
       ++failed_runs;
       continue;
     }
-    const int pass = r.pass_alt && r.pass_late && r.pass_drop;
+    const int timed_out = r.steps_done < r.steps;
+    const int pass = !timed_out && r.pass_alt && r.pass_late && r.pass_drop;
     failing_rows += !pass;
     char verdict[64];
-    if (pass) snprintf(verdict, sizeof verdict, "pass");
+    if (timed_out)
+      snprintf(verdict, sizeof verdict, "TIMEOUT: %d of %d steps in %g s", r.steps_done, r.steps, run_limit_s);
+    else if (pass) snprintf(verdict, sizeof verdict, "pass");
     else
       snprintf(verdict, sizeof verdict, "FAIL:%s%s%s", r.pass_alt ? "" : " alt", r.pass_late ? "" : " late",
                r.pass_drop ? "" : " drop");
