@@ -4,7 +4,8 @@
 # See docs/accuracy-vs-time.md and docs/performance.md.
 #
 #   scripts/study.sh            the full study: 4 minutes on a quiet 2-core machine (11 when
-#                               it shared the machine with other work, in libmica 0.2)
+#                               it shared the machine with other work, in libmica 0.2), and
+#                               about 1.5 more for the force-quality stage (bench_contact --quick)
 #   scripts/study.sh quick      a smoke test: a few configurations of each part
 #
 # Environment: MICA_STUDY_BUILD (default ./build-study) is the CMake build folder;
@@ -24,7 +25,7 @@ echo "study: building in $build (log: $out/logs/build.log)"
 {
   cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release -DMICA_BUILD_DOCS=OFF -DMICA_BUILD_TESTS=OFF \
     -DMICA_BUILD_EXAMPLES=OFF -DMICA_BUILD_BENCH=ON
-  cmake --build "$build" -j 2 --target mica bench_nidus
+  cmake --build "$build" -j 2 --target mica bench_nidus bench_contact
 } >"$out/logs/build.log" 2>&1 || { tail -20 "$out/logs/build.log"; exit 1; }
 bin="$build/study-bin"
 mkdir -p "$bin"
@@ -49,6 +50,7 @@ else
   done
 fi
 nidus_bin="$build/bench/bench_nidus"
+contact_bin="$build/bench/bench_contact"
 pin=""
 # The scaling benchmark's "one core"; the nidus one is not pinned: its refreshed variant factors on
 # a second thread (its Gauss-Seidel comparison, hundreds of times slower, is bench_nidus's own job).
@@ -60,9 +62,11 @@ quick=()
 [[ $mode == quick ]] && quick=(quick)
 nidus_steps=(30 30)
 scaling_max=110000
+contact_set="--quick" # force quality: 12 cells, dt 10 ms, every tool, exact and MICA factored (docs/accuracy-vs-time.md)
 if [[ $mode == quick ]]; then
   nidus_steps=(5 30)
   scaling_max=20000
+  contact_set="--cells 8 --dt 20 --no-nidus"
 fi
 stages=(
   "sweep|250|$bin/study_sweep $out ${quick[*]:-}"
@@ -70,6 +74,7 @@ stages=(
   "filter|35|$bin/study_filter $out"
   "nidus|45|$nidus_bin $root/data/nidus/nidus.msh 1e-6 ${nidus_steps[0]} ${nidus_steps[1]} 1e4 0.01 0 4"
   "scaling|215|$pin $nidus_bin --scaling $out/scaling.csv $scaling_max factored"
+  "contact|90|$pin $contact_bin $contact_set --csv $out/contact.csv"
   "plots|6|/usr/bin/python3 $root/scripts/study_plots.py $out"
 )
 total=0
@@ -127,7 +132,8 @@ done
 [[ $has_tty == 1 ]] && echo
 mv "$out/logs/times.txt.new" "$out/logs/times.txt"
 cp "$out/logs/nidus.log" "$out/nidus.txt"
+cp "$out/logs/contact.log" "$out/contact.txt"
 echo "study: done in $((SECONDS - start)) s; stage times in $out/logs/times.txt"
 echo "  CSV: $(cd "$out" && ls *.csv | tr '\n' ' ')"
 echo "  PNG: $(cd "$out" && ls *.png | tr '\n' ' ')"
-echo "  tables for the docs: $out/tables.md; the nidus benchmark: $out/nidus.txt"
+echo "  tables for the docs: $out/tables.md; the nidus benchmark: $out/nidus.txt; force quality: $out/contact.txt"

@@ -15,6 +15,8 @@ writes tables.md (the tables of docs/accuracy-vs-time.md and docs/performance.md
   anchors.png                Hertz and Euler-Bernoulli: error against element size (log-log), and
                              the Hertz force against depth
   scaling.png                ms per step, iterations and ms per iteration against tets
+and, in tables.md only, the force quality of a held tool and of loading (contact.csv, from
+bench/bench_contact.c).
 
 usage: study_plots.py <study-folder>
 """
@@ -402,7 +404,7 @@ def g(v, fmt="{:.3g}"):
     return "-" if not fin(x) else fmt.format(x)
 
 
-def tables(rows, anchor_rows, filt, scal, comments, out):
+def tables(rows, anchor_rows, filt, scal, comments, out, contact=()):
     lines = []
     w = lines.append
     w("<!-- written by scripts/study_plots.py -->")
@@ -488,6 +490,18 @@ def tables(rows, anchor_rows, filt, scal, comments, out):
         for r in scal:
             w(f"| {r['cells']}^3 | {r['nodes']} | {r['tets']} | {g(r['ms_median'])} | {g(r['ms_p95'])} | "
               f"{g(r['iterations'], '{:.1f}')} | {g(r['ms_per_iteration'], '{:.4f}')} | {r['mem_B_per_tet']} |")
+    if contact:
+        w("\n### Force quality (bench_contact: tool pressed 10 mm and held 1 s)\n")
+        w("| body | tool | cells | dt (ms) | solver | F end (N) | alt. run | late change | loading drop "
+          "| ms/step | iters/step | verdict |")
+        w("|---|---|---|---|---|---|---|---|---|---|---|---|")
+        for r in contact:
+            fails = [k for k, c in (("alt", "pass_alt"), ("late", "pass_late"), ("drop", "pass_drop")) if r[c] != "1"]
+            verdict = "pass" if not fails else "**FAIL**: " + ", ".join(fails)
+            w(f"| {r['body']} | {r['shape']} | {r['cells'] if r['body'] == 'cube' else '-'} | {r['dt_ms']} | "
+              f"{r['solver']} | {g(r['force_N'], '{:.4f}')} | {r['alt_run']} | {g(r['late_rel'], '{:.2e}')} | "
+              f"{g(r['load_drop_rel'], '{:.3%}')} | {g(r['ms_median'], '{:.1f}')} | {g(r['iters_mean'], '{:.1f}')} | "
+              f"{verdict} |")
     with open(os.path.join(out, "tables.md"), "w") as f:
         f.write("\n".join(lines) + "\n")
 
@@ -500,6 +514,7 @@ def main(folder):
     filt, c_filter = read(os.path.join(folder, "filter.csv"))
     samples, _ = read(os.path.join(folder, "filter_samples.csv"))
     scal, c_scal = read(os.path.join(folder, "scaling.csv"))
+    contact, c_contact = read(os.path.join(folder, "contact.csv"))
     if rows:
         error_vs_time(rows, folder)
         iterations_vs_tolerance(rows, folder)
@@ -509,7 +524,8 @@ def main(folder):
     anchors(anchor_rows, curve, folder)
     scaling(scal, folder)
     tables(rows, anchor_rows, filt, scal,
-           {"sweep": c_sweep, "anchors": c_anchor, "filter": c_filter, "scaling": c_scal}, folder)
+           {"sweep": c_sweep, "anchors": c_anchor, "filter": c_filter, "scaling": c_scal, "contact": c_contact}, folder,
+           contact)
     print(f"plots and tables.md in {folder}")
 
 
