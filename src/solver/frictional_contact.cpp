@@ -153,6 +153,9 @@ FrictionalSolution solve_frictional_contact(const Eigen::MatrixXd& M, const Eige
     s.out_of_time = settings.deadline && std::chrono::steady_clock::now() >= *settings.deadline;
     return s.out_of_time;
   };
+  // A Newton step factors the dense n x n Jacobian: past kMaxNewtonRows rows (hundreds of
+  // contacts, a body gone wild) twenty of them per batch took minutes a step; sweeps only there.
+  const bool newton = n <= kMaxNewtonRows;
   s.solved = converged();
   for (int32_t batch = 8; !s.solved && s.sweeps < 2 * settings.max_sweeps; batch = std::min(2 * batch, 512)) {
     const int32_t sweeps_end = std::min(s.sweeps + batch, 2 * settings.max_sweeps);
@@ -161,7 +164,7 @@ FrictionalSolution solve_frictional_contact(const Eigen::MatrixXd& M, const Eige
       ++s.sweeps;
       s.solved = converged();
     }
-    for (int k = 0; k < 20 && !s.solved && !out_of_time(); ++k) {
+    for (int k = 0; k < 20 && newton && !s.solved && !out_of_time(); ++k) {
       natural_map(M, blocks, s.z, s.w, F, &J);
       cod.compute(J);
       dz.noalias() = -cod.solve(F);

@@ -14,6 +14,9 @@
 
 namespace mica {
 
+// Problems with more rows than this are solved by the sweeps alone (no Newton steps).
+constexpr Eigen::Index kMaxNewtonRows = 300;
+
 struct FrictionalSettings {
   // Solved when cone_error <= tolerance * the impulse scale: the largest of |z| and, per
   // contact, the impulse -q_n / M_nn its normal row alone asks for.
