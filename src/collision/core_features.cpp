@@ -37,32 +37,10 @@ void tool_core(const Tool& tool, ToolCore& core) {
       core.radius = tool.radius;
       return;
     case ToolShape::Box:
-      for (int i = 0; i < 8; ++i) {
-        Vec3 corner = tool.half_extents;
-        for (int k = 0; k < 3; ++k)
-          if (i >> k & 1) corner[k] = -corner[k];
-        core.corners.push_back(tool.position + R * corner);
-        for (int k = 0; k < 3; ++k)  // the corners that differ in one sign, each edge once
-          if (i >> k & 1) core.edges.push_back({i, i ^ (1 << k)});
-      }
-      return;
-    case ToolShape::ConvexHull: {
-      if (!tool.hull) fail(Errc::WrongState, "the convex hull tool was not prepared (prepare_tool_shape)");
-      const Vec3List& v = tool.hull->vertices;
-      for (const Vec3& p : v) core.corners.push_back(tool.position + R * p);
-      auto index = [&](const Vec3& p) { return int32_t(std::find(v.begin(), v.end(), p) - v.begin()); };
-      for (const HullFace& f : tool.hull->faces)
-        for (size_t k = 0; k < f.polygon.size(); ++k) {
-          int32_t i = index(f.polygon[k]), j = index(f.polygon[(k + 1) % f.polygon.size()]);
-          if (i > j) std::swap(i, j);  // each edge is on two faces: once
-          if (std::find(core.edges.begin(), core.edges.end(), std::array<int32_t, 2>{i, j}) == core.edges.end())
-            core.edges.push_back({i, j});
-        }
-      return;
-    }
+    case ToolShape::ConvexHull:
     case ToolShape::Plane: break;
   }
-  fail(Errc::Internal, "a plane tool has no core");
+  fail(Errc::Internal, "only a sphere's and a capsule's contacts are made from their core");
 }
 
 bool corner_triangle(const Vec3& corner, double radius, const Vec3& a, const Vec3& b, const Vec3& c, FeatureHit& hit) {

@@ -178,7 +178,7 @@ void World::add_contact_stiffness(Body& b, double h) const {
   thread_local ToolCore core;  // kept: a step allocates nothing here
   int32_t core_of = -1;
   for (const Contact& c : contacts_) {
-    if (c.tool < 0 || c.triangle < 0 || c.a.body != index) continue;
+    if (c.tool < 0 || (c.core_corner < 0 && c.core_edge < 0) || c.a.body != index) continue;
     const auto last = warm_start_.find(ContactRows::normal_row_key(c.key));
     if (last == warm_start_.end() || !(last->second > 0)) continue;
     if (core_of != c.tool) tool_core(*step_tools_[size_t(c.tool)], core);
