@@ -391,8 +391,8 @@ MICA_API mica_status mica_lpc_get_reaction(const mica_world* world, mica_lpc_id 
 #define MICA_TOOL_SPHERE 0  /**< a sphere of `radius` around the tool origin */
 #define MICA_TOOL_PLANE 1   /**< a half-space: bodies stay on the side `normal` points to */
 #define MICA_TOOL_CAPSULE 2 /**< the segment from -half_length to +half_length along local z, inflated by `radius` */
-#define MICA_TOOL_BOX 3     /**< a box of `half_extents` centred on the tool origin */
-#define MICA_TOOL_HULL 4    /**< the convex hull of `hull_points` (4 to 64 points, tool frame) */
+#define MICA_TOOL_BOX 3     /**< a box of `half_extents` centred on the tool origin, its edges and corners rounded (inside it) by a tenth of its smallest half extent, at most 1 mm */
+#define MICA_TOOL_HULL 4    /**< the convex hull of `hull_points` (4 to 64 points, tool frame), rounded inside it as a box (by a tenth of the distance from its centre to its nearest face, at most 1 mm) */
 
 /** A kinematic tool: shape, size, initial pose, contact margin. Fill with mica_tool_def_default(). */
 typedef struct mica_tool_def {

@@ -5,7 +5,6 @@
 #include "collision/closest_point.hpp"
 #include "collision/core_features.hpp"
 #include "collision/tool_sweep.hpp"
-#include "collision/triangle_contact.hpp"
 
 namespace mica {
 
@@ -20,6 +19,7 @@ constexpr uint64_t kSweptEdgeFeature = uint64_t(1) << 62;
 // kCoreEdgeFeatures; a node against the tool's surface (its nearest point) is a pair of its own.
 constexpr uint64_t kCoreEdgeFeatures = 1 << 16;
 constexpr uint64_t kToolSurface = 1 << 17;
+constexpr uint64_t kCoreFaceFeatures = 1 << 18;
 
 uint64_t pair_id(uint64_t body_feature, uint64_t core_feature) {
   return body_feature ^ (core_feature * 0x9E3779B97F4A7C15ull);  // 0 for a sphere: the body feature alone
@@ -96,6 +96,25 @@ Vec3 tool_point_velocity(const Tool& tool, const Vec3& p) {
   return tool.velocity + tool.angular_velocity.cross(p - tool.position);
 }
 
+// Whether point p lies behind the body's surface with the surface point `distance` from it as
+// its nearest: on the inner side of the pseudo-normal there, and no surface point nearer.
+bool behind_surface_at(const SurfaceView& body, const Vec3& p, double distance) {
+  const Vec3List& x = *body.x;
+  const double reach = distance * (1 + 1e-6) + 1e-12;  // the point itself, within round-off
+  bool nearest = true, behind = false;
+  body.bvh->query(Aabb{p, p}.inflated(reach), [&](int32_t tri) {
+    if (!nearest) return;
+    const Tri& t = (*body.triangles)[tri];
+    const TrianglePoint q = closest_on_triangle(p, x[t[0]], x[t[1]], x[t[2]]);
+    const double d = (p - q.point).norm();
+    if (d < distance * (1 - 1e-6) - 1e-12) nearest = false;  // another point is nearer: not this one's
+    if (d > reach || behind) return;
+    const Vec3 face = (x[t[1]] - x[t[0]]).cross(x[t[2]] - x[t[0]]).normalized();
+    behind = (p - q.point).dot(body.normals->at(tri, t, q.weights, face)) < 0;
+  });
+  return nearest && behind;
+}
+
 }  // namespace
 
 void collide_tool(const Tool& tool, int32_t tool_index, uint64_t tool_key, const SurfaceView& body, double h,
@@ -110,7 +129,8 @@ void collide_tool(const Tool& tool, int32_t tool_index, uint64_t tool_key, const
   const bool swept = sweep.moved() && tool.shape != ToolShape::Plane;
   const Vec3List& x = *body.x;
   const size_t first = out.size();
-  const bool rounded = tool.shape == ToolShape::Sphere || tool.shape == ToolShape::Capsule;
+  thread_local ToolCore core;  // kept: a step allocates nothing here
+  tool_core(tool, core);
   // A contact of the body point p; pair is the feature pair's id (the contact's key).
   auto emit = [&](uint64_t pair, const BodyPoint& p, const Vec3& normal, const Vec3& point, double gap) -> Contact& {
     out.push_back(Contact{contact_key(tool_key, body.key, pair), tool_index, p, BodyPoint{}, normal, point, gap,
@@ -134,10 +154,19 @@ void collide_tool(const Tool& tool, int32_t tool_index, uint64_t tool_key, const
       if (met && side.normal.dot(s.normal) < 0) passed_nodes.push_back(node);
       if (side.gap >= margin) continue;
     }
-    // A rounded core (sphere, capsule) has no face for a node to meet: a node that is a
-    // triangle's closest point gets that pair's contact below, and one that is not lies behind
-    // its triangles' contacts. Only a node kept on its start side needs its own.
-    if (rounded && side.normal == s.normal && side.gap == s.distance) continue;
+    const bool kept = !(side.normal == s.normal && side.gap == s.distance);  // on its start side
+    // A box's or hull's core meets a node with its faces and edges; its corners, as a sphere's or
+    // a capsule's core, meet the node's triangles below (a node that is no triangle's closest
+    // point lies behind their contacts). Only a node kept on its start side needs its own.
+    if (!kept && core.polytope) {
+      FeatureHit hit;
+      int32_t face = -1, edge = -1;
+      if (!node_core(core, x[node], hit, face, edge) || !(hit.gap < margin)) continue;
+      const uint64_t feature = face >= 0 ? kCoreFaceFeatures + uint64_t(face) : kCoreEdgeFeatures + uint64_t(edge);
+      emit(pair_id(uint64_t(node), feature), node_point(body.index, node), hit.normal, x[node], hit.gap);
+      continue;
+    }
+    if (!kept && tool.shape != ToolShape::Plane) continue;
     emit(pair_id(uint64_t(node), kToolSurface), node_point(body.index, node), side.normal, x[node], side.gap);
   }
   if (tool.shape == ToolShape::Plane) return;  // a plane's deepest point on a triangle is a node
@@ -147,8 +176,6 @@ void collide_tool(const Tool& tool, int32_t tool_index, uint64_t tool_key, const
     SideContact side;
     return !node_start_side(tool, sweep, x[n], side);
   };
-  thread_local ToolCore core;  // kept: a step allocates nothing here
-  if (rounded) tool_core(tool, core);
   body.bvh->query(reach, [&](int32_t tri) {
     const Tri& t = (*body.triangles)[tri];
     // Edges from a node the tool went past to one beside its path (each edge once: from the
@@ -191,23 +218,20 @@ void collide_tool(const Tool& tool, int32_t tool_index, uint64_t tool_key, const
       c.core_corner = core_corner;
       c.core_edge = core_edge;
     };
-    if (!rounded) {
-      // A box or a hull: the triangle's deepest point against the tool (collide_triangle: exact
-      // distance apart, separating axes in contact), on the feature it lies on. (Pairs of their
-      // sharp corners and edges were tried in 0.5: a 6 mm box between the nodes of a 1 cm mesh
-      // drove the body unstable; docs/stability.md, K8.)
-      TriangleHit deepest;
-      if (!collide_triangle(tool, corner[0], corner[1], corner[2], margin, deepest)) return;
-      const Feature f = feature_of(body.index, tri, t, deepest.weights);
-      add(FeatureHit{deepest.weights, deepest.point, deepest.normal, deepest.gap}, f.id, f.point, -1, -1);
-      return;
-    }
     // A rounded core: its corners against the triangle, its edge against the triangle's edges.
     // Orienting a hit by the surface may only lower its gap: a pair farther than margin plus the
     // rounding is out of reach either way.
     const double out_of_reach = margin + core.radius;
     auto oriented = [&](FeatureHit hit) {
+      const FeatureHit as_found = hit;
       orient_by_surface(body.normals->at(tri, t, hit.weights, face), core.radius, body.depth, hit);
+      // Inside, a core point is as deep as its nearest surface point says, not as this pair's: a
+      // box's core edge just through the surface once got its pair with a triangle edge 1.5 mm
+      // away, 1.8 mm "deep" sideways, and threw the body. Other pairs stay one-sided.
+      const double distance = as_found.gap + core.radius;
+      if (hit.normal.dot(as_found.normal) < 0 &&
+          !behind_surface_at(body, as_found.point - distance * as_found.normal, distance))
+        return as_found;
       return hit;
     };
     for (int32_t k = 0; k < int32_t(core.corners.size()); ++k) {

@@ -63,10 +63,11 @@ struct SurfaceView {
   double travel;                    // m, how far a node may move this step (h times the top speed; 0 when static)
 };
 
-// Tool against a body: a contact for each surface node closer to the tool than its margin, and
-// one for each pair of a feature of the tool's core and of a surface triangle closer than that
-// (core_features.hpp: core corners against triangles, core edges against triangle edges), so
-// that no point of the surface goes uncovered; a pair reached from two triangles is made once. Speculative: the margin grows by how
+// Tool against a body: a contact for each pair of a feature of the tool's rounded core and of
+// the body's surface closer than the margin (core_features.hpp: core corners against triangles,
+// core edges against triangle edges, a box's or hull's core faces and edges against nodes), so
+// that no point of the surface goes uncovered; a pair reached from two triangles is made once; a
+// plane meets each node. Speculative: the margin grows by how
 // far the tool and the body can travel in the step (h), so a fast approach is caught before it
 // crosses; the constraint keeps the true gap, so the sides may close it but not cross it.
 // Swept: the tool is at its new pose, and where it moved past a node or a triangle in the step

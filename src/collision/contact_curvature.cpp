@@ -30,6 +30,8 @@ bool gap_gradient(const ToolCore& core, const Contact& c, const Tri& t, const Ve
     hit.weights[ej] = w[1];
   }
   if (hit.normal.isZero()) return false;
+  // The contact's side: a core point that crosses the triangle's plane must not flip the gradient.
+  if (hit.normal.dot(c.normal) < 0) hit.normal = -hit.normal;
   for (int k = 0; k < 3; ++k) g.segment<3>(3 * k) = hit.weights[k] * hit.normal;
   return true;
 }

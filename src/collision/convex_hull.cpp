@@ -137,6 +137,16 @@ std::shared_ptr<const HullData> build_convex_hull(const Vec3List& points, const 
   if (hull->faces.size() < 4) fail(Errc::InvalidArgument, field + " span no solid hull");
   hull->centre /= double(hull->vertices.size());
 
+  const Vec3List& v = hull->vertices;
+  for (HullFace& f : hull->faces)
+    for (size_t k = 0; k < f.polygon.size(); ++k)
+      f.corners.push_back(int32_t(std::find(v.begin(), v.end(), f.polygon[k]) - v.begin()));
+  for (const HullFace& f : hull->faces)
+    for (size_t k = 0; k < f.corners.size(); ++k) {
+      const int32_t a = f.corners[k], b = f.corners[(k + 1) % f.corners.size()];
+      const std::array<int32_t, 2> e{std::min(a, b), std::max(a, b)};
+      if (std::find(hull->edges.begin(), hull->edges.end(), e) == hull->edges.end()) hull->edges.push_back(e);
+    }
   for (const HullFace& f : hull->faces)
     for (size_t k = 0; k < f.polygon.size(); ++k) {
       const Vec3 d = (f.polygon[(k + 1) % f.polygon.size()] - f.polygon[k]).normalized();

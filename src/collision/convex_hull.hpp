@@ -1,5 +1,6 @@
 // The convex hull of a small point set as outward face planes and face polygons, built once per tool.
 #pragma once
+#include <array>
 #include <memory>
 #include <string>
 
@@ -14,11 +15,13 @@ struct HullFace {
   Vec3 normal;       // outward, unit
   double offset;     // normal . x = offset on the face plane
   Vec3List polygon;  // the face's corners, counter-clockwise seen from outside
+  std::vector<int32_t> corners;  // the same corners as indices into HullData::vertices
 };
 
 struct HullData {
   std::vector<HullFace> faces;
   Vec3List vertices;  // the hull's corners (a subset of the input points)
+  std::vector<std::array<int32_t, 2>> edges;  // corner pairs (smaller index first), each edge once
   Vec3List edge_directions;  // unit, one per set of parallel edges (for separating-axis tests)
   Vec3 centre;        // the mean of the corners: a point strictly inside
 };

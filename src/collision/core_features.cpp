@@ -1,6 +1,7 @@
 #include "collision/core_features.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 #include "collision/closest_point.hpp"
 #include "core/error.hpp"
@@ -25,6 +26,7 @@ void tool_core(const Tool& tool, ToolCore& core) {
   core.corners.clear();
   core.edges.clear();
   core.radius = 0;
+  core.polytope = nullptr;
   switch (tool.shape) {
     case ToolShape::Sphere:
       core.corners.push_back(tool.position);
@@ -38,9 +40,72 @@ void tool_core(const Tool& tool, ToolCore& core) {
       return;
     case ToolShape::Box:
     case ToolShape::ConvexHull:
-    case ToolShape::Plane: break;
+      if (!tool.core) break;
+      core.polytope = tool.core.get();
+      core.rotation = R;
+      core.position = tool.position;
+      for (const Vec3& v : tool.core->vertices) core.corners.push_back(tool.position + R * v);
+      core.edges.assign(tool.core->edges.begin(), tool.core->edges.end());
+      core.radius = tool.rounding;
+      return;
+    case ToolShape::Plane: return;  // no core: a plane meets each node
   }
-  fail(Errc::Internal, "only a sphere's and a capsule's contacts are made from their core");
+  fail(Errc::Internal, "a box or hull without its core (prepare_tool_shape makes it)");
+}
+
+bool node_core(const ToolCore& core, const Vec3& x, FeatureHit& hit, int32_t& face, int32_t& edge) {
+  const HullData& P = *core.polytope;
+  const Vec3 p = core.rotation.transpose() * (x - core.position);  // in the tool frame
+  face = edge = -1;
+  hit.weights = Vec3(1, 0, 0);
+  hit.point = x;
+  // Inside the core: its nearest face (the node is deeper than the rounding).
+  double highest = -HUGE_VAL;
+  for (size_t f = 0; f < P.faces.size(); ++f) {
+    const double height = P.faces[f].normal.dot(p) - P.faces[f].offset;
+    if (height > highest) {
+      highest = height;
+      face = int32_t(f);
+    }
+  }
+  Vec3 from = P.faces[size_t(face)].normal;  // the direction from the core's nearest point to p
+  double distance = highest;
+  if (highest > 0) {
+    // Outside: the nearest of the faces p projects into, the edges and the corners.
+    distance = HUGE_VAL;
+    face = -1;
+    bool corner = false;
+    auto consider = [&](double d, const Vec3& direction, int32_t f, int32_t e) {
+      if (d >= distance) return;
+      distance = d;
+      from = direction;
+      face = f;
+      edge = e;
+      corner = f < 0 && e < 0;
+    };
+    for (size_t f = 0; f < P.faces.size(); ++f) {
+      const HullFace& F = P.faces[f];
+      const double height = F.normal.dot(p) - F.offset;
+      if (!(height > 0)) continue;
+      const Vec3 foot = p - height * F.normal;
+      bool within = true;
+      for (size_t k = 0; within && k < F.polygon.size(); ++k)
+        within = (F.polygon[(k + 1) % F.polygon.size()] - F.polygon[k]).cross(foot - F.polygon[k]).dot(F.normal) >= 0;
+      if (within) consider(height, F.normal, int32_t(f), -1);
+    }
+    for (size_t e = 0; e < P.edges.size(); ++e) {
+      const Vec3 a = P.vertices[size_t(P.edges[e][0])], d = P.vertices[size_t(P.edges[e][1])] - a;
+      const double t = d.dot(p - a) / d.squaredNorm();
+      if (!(t > 0 && t < 1)) continue;
+      const Vec3 off = p - (a + t * d);
+      consider(off.norm(), off.normalized(), -1, int32_t(e));
+    }
+    for (const Vec3& v : P.vertices) consider((p - v).norm(), (p - v).normalized(), -1, -1);
+    if (corner) return false;
+  }
+  hit.normal = core.rotation * from;
+  hit.gap = distance - core.radius;
+  return hit.normal.allFinite();
 }
 
 bool corner_triangle(const Vec3& corner, double radius, const Vec3& a, const Vec3& b, const Vec3& c, FeatureHit& hit) {

@@ -1,13 +1,13 @@
-// A rounded tool as its core (a sphere: its centre; a capsule: its axis) and radius, and the
-// contacts between the core's features and a body's surface triangle.
+// A tool as a core rounded by a radius (a sphere: its centre; a capsule: its axis; a box or a
+// hull: a polytope inside it, rounded by a little: tool.hpp), and the contacts between the
+// core's features and a body's surface triangle or node.
 //
 // Why features: a tool smaller than a triangle touches it between its nodes, and the pairs of
 // features cover every point: each core corner against the triangle (the triangle's closest
 // point to it, on its face, an edge or a corner) and the core's edge against each triangle edge
 // (their closest points, inside both). Because a triangle is flat, this covers it: a capsule
-// lying across a face meets the face's edges where it enters and leaves. (Box and hull cores
-// were tried with their sharp corners and edges as features, radius 0: a 6 mm box between the
-// nodes of a 1 cm mesh drove the body unstable; they keep the triangle's deepest point.)
+// lying across a face meets the face's edges where it enters and leaves. A polytope core's faces
+// meet the body's nodes (node_core), and its edges a node that sticks out towards them.
 #pragma once
 #include <array>
 #include <vector>
@@ -20,11 +20,21 @@ struct ToolCore {
   Vec3List corners;                            // m, world
   std::vector<std::array<int32_t, 2>> edges;   // corner pairs
   double radius = 0;                           // m, the rounding
+  // A box's or hull's core (tool frame; its corners are `corners` in the world) and the pose.
+  const HullData* polytope = nullptr;
+  Mat3 rotation = Mat3::Identity();
+  Vec3 position = Vec3::Zero();
 };
 
-// The core of a sphere or capsule at its pose; reuses `core`'s storage. (Box and hull contacts
-// are made from the triangle's deepest point instead: contact.hpp.)
+// The core of a sphere, capsule, box or hull at its pose (a plane has none: empty); reuses
+// `core`'s storage.
 void tool_core(const Tool& tool, ToolCore& core);
+
+struct FeatureHit;
+// A node at x against a polytope core (box, hull): the core face or edge (as in core.edges)
+// nearest x, and the pair's hit; inside the core, its nearest face. False where a core corner
+// is nearest: that pair is a corner's against the node's triangles (corner_triangle).
+bool node_core(const ToolCore& core, const Vec3& x, FeatureHit& hit, int32_t& face, int32_t& edge);
 
 // A feature pair in contact: the body's point (barycentric weights over the body feature's
 // corners), the direction the body point must move to separate (unit), the signed gap (m).

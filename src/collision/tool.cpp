@@ -77,10 +77,40 @@ SurfacePoint hull_point(const HullData& hull, const Vec3& q) {
   return {distance, (q - foot) / distance};
 }
 
+// Sharp edges make a contact's normal jump as the surface turns under them, and a held tool
+// chatters (docs/method.md); a tenth of the distance to the nearest face rounds them, at most 1 mm.
+constexpr double kRoundingFraction = 0.1;
+constexpr double kMaxRounding = 1e-3;  // m
+
+// The box's or hull's rounded core: a box shrinks by the rounding along each axis (its faces stay
+// where they are), a hull's corners move towards its centre until its nearest face is the
+// rounding inside (its other faces move in a little more).
+void prepare_core(Tool& tool) {
+  const bool box = tool.shape == ToolShape::Box;
+  double nearest = tool.half_extents.minCoeff();
+  if (!box) {
+    nearest = HUGE_VAL;
+    for (const HullFace& f : tool.hull->faces) nearest = std::min(nearest, f.offset - f.normal.dot(tool.hull->centre));
+  }
+  tool.rounding = std::min(kMaxRounding, kRoundingFraction * nearest);
+  Vec3List points;
+  if (box) {
+    const Vec3 c = tool.half_extents - Vec3::Constant(tool.rounding);
+    for (int k = 0; k < 8; ++k)
+      points.push_back(Vec3(k & 1 ? c.x() : -c.x(), k & 2 ? c.y() : -c.y(), k & 4 ? c.z() : -c.z()));
+  } else {
+    const double scale = 1 - tool.rounding / nearest;
+    for (const Vec3& v : tool.hull->vertices) points.push_back(tool.hull->centre + scale * (v - tool.hull->centre));
+  }
+  tool.core = build_convex_hull(points, "tool core");
+}
+
 }  // namespace
 
 void prepare_tool_shape(Tool& tool) {
   tool.hull.reset();
+  tool.core.reset();
+  tool.rounding = 0;
   switch (tool.shape) {
     case ToolShape::Sphere:
       require_positive(tool.radius, "radius");
@@ -91,6 +121,7 @@ void prepare_tool_shape(Tool& tool) {
       return;
     case ToolShape::Box:
       for (int k = 0; k < 3; ++k) require_positive(tool.half_extents[k], "half_extents[" + std::to_string(k) + "]");
+      prepare_core(tool);
       return;
     case ToolShape::Plane:
       if (!(tool.plane_normal.allFinite() && tool.plane_normal.norm() > 1e-12))
@@ -99,6 +130,7 @@ void prepare_tool_shape(Tool& tool) {
       return;
     case ToolShape::ConvexHull:
       tool.hull = build_convex_hull(tool.hull_points, "tool hull_points");
+      prepare_core(tool);
       return;
   }
   fail(Errc::InvalidArgument, "tool shape " + std::to_string(int(tool.shape)) + " is not a ToolShape");

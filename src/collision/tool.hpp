@@ -25,6 +25,11 @@ struct Tool {
 
   // Derived from hull_points by prepare_tool_shape (null for other shapes); shared by copies.
   std::shared_ptr<const HullData> hull;
+  // A box's or hull's contact core (tool frame) and rounding (m), by prepare_tool_shape: the shape
+  // shrunk so that, rounded by `rounding`, it fits inside the shape and touches its nearest face.
+  // Contacts are made with the rounded core (core_features.hpp); null for the other shapes.
+  std::shared_ptr<const HullData> core;
+  double rounding = 0;
 
   // The pose at the start of the step, and the velocities the step's pose change implies.
   Vec3 previous_position = Vec3::Zero();

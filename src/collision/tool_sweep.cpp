@@ -6,11 +6,32 @@
 
 namespace mica {
 
+namespace {
+
+// The turn of the tool's shape in the step, new * previous^-1, less what the shape cannot show:
+// a sphere looks the same turned any way, a capsule turned about its axis. (Each body point's
+// path is the chord of its arc: a sphere spun about its centre once swept every node across it,
+// and a half turn pushed the tissue 10 N into the tool.)
+Mat3 shape_turn(const Tool& tool) {
+  switch (tool.shape) {
+    case ToolShape::Sphere: return Mat3::Identity();
+    case ToolShape::Capsule: {
+      const Vec3 before = tool.previous_orientation * Vec3::UnitZ(), after = tool.orientation * Vec3::UnitZ();
+      if ((after - before).norm() <= 1e-12) return Mat3::Identity();  // a spin: the axis moved by round-off
+      return Eigen::Quaterniond::FromTwoVectors(before, after).toRotationMatrix();  // the axis's swing
+    }
+    case ToolShape::Box:
+    case ToolShape::ConvexHull:
+    case ToolShape::Plane: break;
+  }
+  return (tool.orientation * tool.previous_orientation.conjugate()).toRotationMatrix();
+}
+
+}  // namespace
+
 ToolSweep::ToolSweep(const Tool& tool)
-    : start_(tool.previous_position), end_(tool.position),
-      turn_((tool.orientation * tool.previous_orientation.conjugate()).toRotationMatrix()),
-      moved_(tool.position != tool.previous_position ||
-             tool.orientation.coeffs() != tool.previous_orientation.coeffs()) {}
+    : start_(tool.previous_position), end_(tool.position), turn_(shape_turn(tool)),
+      moved_(tool.position != tool.previous_position || turn_ != Mat3::Identity()) {}
 
 bool node_start_side(const Tool& tool, const ToolSweep& sweep, const Vec3& x, SideContact& side) {
   const Vec3 y0 = sweep.start_relative(x);

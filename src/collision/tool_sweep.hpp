@@ -21,7 +21,7 @@ class ToolSweep {
 
  private:
   Vec3 start_, end_;
-  Mat3 turn_;  // the orientation change, new * previous^-1
+  Mat3 turn_;  // the shape's turn, new * previous^-1 (none for a sphere, the axis's swing for a capsule)
   bool moved_;
 };
 
