@@ -47,18 +47,6 @@ namespace mica {
 
 namespace {
 
-// v^T M w
-double mass_dot(const FemModel& m, const Vec3List& v, const Vec3List& w) {
-  const BlockPattern& p = m.pattern;
-  double s = 0;
-  for (int32_t i = 0; i < p.rows; ++i) {
-    Vec3 sum = Vec3::Zero();
-    for (int32_t k = p.row_start[i]; k < p.row_start[i + 1]; ++k) sum += m.mass[k] * w[p.col[k]];
-    s += v[i].dot(sum);
-  }
-  return s;
-}
-
 struct BodyTerms {
   double alpha = 0, beta = 0;  // Rayleigh damping, if the body is damped
   bool loads = false;          // f_ext is part of the step
@@ -188,22 +176,21 @@ void add_twist_stiffness(Body& b, double h) {
 
 }  // namespace
 
-void World::start_rotations(Body& b) const {
+void World::start_rotations(const StepContext& ctx, Body& b) const {
   // The rotations computed after the last step's solve, if the positions are still those.
   b.relin.u_start_known = !b.x_end.empty() && b.x_end == b.x;
   if (b.relin.u_start_known) {
     std::swap(b.R, b.R_end);
     b.relin.u_start = b.relin.u_end;
-  } else if (pool_) {
-    compute_rotations(b.fem, b.x, b.R, *pool_);
   } else {
-    compute_rotations(b.fem, b.x, b.R);
+    compute_rotations(b.fem, b.x, b.R, ctx.pool);
   }
   b.x_end.clear();
 }
 
-void World::relinearise(const std::vector<Body*>& dynamic, double h, StageRunner& stage,
-                        const std::function<void()>& solve) {
+void World::relinearise(const StepContext& ctx, StageRunner& stage) {
+  const std::vector<Body*>& dynamic = ctx.dynamic;
+  const double h = ctx.h;
   const double tol = settings_.relinearise_tolerance;
   const int32_t max_solves = settings_.relinearise_max;
   if (max_solves < 2) return;
@@ -281,19 +268,19 @@ void World::relinearise(const std::vector<Body*>& dynamic, double h, StageRunner
     stage.run(Stage::Elements, true, [&] {
       for (Body* b : dynamic) {
         if (!b->settings.corotational) continue;  // the others' A and forces do not change
-        assemble_elements(*b, h, needs_damping(*b));
+        assemble_elements(ctx, *b);
         if (!at_start) add_twist_stiffness(*b, h);
       }
     });
     stage.run(Stage::Damping, std::any_of(dynamic.begin(), dynamic.end(), [&](Body* b) { return needs_damping(*b); }),
               [&] {
                 for (Body* b : dynamic)
-                  if (b->settings.corotational && needs_damping(*b)) add_damping(*b, h);
+                  if (b->settings.corotational && needs_damping(*b)) add_damping(ctx, *b);
               });
     // The statistics report the solve whose solution the step keeps; iterations add up.
     stats_.solver_residual = 0;
     stats_.converged = true;
-    stage.run(Stage::Solve, true, solve);
+    stage.run(Stage::Solve, true, [&] { solve(ctx); });
   };
   for (Body* b : dynamic) b->relin.v_iter = b->v_next;
   double phi_iter = cur.phi, best = cur.growth;
@@ -347,8 +334,7 @@ void World::relinearise(const std::vector<Body*>& dynamic, double h, StageRunner
         b->relin.v_iter = b->relin.v_best;
         end_state(*b, b->relin.v_iter, h);
         if (b->settings.corotational) {
-          if (pool_) compute_rotations(b->fem, b->x_end, b->R_end, *pool_);
-          else compute_rotations(b->fem, b->x_end, b->R_end);
+          compute_rotations(b->fem, b->x_end, b->R_end, ctx.pool);
         }
       }
     }
