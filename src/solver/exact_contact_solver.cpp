@@ -8,32 +8,24 @@
 
 namespace mica {
 
-int64_t ExactContactSolver::factorizations(uint64_t key) const {
-  const auto it = caches_.find(key);
-  return it == caches_.end() ? 0 : it->second->direct.factorizations();
-}
-
 LinearSolver& ExactContactSolver::linear_solver(const SolveContext& ctx, const SolverBody& body) {
-  std::unique_ptr<BodyCache>& cache = caches_[body.key];
-  if (!cache) {
-    cache = std::make_unique<BodyCache>();
-    if (method_ == LinearMethod::Pcg) cache->pcg.reserve(size_t(body.node_count()));
-  }
+  BodyCache& cache = caches_.of(body);
   if (method_ == LinearMethod::Pcg) {
-    cache->pcg.configure(settings_.tolerance, settings_.max_iterations, ctx.deadline);
-    return cache->pcg;
+    cache.pcg.reserve(size_t(body.node_count()));  // sizes its workspace once
+    cache.pcg.configure(settings_.tolerance, settings_.max_iterations, ctx.deadline);
+    return cache.pcg;
   }
   // CHOLMOD: analysed once; factored when A or the constraint set changed.
-  if (!cache->direct.analyzed()) cache->direct.analyze(body.pattern());
-  if (!cache->factored || cache->matrix_version != body.matrix_version ||
-      cache->constraint_version != body.constraint_version) {
-    cache->factored = false;
-    cache->direct.factorize(body.projected());
-    cache->factored = true;
-    cache->matrix_version = body.matrix_version;
-    cache->constraint_version = body.constraint_version;
+  if (!cache.direct.analyzed()) cache.direct.analyze(body.pattern());
+  if (!cache.factored || cache.matrix_version != body.matrix_version ||
+      cache.constraint_version != body.constraint_version) {
+    cache.factored = false;
+    cache.direct.factorize(body.projected());
+    cache.factored = true;
+    cache.matrix_version = body.matrix_version;
+    cache.constraint_version = body.constraint_version;
   }
-  return cache->direct;
+  return cache.direct;
 }
 
 SolveReport ExactContactSolver::solve(const SolveContext& ctx, std::vector<SolverBody>& bodies,
@@ -56,6 +48,7 @@ SolveReport ExactContactSolver::solve(const SolveContext& ctx, std::vector<Solve
     for (SolverBody& body : bodies)
       for (Vec3& f : *body.contact_impulse) f.setZero();
     lambda.clear();
+    diagonal_.clear();
     return linear;
   }
   warm_.assign(lambda.begin(), lambda.end());

@@ -4,8 +4,6 @@
 // With CHOLMOD it is exact, the reference MICA is measured against; with projected PCG it is as
 // exact as the PCG tolerance. Costly: one linear solve per contact row.
 #pragma once
-#include <memory>
-#include <unordered_map>
 #include <vector>
 
 #include "solver/direct_solver.hpp"
@@ -35,8 +33,11 @@ class ExactContactSolver : public VelocitySolver {
                     std::vector<double>& lambda) override;
   // W_rr per row of the last solve with contacts.
   const std::vector<double>& row_diagonal() const override { return diagonal_; }
-  void forget(uint64_t key) override { caches_.erase(key); }
-  int64_t factorizations(uint64_t key) const override;
+  void forget(uint64_t key) override { caches_.forget(key); }
+  int64_t factorizations(uint64_t key) const override {
+    const BodyCache* cache = caches_.find(key);
+    return cache ? cache->direct.factorizations() : 0;
+  }
 
  private:
   struct BodyCache {
@@ -50,7 +51,7 @@ class ExactContactSolver : public VelocitySolver {
 
   LinearMethod method_;
   SolverSettings settings_;
-  std::unordered_map<uint64_t, std::unique_ptr<BodyCache>> caches_;  // by SolverBody::key
+  BodyCaches<BodyCache> caches_;
   std::vector<LinearSolver*> solvers_;  // per body of the solve
   std::vector<double> diagonal_, warm_;
 };

@@ -20,25 +20,19 @@ const Mat3& projector(const SolverBody& body, int32_t i) {
 
 }  // namespace
 
-int64_t FactoredMicaSolver::factorizations(uint64_t key) const {
-  const auto it = caches_.find(key);
-  return it == caches_.end() ? 0 : it->second->factor.factorizations();
-}
-
 void FactoredMicaSolver::update_factors(const std::vector<SolverBody>& bodies) {
   factored_.resize(bodies.size());
   for (size_t k = 0; k < bodies.size(); ++k) {
     const SolverBody& b = bodies[k];
-    std::unique_ptr<BodyCache>& cache = caches_[b.key];
-    if (!cache) cache = std::make_unique<BodyCache>();
+    BodyCache& cache = caches_.of(b);
     const std::vector<Mat3>* rotation = nullptr;
     if (b.rotation) {
-      compute_node_rotations(*b.fem, *b.rotation, cache->node_rotation);
-      rotation = &cache->node_rotation;
+      compute_node_rotations(*b.fem, *b.rotation, cache.node_rotation);
+      rotation = &cache.node_rotation;
     }
     const LaggedFactor::Key key{b.system.h, b.system.alpha, b.system.beta, b.constraint_version};
-    cache->factor.update(*b.fem, key, *b.A, *b.projection, rotation, rotation ? settings_.refactor_interval : 0);
-    factored_[k] = {&cache->factor, rotation};
+    cache.factor.update(*b.fem, key, *b.A, *b.projection, rotation, rotation ? settings_.refactor_interval : 0);
+    factored_[k] = {&cache.factor, rotation};
   }
 }
 

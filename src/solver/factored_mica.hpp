@@ -11,9 +11,7 @@
 // With P = A the loop would end after one correction; the rotations' mismatch costs a few more.
 #pragma once
 #include <chrono>
-#include <memory>
 #include <optional>
-#include <unordered_map>
 #include <vector>
 
 #include "solver/lagged_factor.hpp"
@@ -32,8 +30,11 @@ class FactoredMicaSolver : public VelocitySolver {
                     std::vector<double>& lambda) override;
   // W_rr of the last solve, per row (0 for a row nothing can move along).
   const std::vector<double>& row_diagonal() const override { return diag_; }
-  void forget(uint64_t key) override { caches_.erase(key); }
-  int64_t factorizations(uint64_t key) const override;
+  void forget(uint64_t key) override { caches_.forget(key); }
+  int64_t factorizations(uint64_t key) const override {
+    const BodyCache* cache = caches_.find(key);
+    return cache ? cache->factor.factorizations() : 0;
+  }
 
  private:
   struct BodyCache {
@@ -61,7 +62,7 @@ class FactoredMicaSolver : public VelocitySolver {
   double complementarity_error(const ContactRows& rows, const std::vector<double>& lambda);
 
   SolverSettings settings_;
-  std::unordered_map<uint64_t, std::unique_ptr<BodyCache>> caches_;  // by SolverBody::key
+  BodyCaches<BodyCache> caches_;
   std::vector<FactoredBody> factored_;
   std::vector<PcgSolver> pcg_;
   std::vector<WarpedFactorPreconditioner> warp_;

@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <unordered_map>
 #include <vector>
 
 #include "core/colouring.hpp"
@@ -26,16 +27,22 @@ enum class SolverKind { Direct, Pcg, Mica };
 // blocks, or the factor of the rest system warped by node rotations (solver/factored_mica.hpp).
 enum class MicaSweep { GaussSeidel, Factored };
 
-// What every solve of a world shares (WorldSettings has the meaning of each).
+// What every solve of a world shares (the first part of WorldSettings).
 struct SolverSettings {
-  double tolerance = 1e-8;
+  double tolerance = 1e-8;      // the stopping test's (each solver's header says on what)
   int32_t max_iterations = 200;
-  bool warm_start = true;      // MICA: start from the last step's velocities (else zero)
-  int32_t pgs_sweeps = 1;      // MICA: PGS sweeps over the contact rows per iteration
-  bool paper_norm = false;     // MICA: stop on the 2-norm of the change of (v, lambda) instead
-  double relaxation = 1.0;     // MICA: MBGS over-relaxation omega in (0, 2)
-  int32_t refactor_interval = 0;  // factored sweep: background refresh every this many solves
-  int32_t refactor_after = 0;     // factored sweep: refactor once a solve used this many iterations
+  bool warm_start = true;       // MICA: start from the last step's velocities and impulses (else zero)
+  int32_t pgs_sweeps = 1;       // MICA: PGS sweeps over the contact rows per iteration
+  bool paper_norm = false;      // MICA: stop on the paper's 2-norm of the change of (v, lambda) instead
+  double relaxation = 1.0;      // MICA: MBGS over-relaxation omega in (0, 2); 1 is the paper's Gauss-Seidel
+  // Factored sweep: refresh each co-rotational body's factor from its current system every this
+  // many steps, factored on a background thread and adopted that many steps later (0: refactor
+  // only when the step size, damping or constraint set changes).
+  int32_t refactor_interval = 0;
+  // Factored sweep: a solve that has used this many conjugate-gradient iterations refactors the
+  // current system and goes on with it (about what a factorization costs on a body of some
+  // thousand nodes; 0: never).
+  int32_t refactor_after = 100;
 };
 
 // What one solve may use of its step.
@@ -85,6 +92,25 @@ class VelocitySolver {
   virtual void forget(uint64_t /*key*/) {}
   // Numeric factorizations made for a body so far (0 for a solver that does not factor).
   virtual int64_t factorizations(uint64_t /*key*/) const { return 0; }
+};
+
+// What a solver keeps per body (factors, workspaces), by SolverBody::key; made on first use.
+template <class Cache>
+class BodyCaches {
+ public:
+  Cache& of(const SolverBody& body) {
+    std::unique_ptr<Cache>& cache = map_[body.key];
+    if (!cache) cache = std::make_unique<Cache>();
+    return *cache;
+  }
+  const Cache* find(uint64_t key) const {
+    const auto it = map_.find(key);
+    return it == map_.end() ? nullptr : it->second.get();
+  }
+  void forget(uint64_t key) { map_.erase(key); }
+
+ private:
+  std::unordered_map<uint64_t, std::unique_ptr<Cache>> map_;
 };
 
 std::unique_ptr<VelocitySolver> make_velocity_solver(SolverKind kind, MicaSweep sweep, const SolverSettings& settings);

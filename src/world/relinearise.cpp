@@ -40,7 +40,7 @@
 #include <chrono>
 #include <cmath>
 
-#include "fem/rotation.hpp"
+#include "fem/linearisation.hpp"
 #include "world/world.hpp"
 
 namespace mica {
@@ -70,22 +70,14 @@ void end_state(Body& b, const Vec3List& v, double h) {
 Eval screen(Body& b, double h) {
   const FemModel& m = b.fem;
   end_state(b, b.v_next, h);
-  double U1 = 0, UR1 = 0, U0 = 0;
   const bool start_known = b.relin.u_start_known;
-  for (size_t e = 0; e < m.elements.size(); ++e) {
-    const TetElement& el = m.elements[e];
-    const Mat3 F1 = deformation_gradient(el, b.x_end);
-    b.R_end[e] = proper_rotation(F1);
-    U1 += elastic_energy(el, m.lame, b.R_end[e], F1);
-    UR1 += elastic_energy(el, m.lame, b.R[e], F1);
-    if (!start_known) U0 += elastic_energy(el, m.lame, b.R[e], deformation_gradient(el, b.x));
-  }
-  if (!start_known) b.relin.u_start = U0;
+  const ScreenEnergies u = screen_energies(m, b.x, b.x_end, b.R, b.R_end, !start_known);
+  if (!start_known) b.relin.u_start = u.u_lin_start;
   b.relin.k_start = 0.5 * mass_dot(m, b.v, b.v);
-  b.relin.u_end = U1;
+  b.relin.u_end = u.u_end;
   Eval out;
-  out.growth = U1 - UR1;
-  out.scale = std::max(b.relin.k_start + b.relin.u_start, 0.5 * mass_dot(m, b.v_next, b.v_next) + U1);
+  out.growth = u.u_end - u.u_lin_end;
+  out.scale = std::max(b.relin.k_start + b.relin.u_start, 0.5 * mass_dot(m, b.v_next, b.v_next) + u.u_end);
   return out;
 }
 
@@ -94,49 +86,17 @@ Eval screen(Body& b, double h) {
 // rotations (they define the damping in phi). Sets x_end, R_end; caches U(x_end).
 Eval evaluate(Body& b, const Vec3List& v, double h, const BodyTerms& d, const std::vector<Mat3>& R_start) {
   const FemModel& m = b.fem;
-  const bool corot = b.settings.corotational;
   end_state(b, v, h);
-  // U1 = U(x+); UL1, UL0 = the linearisation's quadratic energy at x+ and at x; vKv = v^T K v
-  // with its stiffness (the damping's K: R Ke R^T, without G); g* = the twist terms.
-  double U1 = 0, UL1 = 0, UL0 = 0, vKv = 0, vKv_start = 0, gvv = 0, gdd = 0, gll = 0;
-  const Mat3 I = Mat3::Identity();
-  const bool twist = !b.relin.modes.empty();
-  for (size_t e = 0; e < m.elements.size(); ++e) {
-    const TetElement& el = m.elements[e];
-    const Mat3& R = corot ? b.R[e] : I;
-    const Mat3 F1 = deformation_gradient(el, b.x_end);
-    if (corot) b.R_end[e] = proper_rotation(F1);
-    U1 += elastic_energy(el, m.lame, corot ? b.R_end[e] : I, F1);
-    UL1 += elastic_energy(el, m.lame, R, F1);
-    UL0 += elastic_energy(el, m.lame, R, deformation_gradient(el, b.x));
-    // v^T (R Ke R^T) v is twice the strain energy of the displacement v in the frame R.
-    const Mat3 Fv = deformation_gradient(el, v);
-    vKv += 2 * elastic_energy(el, m.lame, R, Fv + R);
-    if (d.beta != 0) {
-      const Mat3& Rs = corot ? R_start[e] : I;
-      vKv_start += 2 * elastic_energy(el, m.lame, Rs, Fv + Rs);
-    }
-    if (!twist) continue;
-    const TwistModes& t = b.relin.modes[e];
-    for (int32_t q = 0; q < t.count; ++q) {
-      double cv = 0, cl = 0;
-      for (int a = 0; a < 4; ++a) {
-        cv += t.q[q][a].dot(v[el.nodes[a]]);
-        cl += t.q[q][a].dot(b.relin.v_lin[el.nodes[a]]);
-      }
-      gvv += t.weight[q] * cv * cv;
-      gdd += t.weight[q] * (cv - cl) * (cv - cl);
-      gll += t.weight[q] * cl * cl;
-    }
-  }
+  const LinearisationEnergies u =
+      linearisation_energies(m, b.x, b.x_end, v, b.settings.corotational ? &b.R : nullptr, b.R_end, &R_start,
+                             d.beta != 0, b.relin.modes, b.relin.v_lin);
   // The linearisation is backward Euler on U_L(y) = U_R(y) + (y - x_lin)^T G (y - x_lin) / 2.
-  UL1 += 0.5 * h * h * gdd;
-  UL0 += 0.5 * h * h * gll;
+  const double U1 = u.u_end, UL1 = u.u_lin_end + 0.5 * h * h * u.gdd, UL0 = u.u_lin_start + 0.5 * h * h * u.gll;
   Vec3List& dv = b.relin.scratch;
   dv.resize(v.size());
   for (size_t i = 0; i < v.size(); ++i) dv[i] = v[i] - b.v[i];
   const double dvMdv = mass_dot(m, dv, dv), vMv = mass_dot(m, v, v);
-  const double dissipation = 0.5 * dvMdv + 0.5 * h * h * (vKv + gvv) + h * (d.alpha * vMv + d.beta * vKv);
+  const double dissipation = 0.5 * dvMdv + 0.5 * h * h * (u.vKv + u.gvv) + h * (d.alpha * vMv + d.beta * u.vKv);
   const double U0 = b.relin.u_start, K0 = b.relin.k_start;
   Eval out;
   out.growth = (U1 - UL1) - (U0 - UL0) - dissipation;
@@ -146,32 +106,16 @@ Eval evaluate(Body& b, const Vec3List& v, double h, const BodyTerms& d, const st
   double fv = 0;
   if (d.loads)
     for (size_t i = 0; i < v.size(); ++i) fv += b.f_ext[i].dot(v[i]);
-  out.phi = 0.5 * dvMdv + U1 - h * fv + 0.5 * h * (d.alpha * vMv + d.beta * vKv_start);
+  out.phi = 0.5 * dvMdv + U1 - h * fv + 0.5 * h * (d.alpha * vMv + d.beta * u.vKv_start);
   b.relin.u_end = U1;
   return out;
 }
 
 // The linearisation at x_end = x + h v_iter (whose rotations b.R are) gains the positive twist
-// stiffness G: A += h^2 G, and f(x_end) - H (y - x_end) = f_R(y) - G (y - x_end) adds h G v_iter
-// to f_int (b = M v + h (f_int + f_ext)).
+// stiffness G (fem/linearisation.hpp).
 void add_twist_stiffness(Body& b, double h) {
-  const FemModel& m = b.fem;
-  b.relin.modes.resize(m.elements.size());
   b.relin.v_lin = b.relin.v_iter;
-  for (size_t e = 0; e < m.elements.size(); ++e) {
-    const TetElement& el = m.elements[e];
-    TwistModes& t = b.relin.modes[e];
-    t = twist_modes(el, m.lame, deformation_gradient(el, b.x_end));
-    for (int32_t q = 0; q < t.count; ++q) {
-      double c = 0;
-      for (int a = 0; a < 4; ++a) c += t.q[q][a].dot(b.relin.v_lin[el.nodes[a]]);
-      const double w = t.weight[q];
-      for (int a = 0; a < 4; ++a) {
-        b.f_int[el.nodes[a]] += (h * w * c) * t.q[q][a];
-        for (int c2 = 0; c2 < 4; ++c2) b.A[m.slots[e][4 * a + c2]] += (h * h * w) * t.q[q][a] * t.q[q][c2].transpose();
-      }
-    }
-  }
+  mica::add_twist_stiffness(b.fem, b.x_end, b.relin.v_lin, h, b.relin.modes, b.A, b.f_int);
 }
 
 }  // namespace

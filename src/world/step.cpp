@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "collision/contact_curvature.hpp"
+#include "core/assert.hpp"
 #include "world/world.hpp"
 
 namespace mica {
@@ -169,7 +170,7 @@ void World::add_contact_stiffness(const StepContext& ctx, Body& b) const {
   // h^2 K_c with K_c = F (-H)+ per contact of a rounded tool on a triangle, F the contact's force
   // in the last step (this step's force is the unknown: the lag keeps the system linear).
   const int32_t index = ctx.index_of(&b);
-  if (index < 0) return;
+  MICA_ASSERT(index >= 0, "the elements stage assembles dynamic bodies only");
   thread_local ToolCore core;  // kept: a step allocates nothing here
   int32_t core_of = -1;
   for (const Contact& c : contacts_) {
@@ -295,6 +296,7 @@ void World::solve(const StepContext& ctx) {
 void World::compute_forces(const StepContext& ctx) {
   const double h = ctx.h;
   const std::vector<double>& row_diagonal = solver_->row_diagonal();
+  MICA_ASSERT(row_diagonal.size() == rows_.size(), "the solver reports the compliance of each row it solved");
   // Tools: the force the tissue puts on the tool is -sum n lambda / h.
   for (Tool* t : ctx.tools) {
     t->force.setZero();
@@ -313,7 +315,7 @@ void World::compute_forces(const StepContext& ctx) {
       t.contact_count += 1;
       // Around the pose it used, pushing the tool in by dx along n raises this row's impulse by
       // n.dx / (h W_rr): the force changes by -n n^T dx / (h^2 W_rr).
-      if (row_diagonal.size() == rows_.size() && row_diagonal[r] > 0)
+      if (row_diagonal[r] > 0)
         t.stiffness -= rows_.direction[r] * rows_.direction[r].transpose() / (h * h * row_diagonal[r]);
     }
   }

@@ -37,26 +37,11 @@ void validate(const WorldSettings& s) {
           "relinearise_tolerance must be finite and >= 0");
 }
 
-namespace {
-SolverSettings solver_settings(const WorldSettings& s) {
-  SolverSettings out;
-  out.tolerance = s.tolerance;
-  out.max_iterations = s.max_iterations;
-  out.warm_start = s.warm_start;
-  out.pgs_sweeps = s.pgs_sweeps;
-  out.paper_norm = s.paper_norm;
-  out.relaxation = s.relaxation;
-  out.refactor_interval = s.refactor_interval;
-  out.refactor_after = s.refactor_after;
-  return out;
-}
-}  // namespace
-
 World::World(const WorldSettings& settings) : settings_(settings) {
   validate(settings);
   const int32_t threads = ThreadPool::resolve(settings.threads);
   if (threads > 1) pool_ = std::make_unique<ThreadPool>(threads);
-  solver_ = make_velocity_solver(settings.solver, settings.mica_sweep, solver_settings(settings));
+  solver_ = make_velocity_solver(settings.solver, settings.mica_sweep, settings);
 }
 
 void World::set_gravity(const Vec3& g) {

@@ -24,27 +24,15 @@ enum class LogLevel { Error, Warning, Info };
 
 constexpr int32_t kMaxThreads = 1024;  // WorldSettings::threads above this is refused
 
-struct WorldSettings {
+// The solver's settings (tolerance, max_iterations, warm_start, pgs_sweeps, paper_norm,
+// relaxation, refactor_interval, refactor_after: solver/velocity_solver.hpp) and the world's.
+struct WorldSettings : SolverSettings {
   Vec3 gravity{0, -9.81, 0};
   SolverKind solver = SolverKind::Direct;
-  int32_t max_iterations = 200;
-  double tolerance = 1e-8;
-  bool plan_all_stages = false;  // run every stage even when its effect is absent
-  int32_t pgs_sweeps = 1;          // MICA: PGS sweeps over the contacts per iteration
-  double max_recovery_speed = 1.0; // m/s, clamps the recovery of penetration (normal_bias)
-  bool paper_norm = false;         // MICA: stop on the paper's 2-norm of the change
-  double relaxation = 1.0;         // MICA: MBGS over-relaxation omega in (0, 2)
   MicaSweep mica_sweep = MicaSweep::GaussSeidel;
-  // Factored sweep: refresh each co-rotational body's factor from its current system every this
-  // many steps, factored on a background thread and adopted that many steps later (0: refactor
-  // only when the step size, damping or constraint set changes).
-  int32_t refactor_interval = 0;
-  // Factored sweep: a solve that has used this many conjugate-gradient iterations refactors the
-  // current system and goes on with it (about what a factorization costs on a body of some
-  // thousand nodes; 0: never).
-  int32_t refactor_after = 100;
-  double time_budget_ms = 0;       // iterative solvers: > 0 stops the solve after this much wall-clock time
-  bool warm_start = true;          // MICA: start from the last step's velocities and impulses (else zero)
+  bool plan_all_stages = false;  // run every stage even when its effect is absent
+  double max_recovery_speed = 1.0; // m/s, clamps the recovery of penetration (normal_bias)
+  double time_budget_ms = 0;       // > 0: every iterative solve of a step stops this long after the step began
   bool body_contact = true;        // contact between bodies (and with static bodies)
   double body_margin = 1e-3;       // m, contacts between bodies are made for gaps below this
   double body_friction = 0;        // Coulomb coefficient between bodies
