@@ -9,7 +9,7 @@
 namespace mica {
 
 LinearSolver& ExactContactSolver::linear_solver(const SolveContext& ctx, const SolverBody& body) {
-  BodyCache& cache = caches_.of(body);
+  ExactBodyCache& cache = cache_of(body);
   if (method_ == LinearMethod::Pcg) {
     cache.pcg.reserve(size_t(body.node_count()));  // sizes its workspace once
     cache.pcg.configure(settings_.tolerance, settings_.max_iterations, ctx.deadline);

@@ -25,33 +25,30 @@ enum class LinearMethod {
 // takes the worst of the linear residuals and the complementarity error (relative to the
 // impulse scale with friction, frictional_contact.hpp). The impulses lambda hold on entry are
 // the sweeps' warm start (frictionless contact is solved by pivoting, which needs none).
-class ExactContactSolver : public VelocitySolver {
+// What the exact solver keeps per body.
+struct ExactBodyCache {
+  DirectSolver direct;
+  PcgSolver pcg;
+  uint64_t matrix_version = 0, constraint_version = 0;  // of the factored system
+  bool factored = false;
+  int64_t factorizations() const { return direct.factorizations(); }
+};
+
+class ExactContactSolver : public CachingVelocitySolver<ExactBodyCache> {
  public:
   explicit ExactContactSolver(LinearMethod method, const SolverSettings& settings = {})
       : method_(method), settings_(settings) {}
   SolveReport solve(const SolveContext& ctx, std::vector<SolverBody>& bodies, const ContactRows& rows,
                     std::vector<double>& lambda) override;
-  // W_rr per row of the last solve with contacts.
+  // W_rr per row of the last solve.
   const std::vector<double>& row_diagonal() const override { return diagonal_; }
-  void forget(uint64_t key) override { caches_.forget(key); }
-  int64_t factorizations(uint64_t key) const override {
-    const BodyCache* cache = caches_.find(key);
-    return cache ? cache->direct.factorizations() : 0;
-  }
 
  private:
-  struct BodyCache {
-    DirectSolver direct;
-    PcgSolver pcg;
-    uint64_t matrix_version = 0, constraint_version = 0;
-    bool factored = false;
-  };
   // The body's linear solver, ready for its A and projection.
   LinearSolver& linear_solver(const SolveContext& ctx, const SolverBody& body);
 
   LinearMethod method_;
   SolverSettings settings_;
-  BodyCaches<BodyCache> caches_;
   std::vector<LinearSolver*> solvers_;  // per body of the solve
   std::vector<double> diagonal_, warm_;
 };

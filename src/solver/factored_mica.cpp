@@ -24,7 +24,7 @@ void FactoredMicaSolver::update_factors(const std::vector<SolverBody>& bodies) {
   factored_.resize(bodies.size());
   for (size_t k = 0; k < bodies.size(); ++k) {
     const SolverBody& b = bodies[k];
-    BodyCache& cache = caches_.of(b);
+    FactoredBodyCache& cache = cache_of(b);
     const std::vector<Mat3>* rotation = nullptr;
     if (b.rotation) {
       compute_node_rotations(*b.fem, *b.rotation, cache.node_rotation);

@@ -20,27 +20,25 @@
 
 namespace mica {
 
+// What the factored solver keeps per body.
+struct FactoredBodyCache {
+  LaggedFactor factor;
+  std::vector<Mat3> node_rotation;  // per node, for warping the factor
+  int64_t factorizations() const { return factor.factorizations(); }
+};
+
 // Each body's factor is updated once per solve for its SystemKey and constraint version
 // (LaggedFactor::update); a co-rotational body's (SolverBody::rotation) is warped by its node
 // rotations and refreshed every SolverSettings::refactor_interval solves in the background.
-class FactoredMicaSolver : public VelocitySolver {
+class FactoredMicaSolver : public CachingVelocitySolver<FactoredBodyCache> {
  public:
   explicit FactoredMicaSolver(const SolverSettings& settings = {}) : settings_(settings) {}
   SolveReport solve(const SolveContext& ctx, std::vector<SolverBody>& bodies, const ContactRows& rows,
                     std::vector<double>& lambda) override;
   // W_rr of the last solve, per row (0 for a row nothing can move along).
   const std::vector<double>& row_diagonal() const override { return diag_; }
-  void forget(uint64_t key) override { caches_.forget(key); }
-  int64_t factorizations(uint64_t key) const override {
-    const BodyCache* cache = caches_.find(key);
-    return cache ? cache->factor.factorizations() : 0;
-  }
 
  private:
-  struct BodyCache {
-    LaggedFactor factor;
-    std::vector<Mat3> node_rotation;  // per node, for warping the factor
-  };
   // What the loop needs beyond SolverBody, per body of a solve.
   struct FactoredBody {
     LaggedFactor* factor;                     // updated for this solve's system and constraints
@@ -62,7 +60,6 @@ class FactoredMicaSolver : public VelocitySolver {
   double complementarity_error(const ContactRows& rows, const std::vector<double>& lambda);
 
   SolverSettings settings_;
-  BodyCaches<BodyCache> caches_;
   std::vector<FactoredBody> factored_;
   std::vector<PcgSolver> pcg_;
   std::vector<WarpedFactorPreconditioner> warp_;

@@ -94,23 +94,26 @@ class VelocitySolver {
   virtual int64_t factorizations(uint64_t /*key*/) const { return 0; }
 };
 
-// What a solver keeps per body (factors, workspaces), by SolverBody::key; made on first use.
+// A solver that keeps a Cache per body (factors, workspaces), by SolverBody::key, made on first
+// use and dropped by forget(); Cache::factorizations() counts the factorizations it made.
 template <class Cache>
-class BodyCaches {
+class CachingVelocitySolver : public VelocitySolver {
  public:
-  Cache& of(const SolverBody& body) {
-    std::unique_ptr<Cache>& cache = map_[body.key];
+  void forget(uint64_t key) override { caches_.erase(key); }
+  int64_t factorizations(uint64_t key) const override {
+    const auto it = caches_.find(key);
+    return it == caches_.end() ? 0 : it->second->factorizations();
+  }
+
+ protected:
+  Cache& cache_of(const SolverBody& body) {
+    std::unique_ptr<Cache>& cache = caches_[body.key];
     if (!cache) cache = std::make_unique<Cache>();
     return *cache;
   }
-  const Cache* find(uint64_t key) const {
-    const auto it = map_.find(key);
-    return it == map_.end() ? nullptr : it->second.get();
-  }
-  void forget(uint64_t key) { map_.erase(key); }
 
  private:
-  std::unordered_map<uint64_t, std::unique_ptr<Cache>> map_;
+  std::unordered_map<uint64_t, std::unique_ptr<Cache>> caches_;
 };
 
 std::unique_ptr<VelocitySolver> make_velocity_solver(SolverKind kind, MicaSweep sweep, const SolverSettings& settings);

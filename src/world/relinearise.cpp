@@ -14,7 +14,7 @@
 //   growth = [U(x+) - U_lin(x+)] - [U(x) - U_lin(x)] - dissipation,
 // U_lin the quadratic energy the step was linearised with (U_R for the first solve),
 // dissipation = |v+ - v|_M^2 / 2 + h^2 v+^T K v+ / 2 + h v+^T C v+ >= 0. Accepted while the
-// growth, summed over the steps since the energy last went down (`energy_debt_`), stays below
+// growth, summed over the steps since the energy last went down (`World::debt_`), stays below
 // WorldSettings::relinearise_tolerance times the bodies' energy. The first screen costs one
 // rotation and two element energies per element: the rotations at x+ are the next step's start
 // rotations (start_rotations reuses them when the positions did not change in between), so the
