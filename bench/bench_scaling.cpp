@@ -6,9 +6,9 @@
 // threads = T (parallel rotations and assembly, colour-ordered sweep). The two worlds step in
 // turn (which one goes first alternates), so both see the same machine load.
 //
-// It uses the C++ API (linked against the core objects): the thread count is not in the C ABI
-// yet. Per size it prints the median ms per step and per stage (Rotations, Elements, Solve),
-// the mean iterations per step, the Solve time per iteration, and the speed-ups T : 1.
+// It uses the C++ API (linked against the core objects). Per size it prints the median ms per
+// step and per stage (Rotations, Elements, Solve), the mean iterations per step, the Solve time
+// per iteration, and the speed-ups T : 1.
 //
 // usage: bench_scaling [out.csv] [max-tets] [threads] [timed-steps-above-40k]
 //          defaults: out/scaling_threads.csv 110000 2 4

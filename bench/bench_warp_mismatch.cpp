@@ -70,16 +70,17 @@ int main(int argc, char** argv) {
   double dt = 0.01, depth = 0.0025, speed = 0.01, wob = 0.001;
   const int K1 = 50;
   std::map<int, std::pair<BlockValues, std::vector<Mat3>>> saved;
+  std::vector<Mat3> Rn;  // the node rotations the last solve warped its factor with
   for (int k = 0; k <= K1; ++k) {
     double tt = (k + 1) * dt, tin = depth / speed;
     double trav = tt < tin ? speed * tt : depth + wob * std::sin(2 * M_PI * (tt - tin));
     w.set_tool_pose(tool, Vec3(c.x(), y0 - trav, c.z()), Eigen::Quaterniond::Identity());
     w.step(dt);
-    if (k == K1 - 1 || k == K1 - 5 || k == 0) saved[K1 - k] = {b.A, b.node_rotation};
+    compute_node_rotations(b.fem, b.R, Rn);
+    if (k == K1 - 1 || k == K1 - 5 || k == 0) saved[K1 - k] = {b.A, Rn};
   }
   const BlockPattern& p = b.fem.pattern;
   const int n = p.rows;
-  const std::vector<Mat3>& Rn = b.node_rotation;
   for (auto& [lag, ref] : saved) {
     const BlockValues& Ar = ref.first;
     const std::vector<Mat3>& Rr = ref.second;

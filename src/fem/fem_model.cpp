@@ -63,60 +63,51 @@ FemModel build_fem_model(const TetMesh& mesh, const Material& material, MassKind
   return m;
 }
 
-void compute_rotations(const FemModel& m, const Vec3List& x, std::vector<Mat3>& R) {
-  for (size_t e = 0; e < m.elements.size(); ++e)
-    R[e] = proper_rotation(deformation_gradient(m.elements[e], x));
-}
-
-void compute_rotations(const FemModel& m, const Vec3List& x, std::vector<Mat3>& R, ThreadPool& pool) {
-  parallel_for(&pool, int64_t(m.elements.size()), 64, [&](int32_t first, int32_t last) {
+void compute_rotations(const FemModel& m, const Vec3List& x, std::vector<Mat3>& R, ThreadPool* pool) {
+  parallel_for(pool, int64_t(m.elements.size()), 64, [&](int32_t first, int32_t last) {
     for (int32_t e = first; e < last; ++e) R[e] = proper_rotation(deformation_gradient(m.elements[e], x));
   });
 }
 
+void compute_node_rotations(const FemModel& m, const std::vector<Mat3>& element_rotation,
+                            std::vector<Mat3>& node_rotation) {
+  node_rotation.assign(size_t(m.node_count()), Mat3::Zero());
+  for (size_t e = 0; e < m.elements.size(); ++e)
+    for (int32_t a : m.elements[e].nodes) node_rotation[size_t(a)] += element_rotation[e];
+  for (Mat3& R : node_rotation) R = R.isZero(0) ? Mat3::Identity() : proper_rotation(R);
+}
+
 void assemble_elastic(const FemModel& m, const Vec3List& x, const std::vector<Mat3>* R, double k_scale,
-                      BlockValues* K, Vec3List& f_int, const Colouring& element_colours, ThreadPool& pool) {
-  parallel_for(&pool, int64_t(f_int.size()), 4096, [&](int32_t first, int32_t last) {
+                      BlockValues* K, Vec3List& f_int, const Colouring* element_colours, ThreadPool* pool) {
+  const bool coloured = pool && element_colours && !element_colours->empty();
+  parallel_for(coloured ? pool : nullptr, int64_t(f_int.size()), 4096, [&](int32_t first, int32_t last) {
     for (int32_t i = first; i < last; ++i) f_int[i].setZero();
   });
   const Mat3 I = Mat3::Identity();
-  const Colouring& c = element_colours;
-  auto blocks = [&](int32_t, int32_t first, int32_t last, int32_t) {
-    Mat3 Ke[16];
-    for (int32_t n = first; n < last; ++n)
-      for (int32_t e = c.block_start[c.order[n]]; e < c.block_start[c.order[n] + 1]; ++e) {
-        const TetElement& el = m.elements[e];
-        const Mat3& Re = R ? (*R)[e] : I;
-        add_elastic_forces(el, m.lame, Re, deformation_gradient(el, x), f_int);
-        if (!K) continue;
-        rotated_stiffness(el, m.lame, Re, k_scale, Ke);
-        for (int q = 0; q < 16; ++q) (*K)[m.slots[e][q]] += Ke[q];
-      }
-  };
-  pool.phased_for(c.start.data(), c.colours(), 1, blocks);
-}
-
-void assemble_elastic(const FemModel& m, const Vec3List& x, const std::vector<Mat3>* R, double k_scale,
-                      BlockValues* K, Vec3List& f_int) {
-  for (auto& f : f_int) f.setZero();
-  const Mat3 I = Mat3::Identity();
-  Mat3 Ke[16];
-  for (size_t e = 0; e < m.elements.size(); ++e) {
+  auto element = [&](int32_t e, Mat3* Ke) {  // Ke: 16 blocks of scratch
     const TetElement& el = m.elements[e];
     const Mat3& Re = R ? (*R)[e] : I;
     add_elastic_forces(el, m.lame, Re, deformation_gradient(el, x), f_int);
-    if (!K) continue;
+    if (!K) return;
     rotated_stiffness(el, m.lame, Re, k_scale, Ke);
     for (int q = 0; q < 16; ++q) (*K)[m.slots[e][q]] += Ke[q];
+  };
+  if (!coloured) {
+    Mat3 Ke[16];
+    for (int32_t e = 0; e < int32_t(m.elements.size()); ++e) element(e, Ke);
+    return;
   }
+  const Colouring& c = *element_colours;
+  auto blocks = [&](int32_t, int32_t first, int32_t last, int32_t) {
+    Mat3 Ke[16];
+    for (int32_t n = first; n < last; ++n)
+      for (int32_t e = c.block_start[c.order[n]]; e < c.block_start[c.order[n] + 1]; ++e) element(e, Ke);
+  };
+  pool->phased_for(c.start.data(), c.colours(), 1, blocks);
 }
 
-void set_scaled_mass(const FemModel& m, double scale, BlockValues& A) {
-  for (size_t k = 0; k < A.size(); ++k) A[k] = (scale * m.mass[k]) * Mat3::Identity();
-}
-
-void set_scaled_mass(const FemModel& m, double scale, BlockValues& A, ThreadPool& pool) {
-  parallel_for(&pool, int64_t(A.size()), 4096, [&](int32_t first, int32_t last) {
+void set_scaled_mass(const FemModel& m, double scale, BlockValues& A, ThreadPool* pool) {
+  parallel_for(pool, int64_t(A.size()), 4096, [&](int32_t first, int32_t last) {
     for (int32_t k = first; k < last; ++k) A[k] = (scale * m.mass[k]) * Mat3::Identity();
   });
 }
@@ -132,6 +123,17 @@ void mass_multiply(const FemModel& m, const Vec3List& v, Vec3List& out) {
     for (int32_t k = p.row_start[i]; k < p.row_start[i + 1]; ++k) sum += m.mass[k] * v[p.col[k]];
     out[i] = sum;
   }
+}
+
+double mass_dot(const FemModel& m, const Vec3List& v, const Vec3List& w) {
+  const BlockPattern& p = m.pattern;
+  double s = 0;
+  for (int32_t i = 0; i < p.rows; ++i) {
+    Vec3 sum = Vec3::Zero();
+    for (int32_t k = p.row_start[i]; k < p.row_start[i + 1]; ++k) sum += m.mass[k] * w[p.col[k]];
+    s += v[i].dot(sum);
+  }
+  return s;
 }
 
 double elastic_energy(const FemModel& m, const Vec3List& x, bool corotational) {

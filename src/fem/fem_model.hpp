@@ -37,31 +37,34 @@ struct FemModel {
 FemModel build_fem_model(const TetMesh& mesh, const Material& material, MassKind mass_kind,
                          const std::string& source);
 
-// Per-element rotations of the current positions x.
-void compute_rotations(const FemModel& m, const Vec3List& x, std::vector<Mat3>& R);
+// Per-element rotations of the current positions x, on the threads of `pool` if there is one
+// (each element's own: the result does not depend on the pool).
+void compute_rotations(const FemModel& m, const Vec3List& x, std::vector<Mat3>& R, ThreadPool* pool = nullptr);
+
+// Per node, the rotation nearest the sum of its elements' rotations (identity for a node in no
+// element).
+void compute_node_rotations(const FemModel& m, const std::vector<Mat3>& element_rotation,
+                            std::vector<Mat3>& node_rotation);
 
 // f_int = sum of element elastic forces at x; when K is not null also K += k_scale * sum R Ke R^T.
-// R == nullptr means the linear model (R = I for every element).
+// R == nullptr means the linear model (R = I for every element). Serial in element order, or,
+// with a pool and a colouring of the elements (blocks of a colour share no node), colour by
+// colour on the pool's threads: every block of A and every force has one writer at a time and
+// no per-step buffer is needed; the sums then run in colour order rather than element order, so
+// A and f_int differ from the serial ones by round-off (but not with the thread count: the
+// order is the colouring's).
 void assemble_elastic(const FemModel& m, const Vec3List& x, const std::vector<Mat3>* R, double k_scale,
-                      BlockValues* K, Vec3List& f_int);
-
-// The same on the threads of `pool`. Rotations: each element's own, so the result is the serial
-// one bit for bit. Assembly: the element blocks colour by colour (`element_colours`: blocks of a
-// colour share no node), so every block of A and every force has one writer at a time and no
-// per-step buffer is needed; the sums run in colour order rather than element order, so A and
-// f_int differ from the serial ones by round-off (but not with the thread count: the order is
-// the colouring's).
-void compute_rotations(const FemModel& m, const Vec3List& x, std::vector<Mat3>& R, ThreadPool& pool);
-void assemble_elastic(const FemModel& m, const Vec3List& x, const std::vector<Mat3>* R, double k_scale,
-                      BlockValues* K, Vec3List& f_int, const Colouring& element_colours, ThreadPool& pool);
+                      BlockValues* K, Vec3List& f_int, const Colouring* element_colours = nullptr,
+                      ThreadPool* pool = nullptr);
 
 // A = scale * M (overwrites every block, so it also clears A).
-void set_scaled_mass(const FemModel& m, double scale, BlockValues& A);
-void set_scaled_mass(const FemModel& m, double scale, BlockValues& A, ThreadPool& pool);
+void set_scaled_mass(const FemModel& m, double scale, BlockValues& A, ThreadPool* pool = nullptr);
 // A += scale * M
 void add_scaled_mass(const FemModel& m, double scale, BlockValues& A);
 // out = M v
 void mass_multiply(const FemModel& m, const Vec3List& v, Vec3List& out);
+// v^T M w
+double mass_dot(const FemModel& m, const Vec3List& v, const Vec3List& w);
 
 // Strain energy at x; co-rotational uses each element's own rotation of x, linear R = I.
 double elastic_energy(const FemModel& m, const Vec3List& x, bool corotational);

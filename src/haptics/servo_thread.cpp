@@ -9,7 +9,6 @@ namespace mica {
 
 namespace {
 using Clock = std::chrono::steady_clock;
-constexpr double kRateWindow = 1.0;  // s, the span measured_rate() averages over
 }  // namespace
 
 void ServoThread::start(Tick tick, void* context, double period_s) {
@@ -19,7 +18,6 @@ void ServoThread::start(Tick tick, void* context, double period_s) {
   if (running() || thread_.joinable()) fail(Errc::WrongState, "servo thread: already running");
 
   stop_requested_.store(false, std::memory_order_relaxed);
-  rate_.store(0, std::memory_order_relaxed);
   ticks_.store(0, std::memory_order_relaxed);
   skipped_.store(0, std::memory_order_relaxed);
   thread_ = std::thread(&ServoThread::loop, this, tick, context, period_s);
@@ -36,32 +34,11 @@ void ServoThread::loop(Tick tick, void* context, double period_s) {
   const auto period = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(period_s));
   const auto step = period.count() > 0 ? period : Clock::duration(1);  // a period below the clock's resolution
   Clock::time_point deadline = Clock::now();
-  Clock::time_point window_start;  // time of the tick that opened the rate window
-  int64_t window_ticks = -1;       // ticks since then; -1: no window yet
-  bool full_window = false;        // a whole window has been measured
 
   while (!stop_requested_.load(std::memory_order_acquire)) {
     tick(context);
     ticks_.fetch_add(1, std::memory_order_relaxed);
-
-    // The rate: intervals between ticks over their span. Until the first whole window it is
-    // refreshed every tick; after, once per window.
     const Clock::time_point now = Clock::now();
-    if (window_ticks < 0) {
-      window_start = now;
-      window_ticks = 0;
-    } else {
-      ++window_ticks;
-      const double elapsed = std::chrono::duration<double>(now - window_start).count();
-      const bool window_done = elapsed >= kRateWindow;
-      if (elapsed > 0 && (window_done || !full_window))
-        rate_.store(double(window_ticks) / elapsed, std::memory_order_relaxed);
-      if (window_done) {
-        full_window = true;
-        window_start = now;
-        window_ticks = 0;
-      }
-    }
 
     // The next deadline on the grid; if it has already passed, the first one still ahead.
     deadline += step;

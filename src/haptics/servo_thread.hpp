@@ -30,9 +30,6 @@ class ServoThread {
   void stop();
 
   bool running() const { return running_.load(std::memory_order_acquire); }
-  // Ticks per second over the last whole second (refreshed once a second; during the first
-  // second, over the time since the first tick); 0 before the second tick. Kept after stop().
-  double measured_rate() const { return rate_.load(std::memory_order_relaxed); }
   // Ticks run and deadlines skipped since start().
   int64_t ticks() const { return ticks_.load(std::memory_order_relaxed); }
   int64_t skipped() const { return skipped_.load(std::memory_order_relaxed); }
@@ -43,7 +40,6 @@ class ServoThread {
   std::thread thread_;
   std::atomic<bool> running_{false};
   std::atomic<bool> stop_requested_{false};
-  std::atomic<double> rate_{0};
   std::atomic<int64_t> ticks_{0};
   std::atomic<int64_t> skipped_{0};
 };

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "solver/friction_cone.hpp"
+
 namespace mica {
 
 void ContactRows::clear() {
@@ -13,6 +15,12 @@ void ContactRows::clear() {
   mu.clear();
   contact.clear();
   key.clear();
+}
+
+void ContactRows::project(std::vector<double>& lambda) const {
+  for (size_t r = 0; r < size(); ++r)
+    if (normal_of[r] < 0) lambda[r] = std::max(lambda[r], 0.0);
+    else if (first_tangent(r)) project_onto_disk(mu[r] * lambda[normal_of[r]], lambda[r], lambda[r + 1]);
 }
 
 double normal_bias(const Contact& contact, double h, double max_recovery_speed) {

@@ -34,6 +34,16 @@ struct ContactRows {
   void clear();
   // Rows of all contacts; normal rows get normal_bias.
   void build(const std::vector<Contact>& contacts, double h, double max_recovery_speed);
+  // Impulses onto their cones: a normal row's onto lambda >= 0, a tangent pair onto the disk of
+  // mu lambda_n (friction_cone.hpp).
+  void project(std::vector<double>& lambda) const;
+  // Adds G^T lambda, row by row: impulse(body) is the body's Vec3List of per-node impulses.
+  template <class ImpulseOf>
+  void scatter(const std::vector<double>& lambda, ImpulseOf&& impulse) const {
+    for (size_t r = 0; r < size(); ++r)
+      for (int32_t t = start[r]; t < start[r + 1]; ++t)
+        impulse(terms[t].body)[terms[t].node] += terms[t].coef * lambda[r] * direction[r];
+  }
 };
 
 // The bias of a contact's normal row, n . v + bias >= 0: gap / h, the velocity that closes the gap

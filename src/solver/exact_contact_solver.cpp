@@ -8,35 +8,63 @@
 
 namespace mica {
 
-SolveReport solve_contact_delassus(std::vector<ExactBody>& bodies, const ContactRows& rows, std::vector<double>& lambda,
-                                   std::vector<double>& diagonal, const ExactContactSettings& settings) {
-  if (settings.warm_start && settings.warm_start->size() != rows.size())
-    fail(Errc::InvalidArgument, "solve_contact_delassus: the warm start needs one impulse per row");
+LinearSolver& ExactContactSolver::linear_solver(const SolveContext& ctx, const SolverBody& body) {
+  ExactBodyCache& cache = cache_of(body);
+  if (method_ == LinearMethod::Pcg) {
+    cache.pcg.reserve(size_t(body.node_count()));  // sizes its workspace once
+    cache.pcg.configure(settings_.tolerance, settings_.max_iterations, ctx.deadline);
+    return cache.pcg;
+  }
+  // CHOLMOD: analysed once; factored when A or the constraint set changed.
+  if (!cache.direct.analyzed()) cache.direct.analyze(body.pattern());
+  if (!cache.factored || cache.matrix_version != body.matrix_version ||
+      cache.constraint_version != body.constraint_version) {
+    cache.factored = false;
+    cache.direct.factorize(body.projected());
+    cache.factored = true;
+    cache.matrix_version = body.matrix_version;
+    cache.constraint_version = body.constraint_version;
+  }
+  return cache.direct;
+}
+
+SolveReport ExactContactSolver::solve(const SolveContext& ctx, std::vector<SolverBody>& bodies,
+                                      const ContactRows& rows, std::vector<double>& lambda) {
   const size_t nb = bodies.size(), nr = rows.size();
   SolveReport linear;
   auto record = [&linear](const SolveReport& r) {
     linear.iterations += r.iterations;
     if (!(r.residual <= linear.residual)) linear.residual = r.residual;
     linear.converged = linear.converged && r.converged;
+    linear.out_of_time = linear.out_of_time || r.out_of_time;
   };
   // Free velocities: the step without contact.
-  for (ExactBody& body : bodies) {
-    const ProjectedSystem sys{*body.pattern, *body.A, *body.projection};
-    record(body.solver->solve(sys, *body.b, *body.v));
+  solvers_.resize(nb);
+  for (size_t bi = 0; bi < nb; ++bi) {
+    solvers_[bi] = &linear_solver(ctx, bodies[bi]);
+    record(solvers_[bi]->solve(bodies[bi].projected(), *bodies[bi].b, *bodies[bi].v));
   }
+  if (nr == 0) {  // no contact: the free velocities are the step's
+    for (SolverBody& body : bodies)
+      for (Vec3& f : *body.contact_impulse) f.setZero();
+    lambda.clear();
+    diagonal_.clear();
+    return linear;
+  }
+  warm_.assign(lambda.begin(), lambda.end());
+  warm_.resize(nr, 0.0);
   // Responses A^-1 G_s^T, per row and per body the row touches.
   std::vector<std::vector<Vec3List>> response(nr, std::vector<Vec3List>(nb));
   for (size_t s = 0; s < nr; ++s)
     for (int32_t t = rows.start[s]; t < rows.start[s + 1]; ++t) {
       const int32_t bi = rows.terms[t].body;
       if (!response[s][bi].empty()) continue;
-      ExactBody& body = bodies[bi];
+      const SolverBody& body = bodies[bi];
       Vec3List f(body.v->size(), Vec3::Zero());
       for (int32_t u = rows.start[s]; u < rows.start[s + 1]; ++u)
         if (rows.terms[u].body == bi) f[rows.terms[u].node] += rows.terms[u].coef * rows.direction[s];
       response[s][bi].resize(f.size());
-      const ProjectedSystem sys{*body.pattern, *body.A, *body.projection};
-      record(body.solver->solve_homogeneous(sys, f, response[s][bi]));
+      record(solvers_[bi]->solve_homogeneous(body.projected(), f, response[s][bi]));
     }
   // W = G A^-1 G^T and q = G v_free + gap / h.
   Eigen::MatrixXd W = Eigen::MatrixXd::Zero(Eigen::Index(nr), Eigen::Index(nr));
@@ -51,7 +79,7 @@ SolveReport solve_contact_delassus(std::vector<ExactBody>& bodies, const Contact
           W(r, s) += term.coef * rows.direction[r].dot(response[s][term.body][term.node]);
     }
   }
-  diagonal.assign(W.diagonal().data(), W.diagonal().data() + nr);
+  diagonal_.assign(W.diagonal().data(), W.diagonal().data() + nr);
   // Rows whose points cannot move along them (W_rr ~ 0: fixed nodes) carry no impulse: they are
   // left out, as in MICA, or a penetrating one would make the problem infeasible.
   const double scale = std::max(W.diagonal().cwiseAbs().maxCoeff(), 1e-300);
@@ -66,7 +94,7 @@ SolveReport solve_contact_delassus(std::vector<ExactBody>& bodies, const Contact
   }
   const Eigen::Index nk = Eigen::Index(kept.size());
   Eigen::MatrixXd Wk(nk, nk);
-  Eigen::VectorXd qk(nk), mu(nk), warm(settings.warm_start ? nk : 0);
+  Eigen::VectorXd qk(nk), mu(nk), warm(nk);
   std::vector<int32_t> normal_of(kept.size());
   bool friction = false;
   for (Eigen::Index i = 0; i < nk; ++i) {
@@ -76,7 +104,7 @@ SolveReport solve_contact_delassus(std::vector<ExactBody>& bodies, const Contact
     const int32_t n = rows.normal_of[kept[i]];
     normal_of[i] = n < 0 ? -1 : kept_at[n];
     friction = friction || normal_of[i] >= 0;
-    if (settings.warm_start) warm[i] = (*settings.warm_start)[size_t(kept[i])];
+    warm[i] = warm_[size_t(kept[i])];
   }
   // Without friction the LCP is solved exactly by Lemke's pivoting; with friction (not an LCP:
   // the cone's radius moves with the normal impulse) by block Gauss-Seidel over the contacts,
@@ -98,7 +126,7 @@ SolveReport solve_contact_delassus(std::vector<ExactBody>& bodies, const Contact
   }
   if (z.size() != nk) {
     FrictionalSettings fs;
-    fs.deadline = settings.deadline;
+    fs.deadline = ctx.deadline;
     const FrictionalSolution sol = solve_frictional_contact(Wk, qk, mu, normal_of, warm, fs);
     if (!sol.z.allFinite()) fail(Errc::Numerical, "the exact contact solve failed: " + pivoting + sol.message);
     z = sol.z;
@@ -112,14 +140,11 @@ SolveReport solve_contact_delassus(std::vector<ExactBody>& bodies, const Contact
   if (!(error <= report.residual)) report.residual = error;
   lambda.assign(l.data(), l.data() + l.size());
   // v = v_free + A^-1 G^T lambda, and the impulses per node.
-  for (size_t bi = 0; bi < nb; ++bi) bodies[bi].contact_impulse.assign(bodies[bi].v->size(), Vec3::Zero());
-  for (size_t s = 0; s < nr; ++s) {
+  for (size_t s = 0; s < nr; ++s)
     for (size_t bi = 0; bi < nb; ++bi)
       if (!response[s][bi].empty())
         for (size_t i = 0; i < response[s][bi].size(); ++i) (*bodies[bi].v)[i] += response[s][bi][i] * l[s];
-    for (int32_t t = rows.start[s]; t < rows.start[s + 1]; ++t)
-      bodies[rows.terms[t].body].contact_impulse[rows.terms[t].node] += rows.terms[t].coef * l[s] * rows.direction[s];
-  }
+  scatter_contact_impulses(rows, lambda, bodies);
   return report;
 }
 

@@ -1,43 +1,56 @@
 // Contact through the Delassus matrix: W = G A^-1 G^T formed column by column with each body's
 // linear solver, and its complementarity problem solved to round-off (Lemke's pivoting without
-// friction; with Coulomb friction block Gauss-Seidel over the contacts, frictional_contact.hpp). With CHOLMOD it is exact, the reference MICA is measured against; with projected
-// PCG it is as exact as the PCG tolerance. Costly: one linear solve per contact row.
+// friction; with Coulomb friction block Gauss-Seidel over the contacts, frictional_contact.hpp).
+// With CHOLMOD it is exact, the reference MICA is measured against; with projected PCG it is as
+// exact as the PCG tolerance. Costly: one linear solve per contact row.
 #pragma once
-#include <chrono>
-#include <optional>
 #include <vector>
 
-#include "solver/contact_rows.hpp"
 #include "solver/direct_solver.hpp"
+#include "solver/pcg.hpp"
+#include "solver/velocity_solver.hpp"
 
 namespace mica {
 
-struct ExactBody {
-  const BlockPattern* pattern;
-  const BlockValues* A;
-  const Vec3List* b;
-  const Projection* projection;
-  LinearSolver* solver;      // ready for this A and projection (a DirectSolver: factored)
-  Vec3List* v;               // out
-  Vec3List contact_impulse;  // out: G^T lambda per node, N s
+// How each body's linear systems are solved.
+enum class LinearMethod {
+  Direct,  // CHOLMOD, factored when A or the constraint set changed (a linear body keeps its factor)
+  Pcg,     // projected block-Jacobi PCG to SolverSettings::tolerance, warm-started, stopped at the deadline
 };
 
-struct ExactContactSettings {
-  // Friction: the impulse per row to start from (say the last step's, matched by row key);
-  // null: zero. Frictionless contact is solved by pivoting, which needs none.
-  const std::vector<double>* warm_start = nullptr;
-  // Friction: the sweeps stop here, unconverged (out_of_time). The linear solves are not cut.
-  std::optional<std::chrono::steady_clock::time_point> deadline;
+// Throws Error(Numerical) if the frictionless complementarity problem has no solution the
+// pivoting can find, or an impulse is not finite; a frictional solve that stops short of its
+// tolerance (sweep cap, deadline: the linear solves are not cut) is reported (converged false),
+// not thrown. The report sums the linear solves' iterations and the frictional sweeps, and
+// takes the worst of the linear residuals and the complementarity error (relative to the
+// impulse scale with friction, frictional_contact.hpp). The impulses lambda hold on entry are
+// the sweeps' warm start (frictionless contact is solved by pivoting, which needs none).
+// What the exact solver keeps per body.
+struct ExactBodyCache {
+  DirectSolver direct;
+  PcgSolver pcg;
+  uint64_t matrix_version = 0, constraint_version = 0;  // of the factored system
+  bool factored = false;
+  int64_t factorizations() const { return direct.factorizations(); }
 };
 
-// lambda: out, impulse per row (N s). Throws Error(Numerical) if the frictionless
-// complementarity problem has no solution the pivoting can find, or an impulse is not finite;
-// a frictional solve that stops short of its tolerance (sweep cap, deadline) is reported
-// (converged false), not thrown. The report sums the linear solves' iterations and the
-// frictional sweeps, and takes the worst of the linear residuals and the complementarity error
-// (relative to the impulse scale with friction, frictional_contact.hpp).
-// `diagonal` receives W_rr per row.
-SolveReport solve_contact_delassus(std::vector<ExactBody>& bodies, const ContactRows& rows, std::vector<double>& lambda,
-                                   std::vector<double>& diagonal, const ExactContactSettings& settings = {});
+class ExactContactSolver : public CachingVelocitySolver<ExactBodyCache> {
+ public:
+  explicit ExactContactSolver(LinearMethod method, const SolverSettings& settings = {})
+      : method_(method), settings_(settings) {}
+  SolveReport solve(const SolveContext& ctx, std::vector<SolverBody>& bodies, const ContactRows& rows,
+                    std::vector<double>& lambda) override;
+  // W_rr per row of the last solve.
+  const std::vector<double>& row_diagonal() const override { return diagonal_; }
+
+ private:
+  // The body's linear solver, ready for its A and projection.
+  LinearSolver& linear_solver(const SolveContext& ctx, const SolverBody& body);
+
+  LinearMethod method_;
+  SolverSettings settings_;
+  std::vector<LinearSolver*> solvers_;  // per body of the solve
+  std::vector<double> diagonal_, warm_;
+};
 
 }  // namespace mica

@@ -1,5 +1,7 @@
 #include "solver/factored_mica.hpp"
 
+#include "solver/mica_solver.hpp"
+
 #include "solver/friction_cone.hpp"
 #include "solver/frictional_contact.hpp"
 
@@ -11,18 +13,31 @@ namespace mica {
 
 namespace {
 
-const Mat3& projector(const MicaBody& body, int32_t i) {
+const Mat3& projector(const SolverBody& body, int32_t i) {
   static const Mat3 identity = Mat3::Identity();
   return body.projection->active() && body.projection->is_constrained[i] ? body.projection->S[i] : identity;
 }
 
-// How far node i turned since the factor's step.
-Mat3 rotation(const FactoredBody& f, int32_t i) { return f.factor->turn(f.node_rotation, i); }
-
 }  // namespace
 
-void FactoredMicaSolver::build_compliance(const std::vector<MicaBody>& bodies,
-                                          const std::vector<FactoredBody>& factored, const ContactRows& rows) {
+void FactoredMicaSolver::update_factors(const std::vector<SolverBody>& bodies) {
+  factored_.resize(bodies.size());
+  for (size_t k = 0; k < bodies.size(); ++k) {
+    const SolverBody& b = bodies[k];
+    FactoredBodyCache& cache = cache_of(b);
+    const std::vector<Mat3>* rotation = nullptr;
+    if (b.rotation) {
+      compute_node_rotations(*b.fem, *b.rotation, cache.node_rotation);
+      rotation = &cache.node_rotation;
+    }
+    const LaggedFactor::Key key{b.system.h, b.system.alpha, b.system.beta, b.constraint_version};
+    cache.factor.update(*b.fem, key, *b.A, *b.projection, rotation, rotation ? settings_.refactor_interval : 0);
+    factored_[k] = {&cache.factor, rotation};
+  }
+}
+
+void FactoredMicaSolver::build_compliance(const std::vector<SolverBody>& bodies, const ContactRows& rows) {
+  const std::vector<FactoredBody>& factored = factored_;
   const size_t nr = rows.size(), nt = rows.terms.size();
   term_columns_.resize(nt);
   term_force_.resize(nt);
@@ -37,7 +52,8 @@ void FactoredMicaSolver::build_compliance(const std::vector<MicaBody>& bodies,
     for (int32_t t = rows.start[r]; t < rows.start[r + 1]; ++t) {
       const RowTerm& term = rows.terms[t];
       term_columns_[t] = &factored[term.body].factor->columns(term.node);
-      term_force_[t] = term.coef * (rotation(factored[term.body], term.node).transpose() *
+      const FactoredBody& f = factored[term.body];
+      term_force_[t] = term.coef * (f.factor->turn(f.node_rotation, term.node).transpose() *
                                     (projector(bodies[term.body], term.node) * rows.direction[r]));
       row_of[t] = int32_t(r);
     }
@@ -52,11 +68,10 @@ void FactoredMicaSolver::build_compliance(const std::vector<MicaBody>& bodies,
     }
 }
 
-void FactoredMicaSolver::start_compliance(const std::vector<MicaBody>& bodies,
-                                          const std::vector<FactoredBody>& factored, const ContactRows& rows,
+void FactoredMicaSolver::start_compliance(const std::vector<SolverBody>& bodies, const ContactRows& rows,
                                           std::vector<double>& lambda) {
   const size_t nr = rows.size();
-  build_compliance(bodies, factored, rows);
+  build_compliance(bodies, rows);
   diag_.assign(nr, 0.0);
   warped_diag_.assign(nr, 0.0);
   const double w_max = nr ? W_.diagonal().cwiseAbs().maxCoeff() : 0.0;
@@ -64,16 +79,13 @@ void FactoredMicaSolver::start_compliance(const std::vector<MicaBody>& bodies,
     if (W_(r, r) > 1e-12 * w_max) diag_[r] = warped_diag_[r] = W_(r, r);
     else lambda[r] = 0;  // nothing can move along this row
   }
-  for (size_t r = 0; r < nr; ++r)  // the warm start onto the cones
-    if (rows.normal_of[r] < 0) lambda[r] = std::max(lambda[r], 0.0);
-    else if (rows.first_tangent(r)) project_onto_disk(rows.mu[r] * lambda[rows.normal_of[r]], lambda[r], lambda[r + 1]);
+  rows.project(lambda);  // the warm start onto the cones
 }
 
-void FactoredMicaSolver::apply_impulse_change(std::vector<MicaBody>& bodies,
-                                              const std::vector<FactoredBody>& factored, const ContactRows& rows,
+void FactoredMicaSolver::apply_impulse_change(std::vector<SolverBody>& bodies, const ContactRows& rows,
                                               const std::vector<double>& dlambda) {
   for (size_t bi = 0; bi < bodies.size(); ++bi) {
-    y_.setZero(3 * Eigen::Index(bodies[bi].pattern->rows));
+    y_.setZero(3 * Eigen::Index(bodies[bi].node_count()));
     bool any = false;
     for (size_t r = 0; r < rows.size(); ++r) {
       if (dlambda[r] == 0) continue;
@@ -85,8 +97,9 @@ void FactoredMicaSolver::apply_impulse_change(std::vector<MicaBody>& bodies,
     }
     if (!any) continue;
     Vec3List& v = *bodies[bi].v;
-    for (int32_t i = 0; i < bodies[bi].pattern->rows; ++i)
-      v[i] += projector(bodies[bi], i) * (rotation(factored[bi], i) * y_.segment<3>(3 * i));
+    const FactoredBody& f = factored_[bi];
+    for (int32_t i = 0; i < bodies[bi].node_count(); ++i)
+      v[i] += projector(bodies[bi], i) * (f.factor->turn(f.node_rotation, i) * y_.segment<3>(3 * i));
   }
 }
 
@@ -164,15 +177,14 @@ double FactoredMicaSolver::complementarity_error(const ContactRows& rows, const 
   return std::sqrt(e2);
 }
 
-MicaReport FactoredMicaSolver::solve(std::vector<MicaBody>& bodies, const std::vector<FactoredBody>& factored,
-                                     const ContactRows& rows, const MicaSettings& settings,
-                                     std::vector<double>& lambda) {
-  using Clock = std::chrono::steady_clock;
-  const auto start = Clock::now();
-  std::optional<Clock::time_point> deadline;
-  if (settings.time_budget_ms > 0)
-    deadline = start + std::chrono::duration_cast<Clock::duration>(
-                           std::chrono::duration<double, std::milli>(settings.time_budget_ms));
+SolveReport FactoredMicaSolver::solve(const SolveContext& ctx, std::vector<SolverBody>& bodies,
+                                      const ContactRows& rows, std::vector<double>& lambda) {
+  using Clock = SolveContext::Clock;
+  const SolverSettings& settings = settings_;
+  const std::optional<Clock::time_point>& deadline = ctx.deadline;
+  if (!settings.warm_start) zero_velocities(bodies);
+  update_factors(bodies);
+  const std::vector<FactoredBody>& factored = factored_;
   const size_t nb = bodies.size(), nr = rows.size();
   pcg_.resize(nb);
   warp_.resize(nb);
@@ -182,11 +194,11 @@ MicaReport FactoredMicaSolver::solve(std::vector<MicaBody>& bodies, const std::v
     pcg_[bi].set_preconditioner(&warp_[bi]);
   }
   lambda.resize(nr, 0.0);
-  start_compliance(bodies, factored, rows, lambda);
+  start_compliance(bodies, rows, lambda);
   bool may_refactor = false;  // only co-rotational bodies: a linear body's factor is its A
   for (const FactoredBody& f : factored) may_refactor = may_refactor || (f.node_rotation && settings.refactor_after > 0);
 
-  MicaReport report;
+  SolveReport report;
   report.converged = false;
   report.momentum_residual = std::numeric_limits<double>::quiet_NaN();
   double l_scale = 0;
@@ -204,13 +216,12 @@ MicaReport FactoredMicaSolver::solve(std::vector<MicaBody>& bodies, const std::v
     if (may_refactor && report.iterations >= settings.refactor_after) {
       for (size_t bi = 0; bi < nb; ++bi)
         if (factored[bi].node_rotation)
-          factored[bi].factor->refactor_now(*bodies[bi].pattern, *bodies[bi].A, *bodies[bi].projection,
+          factored[bi].factor->refactor_now(bodies[bi].pattern(), *bodies[bi].A, *bodies[bi].projection,
                                             factored[bi].node_rotation);
       for (size_t bi = 0; bi < nb; ++bi) warp_[bi].bind(factored[bi].factor, factored[bi].node_rotation);
-      start_compliance(bodies, factored, rows, lambda);
+      start_compliance(bodies, rows, lambda);
       previous_inner_tolerance = 1;
       may_refactor = false;
-      ++report.refactorizations;
     }
     ++outer;
     // Velocities for the current impulses: A v = b + G^T lambda on the free directions. While the
@@ -227,19 +238,12 @@ MicaReport FactoredMicaSolver::solve(std::vector<MicaBody>& bodies, const std::v
     for (size_t bi = 0; bi < nb; ++bi) pcg_[bi].configure(inner_tolerance, inner_cap, deadline);
     velocities_solved = true;
     report.velocity_change = 0;  // the residual of this round's solves
+    scatter_contact_impulses(rows, lambda, bodies);
     for (size_t bi = 0; bi < nb; ++bi) {
-      MicaBody& body = bodies[bi];
-      body.contact_impulse.assign(size_t(body.pattern->rows), Vec3::Zero());
-    }
-    for (size_t r = 0; r < nr; ++r)
-      for (int32_t t = rows.start[r]; t < rows.start[r + 1]; ++t)
-        bodies[rows.terms[t].body].contact_impulse[rows.terms[t].node] +=
-            rows.terms[t].coef * lambda[r] * rows.direction[r];
-    for (size_t bi = 0; bi < nb; ++bi) {
-      MicaBody& body = bodies[bi];
+      SolverBody& body = bodies[bi];
       rhs_[bi] = *body.b;
-      for (size_t i = 0; i < rhs_[bi].size(); ++i) rhs_[bi][i] += body.contact_impulse[i];
-      const SolveReport s = pcg_[bi].solve(ProjectedSystem{*body.pattern, *body.A, *body.projection}, rhs_[bi], *body.v);
+      for (size_t i = 0; i < rhs_[bi].size(); ++i) rhs_[bi][i] += (*body.contact_impulse)[i];
+      const SolveReport s = pcg_[bi].solve(body.projected(), rhs_[bi], *body.v);
       report.iterations += std::max(1, s.iterations);
       report.velocity_change = std::max(report.velocity_change, s.residual);
       velocities_solved = velocities_solved && s.converged && inner_tolerance == final_tolerance;
@@ -289,22 +293,18 @@ MicaReport FactoredMicaSolver::solve(std::vector<MicaBody>& bodies, const std::v
     if (report.impulse_change <= settings.tolerance && velocities_solved &&
         complementarity_error(rows, lambda) <= settings.tolerance * std::sqrt(std::max(l2, l_scale))) {
       // v balances the current impulses and the impulses no longer move: done.
-      report.momentum_residual = MicaSolver::momentum_residual(bodies);
+      report.momentum_residual = momentum_residual(bodies);
       report.residual = std::max({report.velocity_change, report.impulse_change, report.momentum_residual});
       report.converged = report.momentum_residual <= settings.tolerance;
       if (report.converged) return report;
     }
-    apply_impulse_change(bodies, factored, rows, dlambda_);
+    apply_impulse_change(bodies, rows, dlambda_);
     lambda = lambda_next_;
   }
   // Stopped early (cap or budget): report G^T lambda of the impulses returned, and how far the
   // velocities are from balancing them.
-  for (MicaBody& body : bodies) body.contact_impulse.assign(size_t(body.pattern->rows), Vec3::Zero());
-  for (size_t r = 0; r < nr; ++r)
-    for (int32_t t = rows.start[r]; t < rows.start[r + 1]; ++t)
-      bodies[rows.terms[t].body].contact_impulse[rows.terms[t].node] +=
-          rows.terms[t].coef * lambda[r] * rows.direction[r];
-  report.momentum_residual = MicaSolver::momentum_residual(bodies);
+  scatter_contact_impulses(rows, lambda, bodies);
+  report.momentum_residual = momentum_residual(bodies);
   report.residual = std::max({report.velocity_change, report.impulse_change, report.momentum_residual});
   return report;
 }

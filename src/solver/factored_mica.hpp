@@ -14,39 +14,53 @@
 #include <optional>
 #include <vector>
 
-#include "solver/mica_solver.hpp"
-#include "solver/pcg.hpp"
 #include "solver/lagged_factor.hpp"
+#include "solver/pcg.hpp"
+#include "solver/velocity_solver.hpp"
 
 namespace mica {
 
-// What the factored loop needs beyond MicaBody, per body.
-struct FactoredBody {
-  LaggedFactor* factor;                     // updated for this step's h, damping and constraints
-  const std::vector<Mat3>* node_rotation;   // null: the linear model (no warping)
+// What the factored solver keeps per body.
+struct FactoredBodyCache {
+  LaggedFactor factor;
+  std::vector<Mat3> node_rotation;  // per node, for warping the factor
+  int64_t factorizations() const { return factor.factorizations(); }
 };
 
-class FactoredMicaSolver {
+// Each body's factor is updated once per solve for its SystemKey and constraint version
+// (LaggedFactor::update); a co-rotational body's (SolverBody::rotation) is warped by its node
+// rotations and refreshed every SolverSettings::refactor_interval solves in the background.
+class FactoredMicaSolver : public CachingVelocitySolver<FactoredBodyCache> {
  public:
-  MicaReport solve(std::vector<MicaBody>& bodies, const std::vector<FactoredBody>& factored, const ContactRows& rows,
-                   const MicaSettings& settings, std::vector<double>& lambda);
+  explicit FactoredMicaSolver(const SolverSettings& settings = {}) : settings_(settings) {}
+  SolveReport solve(const SolveContext& ctx, std::vector<SolverBody>& bodies, const ContactRows& rows,
+                    std::vector<double>& lambda) override;
   // W_rr of the last solve, per row (0 for a row nothing can move along).
-  const std::vector<double>& row_diagonal() const { return diag_; }
+  const std::vector<double>& row_diagonal() const override { return diag_; }
 
  private:
+  // What the loop needs beyond SolverBody, per body of a solve.
+  struct FactoredBody {
+    LaggedFactor* factor;                     // updated for this solve's system and constraints
+    const std::vector<Mat3>* node_rotation;   // null: the linear model (no warping)
+  };
+  // Each body's factor brought up to its system (factored_ in the bodies' order).
+  void update_factors(const std::vector<SolverBody>& bodies);
   // W, its diagonal and the rows nothing can move along, from the factor in use.
-  void start_compliance(const std::vector<MicaBody>& bodies, const std::vector<FactoredBody>& factored,
-                        const ContactRows& rows, std::vector<double>& lambda);
-  void build_compliance(const std::vector<MicaBody>& bodies, const std::vector<FactoredBody>& factored,
-                        const ContactRows& rows);
+  void start_compliance(const std::vector<SolverBody>& bodies, const ContactRows& rows, std::vector<double>& lambda);
+  void build_compliance(const std::vector<SolverBody>& bodies, const ContactRows& rows);
   // v += S Q K_f^-1 Q^T S G^T dlambda, through the cached columns.
-  void apply_impulse_change(std::vector<MicaBody>& bodies, const std::vector<FactoredBody>& factored,
-                            const ContactRows& rows, const std::vector<double>& dlambda);
+  void apply_impulse_change(std::vector<SolverBody>& bodies, const ContactRows& rows,
+                            const std::vector<double>& dlambda);
   // lambda_next_ solves the contact problem on W around lambda: 0 <= lambda_next _|_ w + W (lambda_next - lambda) >= 0
   // on normal rows, Coulomb's cone on tangent pairs (frictional_contact.hpp).
   void solve_small_lcp(const ContactRows& rows, double tolerance, const std::vector<double>& lambda,
                        const std::optional<std::chrono::steady_clock::time_point>& deadline);
+  // Of the current lambda against the current row velocities w_ (N s).
+  double complementarity_error(const ContactRows& rows, const std::vector<double>& lambda);
 
+  SolverSettings settings_;
+  std::vector<FactoredBody> factored_;
   std::vector<PcgSolver> pcg_;
   std::vector<WarpedFactorPreconditioner> warp_;
   std::vector<const Eigen::MatrixXd*> term_columns_;  // per row term: K_f^-1 columns of its node
@@ -58,8 +72,6 @@ class FactoredMicaSolver {
   Eigen::VectorXd small_q_, small_mu_, small_start_;
   std::vector<int32_t> small_normal_;
   std::vector<double> warped_diag_;  // W_rr before the secant updates
-  // Of the current lambda against the current row velocities w_ (N s).
-  double complementarity_error(const ContactRows& rows, const std::vector<double>& lambda);
   std::vector<Vec3List> rhs_;
   Eigen::VectorXd y_;
 };

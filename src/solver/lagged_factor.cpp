@@ -2,8 +2,6 @@
 
 #include <algorithm>
 
-#include "fem/rotation.hpp"
-
 namespace mica {
 
 LaggedFactor::LaggedFactor() : active_(std::make_unique<Slot>()), pending_(std::make_unique<Slot>()) {}
@@ -116,14 +114,6 @@ void WarpedFactorPreconditioner::apply(const Vec3List& r, Vec3List& z) {
   for (size_t i = 0; i < n; ++i) rotated_[i] = turn_[i].transpose() * r[i];
   factor_->solve(rotated_, z);
   for (size_t i = 0; i < n; ++i) z[i] = turn_[i] * z[i];
-}
-
-void compute_node_rotations(const FemModel& fem, const std::vector<Mat3>& element_rotation,
-                            std::vector<Mat3>& node_rotation) {
-  node_rotation.assign(size_t(fem.node_count()), Mat3::Zero());
-  for (size_t e = 0; e < fem.elements.size(); ++e)
-    for (int32_t a : fem.elements[e].nodes) node_rotation[size_t(a)] += element_rotation[e];
-  for (Mat3& R : node_rotation) R = R.isZero(0) ? Mat3::Identity() : proper_rotation(R);
 }
 
 }  // namespace mica

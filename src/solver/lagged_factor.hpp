@@ -99,9 +99,4 @@ class WarpedFactorPreconditioner : public Preconditioner {
   std::vector<Mat3> turn_;  // empty: no warping (a linear body)
 };
 
-// Per node, the rotation nearest the sum of its elements' rotations (identity for a node in no
-// element).
-void compute_node_rotations(const FemModel& fem, const std::vector<Mat3>& element_rotation,
-                            std::vector<Mat3>& node_rotation);
-
 }  // namespace mica

@@ -1,7 +1,6 @@
 #include "solver/mica_solver.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <limits>
 
@@ -13,8 +12,8 @@ namespace {
 
 // v_i = z_i + Dt_i^-1 (q_i - sum_{j != i} A_ij v_j - D_ii z_i): the constraint-filtered block
 // Gauss-Seidel update of node i (with v read but not written, the Jacobi anticipation).
-Vec3 node_update(const MicaBody& body, const Mat3& inv_diag, int32_t i, const Vec3& q_i) {
-  const BlockPattern& p = *body.pattern;
+Vec3 node_update(const SolverBody& body, const Mat3& inv_diag, int32_t i, const Vec3& q_i) {
+  const BlockPattern& p = body.pattern();
   const BlockValues& A = *body.A;
   const Vec3List& v = *body.v;
   Vec3 r = q_i;
@@ -29,11 +28,11 @@ Vec3 node_update(const MicaBody& body, const Mat3& inv_diag, int32_t i, const Ve
 
 }  // namespace
 
-double MicaSolver::anticipated_velocity(const std::vector<MicaBody>& bodies, const ContactRows& rows, size_t r) const {
+double MicaSolver::anticipated_velocity(const std::vector<SolverBody>& bodies, const ContactRows& rows, size_t r) const {
   double c = rows.bias[r];
   for (int32_t t = rows.start[r]; t < rows.start[r + 1]; ++t) {
     const RowTerm& term = rows.terms[t];
-    const MicaBody& body = bodies[term.body];
+    const SolverBody& body = bodies[term.body];
     const Vec3 vt = node_update(body, inv_diag_[term.body][term.node], term.node, (*body.b)[term.node]);
     c += term.coef * rows.direction[r].dot(vt);
   }
@@ -64,10 +63,10 @@ void MicaSolver::update_tangents(const ContactRows& rows, size_t r, std::vector<
   }
 }
 
-double MicaSolver::momentum_residual(const std::vector<MicaBody>& bodies) {
+double momentum_residual(const std::vector<SolverBody>& bodies) {
   double worst = 0;
-  for (const MicaBody& body : bodies) {  // per body: a small body's imbalance may not hide in a large one's
-    const BlockPattern& p = *body.pattern;
+  for (const SolverBody& body : bodies) {  // per body: a small body's imbalance may not hide in a large one's
+    const BlockPattern& p = body.pattern();
     const BlockValues& A = *body.A;
     const Vec3List& v = *body.v;
     const bool projected = body.projection->active();
@@ -80,10 +79,10 @@ double MicaSolver::momentum_residual(const std::vector<MicaBody>& bodies) {
         terms += A[k].norm() * v[p.col[k]].norm();
       }
       const Vec3& b = (*body.b)[i];
-      const Vec3& g = body.contact_impulse[i];
+      const Vec3& g = (*body.contact_impulse)[i];
       const Vec3 r = b + g - av;
       r2 += (projected && body.projection->is_constrained[i] ? body.projection->S[i] * r : r).squaredNorm();
-      const double floor = body.node_mass ? 1e-6 * (*body.node_mass)[i] : 0.0;
+      const double floor = 1e-6 * body.fem->node_mass[i];
       scale2 += std::max({b.squaredNorm(), g.squaredNorm(), av.squaredNorm(), floor * floor});
       terms2 += terms * terms;
     }
@@ -95,19 +94,23 @@ double MicaSolver::momentum_residual(const std::vector<MicaBody>& bodies) {
   return worst;
 }
 
-MicaReport MicaSolver::solve(std::vector<MicaBody>& bodies, const ContactRows& rows, const MicaSettings& settings,
-                             std::vector<double>& lambda) {
+SolveReport MicaSolver::solve(const SolveContext& ctx, std::vector<SolverBody>& bodies, const ContactRows& rows,
+                              std::vector<double>& lambda) {
+  const SolverSettings& settings = settings_;
   const size_t nb = bodies.size(), nr = rows.size();
+  // The warm start: the last step's velocities (MICA's iterate carries its information in v: one
+  // PGS sweep makes an isolated row's impulse a function of v alone), or zero.
+  if (!settings.warm_start) zero_velocities(bodies);
   inv_diag_.resize(nb);
   u_.resize(nb);
   // Filtered diagonal inverses; the warm start made to satisfy (I - S) v = z.
   for (size_t bi = 0; bi < nb; ++bi) {
-    MicaBody& body = bodies[bi];
-    const ProjectedSystem sys{*body.pattern, *body.A, *body.projection};
-    const int32_t n = body.pattern->rows;
+    SolverBody& body = bodies[bi];
+    const ProjectedSystem sys = body.projected();
+    const int32_t n = body.node_count();
     inv_diag_[bi].resize(size_t(n));
     u_[bi].assign(size_t(n), Vec3::Zero());
-    body.contact_impulse.assign(size_t(n), Vec3::Zero());
+    body.contact_impulse->assign(size_t(n), Vec3::Zero());
     for (int32_t i = 0; i < n; ++i) inv_diag_[bi][i] = sys.diagonal_block(i).inverse();
     for (int32_t i : body.projection->nodes) {
       const Mat3& S = body.projection->S[i];
@@ -146,9 +149,7 @@ MicaReport MicaSolver::solve(std::vector<MicaBody>& bodies, const ContactRows& r
   }
   for (size_t r = 0; r < nr; ++r)
     if (diag_[r] == 0) lambda[r] = 0;
-  for (size_t r = 0; r < nr; ++r)  // the warm start onto the cones
-    if (rows.normal_of[r] < 0) lambda[r] = std::max(lambda[r], 0.0);
-    else if (rows.first_tangent(r)) project_onto_disk(rows.mu[r] * lambda[rows.normal_of[r]], lambda[r], lambda[r + 1]);
+  rows.project(lambda);  // the warm start onto the cones
   for (size_t r = 0; r < nr; ++r)
     for (int32_t t = rows.start[r]; t < rows.start[r + 1]; ++t)
       u_[rows.terms[t].body][rows.terms[t].node] += g_[t] * lambda[r];
@@ -159,22 +160,19 @@ MicaReport MicaSolver::solve(std::vector<MicaBody>& bodies, const ContactRows& r
   // Below 1 micrometre per second (RMS per node) velocity changes are round-off for any tissue
   // scene, so a body at rest with no loads stops at once.
   double v_scale2 = 0, l_scale2 = 0;
-  for (size_t bi = 0; bi < nb; ++bi) v_scale2 += 1e-12 * bodies[bi].pattern->rows;
+  for (size_t bi = 0; bi < nb; ++bi) v_scale2 += 1e-12 * bodies[bi].node_count();
   for (size_t bi = 0; bi < nb; ++bi)
-    for (int32_t i = 0; i < bodies[bi].pattern->rows; ++i)
+    for (int32_t i = 0; i < bodies[bi].node_count(); ++i)
       v_scale2 += (inv_diag_[bi][i] * (*bodies[bi].b)[i]).squaredNorm();
   for (size_t r = 0; r < nr; ++r)
     if (diag_[r] > 0) l_scale2 += std::pow(anticipated_velocity(bodies, rows, r) / diag_[r], 2);
 
-  using Clock = std::chrono::steady_clock;
-  const auto start = Clock::now();
-  MicaReport report;
+  SolveReport report;
   report.converged = false;
   report.momentum_residual = std::numeric_limits<double>::quiet_NaN();
   int32_t next_residual_check = 0;  // the true residual costs a sweep: checked when the changes say done
   while (report.iterations < settings.max_iterations) {
-    if (settings.time_budget_ms > 0 && report.iterations > 0 &&
-        std::chrono::duration<double, std::milli>(Clock::now() - start).count() >= settings.time_budget_ms) {
+    if (ctx.deadline && report.iterations > 0 && SolveContext::Clock::now() >= *ctx.deadline) {
       report.out_of_time = true;
       break;
     }
@@ -200,21 +198,17 @@ MicaReport MicaSolver::solve(std::vector<MicaBody>& bodies, const ContactRows& r
           u_[rows.terms[t].body][rows.terms[t].node] += g_[t] * (lambda[r] - before);
       }
     // MBGS sweep with the contact impulses G^T lambda on the right-hand side.
-    for (auto& body : bodies)
-      for (Vec3& f : body.contact_impulse) f.setZero();
-    for (size_t r = 0; r < nr; ++r)
-      for (int32_t t = rows.start[r]; t < rows.start[r + 1]; ++t)
-        bodies[rows.terms[t].body].contact_impulse[rows.terms[t].node] +=
-            rows.terms[t].coef * lambda[r] * rows.direction[r];
+    scatter_contact_impulses(rows, lambda, bodies);
     double dv2 = 0, v2 = 0;
-    const auto has_colours = [](const MicaBody& body) { return body.colours != nullptr; };
-    if (settings.pool && std::all_of(bodies.begin(), bodies.end(), has_colours))
-      coloured_sweep(bodies, settings.relaxation, *settings.pool, dv2, v2);
+    const auto has_colours = [](const SolverBody& body) { return body.colours != nullptr; };
+    if (ctx.pool && std::all_of(bodies.begin(), bodies.end(), has_colours))
+      coloured_sweep(bodies, *ctx.pool, dv2, v2);
     else for (size_t bi = 0; bi < nb; ++bi) {
-      MicaBody& body = bodies[bi];
+      SolverBody& body = bodies[bi];
       Vec3List& v = *body.v;
-      for (int32_t i = 0; i < body.pattern->rows; ++i) {
-        const Vec3 gs = node_update(body, inv_diag_[bi][i], i, (*body.b)[i] + body.contact_impulse[i]);
+      const Vec3List& impulse = *body.contact_impulse;
+      for (int32_t i = 0; i < body.node_count(); ++i) {
+        const Vec3 gs = node_update(body, inv_diag_[bi][i], i, (*body.b)[i] + impulse[i]);
         // Over-relaxation keeps (I - S) v = z: both v_i and the Gauss-Seidel value satisfy it.
         const Vec3 next = v[i] + settings.relaxation * (gs - v[i]);
         dv2 += (next - v[i]).squaredNorm();
@@ -257,19 +251,20 @@ MicaReport MicaSolver::solve(std::vector<MicaBody>& bodies, const ContactRows& r
 // at once is the Gauss-Seidel sweep in the colouring's order (each block in node order),
 // whichever thread takes which block. The sums of the stopping test add up per block, then in
 // the colouring's order: the result does not depend on the thread count either.
-void MicaSolver::coloured_sweep(std::vector<MicaBody>& bodies, double relaxation, ThreadPool& pool, double& dv2,
-                                double& v2) {
+void MicaSolver::coloured_sweep(std::vector<SolverBody>& bodies, ThreadPool& pool, double& dv2, double& v2) {
+  const double relaxation = settings_.relaxation;
   for (size_t bi = 0; bi < bodies.size(); ++bi) {
-    MicaBody& body = bodies[bi];
+    SolverBody& body = bodies[bi];
     const Colouring& c = *body.colours;
     const std::vector<Mat3>& inv_diag = inv_diag_[bi];
     Vec3List& v = *body.v;
+    const Vec3List& impulse = *body.contact_impulse;
     if (block_sums_.size() < size_t(c.blocks())) block_sums_.resize(size_t(c.blocks()));  // the first solve only
     auto blocks = [&](int32_t, int32_t first, int32_t last, int32_t) {
       for (int32_t n = first; n < last; ++n) {
         double d = 0, s = 0;
         for (int32_t i = c.block_start[c.order[n]]; i < c.block_start[c.order[n] + 1]; ++i) {
-          const Vec3 gs = node_update(body, inv_diag[i], i, (*body.b)[i] + body.contact_impulse[i]);
+          const Vec3 gs = node_update(body, inv_diag[i], i, (*body.b)[i] + impulse[i]);
           const Vec3 next = v[i] + relaxation * (gs - v[i]);
           d += (next - v[i]).squaredNorm();
           v[i] = next;

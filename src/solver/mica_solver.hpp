@@ -10,74 +10,36 @@
 // contact impulses on the right-hand side. At a fixed point v and lambda solve the
 // complementarity problem above exactly.
 #pragma once
+#include <array>
 #include <vector>
 
-#include "core/colouring.hpp"
-#include "core/thread_pool.hpp"
-#include "solver/contact_rows.hpp"
-#include "solver/projected_system.hpp"
+#include "solver/velocity_solver.hpp"
 
 namespace mica {
 
-struct MicaSettings {
-  // Stop when the change of v between iterations is below tolerance * max(|v|, |Dt^-1 b|, 1 um/s
-  // RMS per node), the change of lambda below tolerance * max(|lambda|, the first anticipated
-  // impulse), and the true momentum residual |S (b + G^T lambda - A v)| of every body below
-  // tolerance times the size of the terms it balances (per node the largest of |b|, |G^T lambda|,
-  // |A v|): the forces a user feels are accurate to the tolerance.
-  // Gauss-Seidel that stagnates (stiff bodies, long steps) changes little per sweep far from the
-  // solution, so small changes alone prove nothing.
-  double tolerance = 1e-8;
-  double time_budget_ms = 0;        // > 0: stop when the solve has used this much wall-clock time
-  int32_t max_iterations = 200;
-  int32_t pgs_sweeps = 1;           // PGS sweeps over the contact rows per iteration
-  bool paper_norm = false;          // stop on the 2-norm of the change of (v, lambda) instead
-  double relaxation = 1.0;          // MBGS over-relaxation omega in (0, 2); 1 is the paper's Gauss-Seidel
-  // Not null (and every body coloured): the MBGS sweep runs colour by colour, a colour's nodes on
-  // the pool's threads. Null: the paper's sweep in node order.
-  ThreadPool* pool = nullptr;
-  // Factored sweep, co-rotational bodies: refactor the current system once a solve has used this
-  // many conjugate-gradient iterations (0: never).
-  int32_t refactor_after = 0;
-};
-
-// One body's system as the solver sees it. v holds the warm start and receives the result.
-struct MicaBody {
-  const BlockPattern* pattern;
-  const BlockValues* A;
-  const Vec3List* b;
-  const Projection* projection;
-  Vec3List* v;
-  const std::vector<double>* node_mass = nullptr;  // kg per node: the residual's floor (none if null)
-  Vec3List contact_impulse;  // out: G^T lambda per node, N s
-  const Colouring* colours = nullptr;  // node blocks coupled by no block of A share a colour (node_colouring.hpp)
-};
-
-struct MicaReport : SolveReport {
-  double velocity_change = 0;  // last change of v, relative to its scale (see MicaSettings)
-  double impulse_change = 0;   // last change of lambda, relative to its scale
-  double paper_change = 0;     // last 2-norm of the change of (v, lambda), the paper's test
-  double momentum_residual = 0;  // last true residual, relative (see MicaSettings; NaN if never checked)
-  int32_t refactorizations = 0;  // factored sweep: factorizations of the current system during the solve
-};
-
-class MicaSolver {
+// The stopping test (SolverSettings::tolerance): stop when the change of v between iterations
+// is below tolerance * max(|v|, |Dt^-1 b|, 1 um/s RMS per node), the change of lambda below
+// tolerance * max(|lambda|, the first anticipated impulse), and the true momentum residual
+// |S (b + G^T lambda - A v)| of every body below tolerance times the size of the terms it
+// balances (per node the largest of |b|, |G^T lambda|, |A v|): the forces a user feels are
+// accurate to the tolerance. Gauss-Seidel that stagnates (stiff bodies, long steps) changes
+// little per sweep far from the solution, so small changes alone prove nothing. With a pool
+// (SolveContext) and every body coloured (SolverBody::colours) the MBGS sweep runs colour by
+// colour, a colour's nodes on the pool's threads; else the paper's sweep in node order.
+class MicaSolver : public VelocitySolver {
  public:
-  // lambda: in, the warm start (projected onto its bounds); out, the impulses (N s) per row.
-  MicaReport solve(std::vector<MicaBody>& bodies, const ContactRows& rows, const MicaSettings& settings,
-                   std::vector<double>& lambda);
+  explicit MicaSolver(const SolverSettings& settings = {}) : settings_(settings) {}
+  SolveReport solve(const SolveContext& ctx, std::vector<SolverBody>& bodies, const ContactRows& rows,
+                    std::vector<double>& lambda) override;
   // B_rr of the last solve, per row: the compliance each row sees (its diagonal of G Dt^-1 G^T).
-  const std::vector<double>& row_diagonal() const { return diag_; }
-
- // |S (b + G^T lambda - A v)| / max(|S b|, |S G^T lambda|, |S A v|, |S M v|, 1 um/s of momentum
-  // per node), with M lumped and G^T lambda from MicaBody::contact_impulse.
-  static double momentum_residual(const std::vector<MicaBody>& bodies);
+  const std::vector<double>& row_diagonal() const override { return diag_; }
 
  private:
-  void coloured_sweep(std::vector<MicaBody>& bodies, double relaxation, ThreadPool& pool, double& dv2, double& v2);
-  double anticipated_velocity(const std::vector<MicaBody>& bodies, const ContactRows& rows, size_t r) const;
+  void coloured_sweep(std::vector<SolverBody>& bodies, ThreadPool& pool, double& dv2, double& v2);
+  double anticipated_velocity(const std::vector<SolverBody>& bodies, const ContactRows& rows, size_t r) const;
   void update_tangents(const ContactRows& rows, size_t r, std::vector<double>& lambda);
 
+  SolverSettings settings_;
   std::vector<std::vector<Mat3>> inv_diag_;  // per body, per node: Dt_i^-1
   std::vector<Vec3> g_;                      // per row term: coef Dt^-1 d
   std::vector<double> diag_, c_;             // per row: B_rr, anticipated velocity
@@ -86,5 +48,9 @@ class MicaSolver {
   std::vector<double> lambda_old_;
   std::vector<std::array<double, 2>> block_sums_;  // coloured sweep: |dv|^2 and |v|^2 per block, in sweep order
 };
+
+// |S (b + G^T lambda - A v)| / max(|S b|, |S G^T lambda|, |S A v|, |S M v|, 1 um/s of momentum
+// per node), the worst body's, with M lumped and G^T lambda from SolverBody::contact_impulse.
+double momentum_residual(const std::vector<SolverBody>& bodies);
 
 }  // namespace mica

@@ -7,11 +7,17 @@
 
 namespace mica {
 
+// What every solve reports, a linear solve of one body or a velocity solve of the step
+// (velocity_solver.hpp); MICA's loops also fill the terms of their stopping test.
 struct SolveReport {
   int32_t iterations = 0;
-  double residual = 0;  // ||P y - r|| / ||r|| of the projected system (0 when r = 0)
+  double residual = 0;  // ||P y - r|| / ||r|| of the projected system (0 when r = 0); a velocity solve: its worst measure
   bool converged = true;
   bool out_of_time = false;  // stopped at the time budget (converged is then false)
+  double velocity_change = 0;    // MICA: last change of v, relative to its scale (mica_solver.hpp)
+  double impulse_change = 0;     // MICA: last change of lambda, relative to its scale
+  double paper_change = 0;       // MICA: last 2-norm of the change of (v, lambda), the paper's test
+  double momentum_residual = 0;  // MICA: last true residual, relative (NaN if never checked)
 };
 
 struct ProjectedSystem {

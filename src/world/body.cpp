@@ -2,26 +2,37 @@
 
 namespace mica {
 
-Body::Body(const TetMesh& mesh, const BodySettings& s, const std::string& body_name)
-    : settings(s), name(body_name), fem(build_fem_model(mesh, s.material, s.mass, body_name)),
+BodyModel::BodyModel(const TetMesh& mesh, const BodySettings& s, const std::string& body_name, uint64_t body_key)
+    : settings(s), name(body_name), key(body_key), fem(build_fem_model(mesh, s.material, s.mass, body_name)),
       tets(mesh.tets), surface(extract_surface(mesh)),
       surface_node_list(surface_nodes(surface)) {
-  const size_t n = fem.rest.size();
-  x = fem.rest;
-  v.assign(n, Vec3::Zero());
-  node_forces.assign(n, Vec3::Zero());
-  R.assign(fem.elements.size(), Mat3::Identity());
-  R_end.assign(fem.elements.size(), Mat3::Identity());
-  A.assign(fem.pattern.block_count(), Mat3::Zero());
-  for (Vec3List* w : {&f_int, &f_ext, &b, &v_next, &x_next, &contact_impulse}) w->assign(n, Vec3::Zero());
-  projection.reset(int32_t(n));
-  pcg.reserve(n);
-  bvh.build(x, surface);
-  pseudo_normals.build(surface, n);
-  pseudo_normals.update(x, surface);
+  const Vec3List& x = fem.rest;
   for (const Tri& t : surface)
     for (int k = 0; k < 3; ++k) surface_edge += (x[t[k]] - x[t[(k + 1) % 3]]).norm();
   surface_edge /= double(3 * surface.size());
 }
+
+BodyState::BodyState(const BodyModel& model) {
+  const size_t n = model.fem.rest.size();
+  x = model.fem.rest;
+  v.assign(n, Vec3::Zero());
+  node_forces.assign(n, Vec3::Zero());
+  contact_impulse.assign(n, Vec3::Zero());
+  bvh.build(x, model.surface);
+  pseudo_normals.build(model.surface, n);
+  pseudo_normals.update(x, model.surface);
+}
+
+BodyScratch::BodyScratch(const BodyModel& model) {
+  const size_t n = model.fem.rest.size();
+  R.assign(model.fem.elements.size(), Mat3::Identity());
+  R_end.assign(model.fem.elements.size(), Mat3::Identity());
+  A.assign(model.fem.pattern.block_count(), Mat3::Zero());
+  for (Vec3List* w : {&f_int, &f_ext, &b, &v_next, &x_next}) w->assign(n, Vec3::Zero());
+  projection.reset(int32_t(n));
+}
+
+Body::Body(const TetMesh& mesh, const BodySettings& settings, const std::string& name, uint64_t key)
+    : BodyModel(mesh, settings, name, key), BodyState(model()), BodyScratch(model()) {}
 
 }  // namespace mica

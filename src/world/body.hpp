@@ -1,5 +1,7 @@
-// A deformable (or static) body: its finite-element model, its state, and the per-step
-// work arrays, sized once at creation so that stepping does not allocate.
+// A deformable (or static) body in three parts: the model it was made with (never changed after
+// creation), the state a step starts from and leaves, and the per-step work arrays, sized once at
+// creation so that stepping does not allocate. Body is the three together; a function that needs
+// one part takes that part.
 #pragma once
 #include <string>
 #include <vector>
@@ -9,10 +11,8 @@
 #include "core/colouring.hpp"
 #include "fem/fem_model.hpp"
 #include "fem/rotation_stiffness.hpp"
-#include "solver/direct_solver.hpp"
-#include "solver/pcg.hpp"
-#include "solver/lagged_factor.hpp"
 #include "solver/projection.hpp"
+#include "solver/velocity_solver.hpp"
 
 namespace mica {
 
@@ -25,26 +25,43 @@ struct BodySettings {
   bool is_static = false;
 };
 
-struct Body {
-  Body(const TetMesh& mesh, const BodySettings& settings, const std::string& name);
+// What the body was made with.
+struct BodyModel {
+  BodyModel(const TetMesh& mesh, const BodySettings& settings, const std::string& name, uint64_t key);
 
   BodySettings settings;
   std::string name;            // "body 0x..." in messages
+  uint64_t key;                // unique in its world, never reused: the solver's caches are keyed by it
   FemModel fem;
   std::vector<Tet> tets;
   std::vector<Tri> surface;
   std::vector<int32_t> surface_node_list;  // candidates for contact
-  TriangleBvh bvh;                         // over the surface triangles, refit every step
-  SurfacePseudoNormals pseudo_normals;     // of the surface, updated with the tree
   double surface_edge = 0;                 // m, mean surface edge length: the deepest penetration looked for
+  // For a world with threads > 1 (empty otherwise): blocks of tets that share no node (parallel
+  // assembly) and blocks of nodes that share no block of A (the colour-ordered MBGS sweep).
+  Colouring element_colours, node_colours;
 
-  // State.
+  bool is_dynamic() const { return !settings.is_static; }
+  bool has_damping() const { return settings.rayleigh_alpha != 0 || settings.rayleigh_beta != 0; }
+};
+
+// What a step starts from and leaves.
+struct BodyState {
+  explicit BodyState(const BodyModel& model);
+
   Vec3List x, v;
   Vec3List node_forces;        // persistent user loads, N
   bool has_node_forces = false;
   uint64_t lpc_version = 0;    // bumped when a constraint on this body is added or removed
+  Vec3List contact_impulse;    // G^T lambda of the last step, N s
+  TriangleBvh bvh;                         // over the surface triangles at x, refit every step
+  SurfacePseudoNormals pseudo_normals;     // of the surface at x, updated with the tree
+};
 
-  // Per-step work.
+// The step's work arrays (and what one step hands the next: R_end at x_end, A of a linear body).
+struct BodyScratch {
+  explicit BodyScratch(const BodyModel& model);
+
   std::vector<Mat3> R;         // element rotations the step is linearised with
   std::vector<Mat3> R_end;     // rotations of x_end (computed after the solve: the next step's R)
   Vec3List x_end;              // the positions R_end belongs to (empty: none)
@@ -59,28 +76,18 @@ struct Body {
   BlockValues A;               // M + h C + h^2 K
   Vec3List f_int, f_ext, b, v_next, x_next;
   Projection projection;
-  Vec3List contact_impulse;    // G^T lambda of the last step, N s
-  DirectSolver direct;
-  PcgSolver pcg;
-  LaggedFactor factor;             // MICA with the factored anticipation
-  std::vector<Mat3> node_rotation;  // per node, for warping the factor
 
-  // For a world with threads > 1 (empty otherwise): blocks of tets that share no node (parallel
-  // assembly) and blocks of nodes that share no block of A (the colour-ordered MBGS sweep).
-  Colouring element_colours, node_colours;
-
-  // What A and the factorization were built for; a linear body reuses both while unchanged.
-  struct MatrixKey {
-    double h = 0, alpha = -1, beta = -1;
-    bool operator==(const MatrixKey& o) const { return h == o.h && alpha == o.alpha && beta == o.beta; }
-  } matrix_key;
+  // What A was built for; a linear body reuses it while unchanged.
+  SystemKey matrix_key{0, -1, -1};
   bool matrix_current = false;   // A holds M + hC + h^2 K for matrix_key
-  uint64_t factored_lpc_version = ~uint64_t(0);
-  bool factor_current = false;
   bool matrix_rebuilt = false;   // this step assembled A anew
+  uint64_t matrix_version = 0;   // bumped whenever the values of A change (the solvers' factors follow it)
+};
 
-  bool is_dynamic() const { return !settings.is_static; }
-  bool has_damping() const { return settings.rayleigh_alpha != 0 || settings.rayleigh_beta != 0; }
+struct Body : BodyModel, BodyState, BodyScratch {
+  Body(const TetMesh& mesh, const BodySettings& settings, const std::string& name, uint64_t key);
+  const BodyModel& model() const { return *this; }
+  const BodyState& state() const { return *this; }
 };
 
 }  // namespace mica

@@ -14,7 +14,7 @@
 //   growth = [U(x+) - U_lin(x+)] - [U(x) - U_lin(x)] - dissipation,
 // U_lin the quadratic energy the step was linearised with (U_R for the first solve),
 // dissipation = |v+ - v|_M^2 / 2 + h^2 v+^T K v+ / 2 + h v+^T C v+ >= 0. Accepted while the
-// growth, summed over the steps since the energy last went down (`energy_debt_`), stays below
+// growth, summed over the steps since the energy last went down (`World::debt_`), stays below
 // WorldSettings::relinearise_tolerance times the bodies' energy. The first screen costs one
 // rotation and two element energies per element: the rotations at x+ are the next step's start
 // rotations (start_rotations reuses them when the positions did not change in between), so the
@@ -40,24 +40,12 @@
 #include <chrono>
 #include <cmath>
 
-#include "fem/rotation.hpp"
+#include "fem/linearisation.hpp"
 #include "world/world.hpp"
 
 namespace mica {
 
 namespace {
-
-// v^T M w
-double mass_dot(const FemModel& m, const Vec3List& v, const Vec3List& w) {
-  const BlockPattern& p = m.pattern;
-  double s = 0;
-  for (int32_t i = 0; i < p.rows; ++i) {
-    Vec3 sum = Vec3::Zero();
-    for (int32_t k = p.row_start[i]; k < p.row_start[i + 1]; ++k) sum += m.mass[k] * w[p.col[k]];
-    s += v[i].dot(sum);
-  }
-  return s;
-}
 
 struct BodyTerms {
   double alpha = 0, beta = 0;  // Rayleigh damping, if the body is damped
@@ -82,22 +70,14 @@ void end_state(Body& b, const Vec3List& v, double h) {
 Eval screen(Body& b, double h) {
   const FemModel& m = b.fem;
   end_state(b, b.v_next, h);
-  double U1 = 0, UR1 = 0, U0 = 0;
   const bool start_known = b.relin.u_start_known;
-  for (size_t e = 0; e < m.elements.size(); ++e) {
-    const TetElement& el = m.elements[e];
-    const Mat3 F1 = deformation_gradient(el, b.x_end);
-    b.R_end[e] = proper_rotation(F1);
-    U1 += elastic_energy(el, m.lame, b.R_end[e], F1);
-    UR1 += elastic_energy(el, m.lame, b.R[e], F1);
-    if (!start_known) U0 += elastic_energy(el, m.lame, b.R[e], deformation_gradient(el, b.x));
-  }
-  if (!start_known) b.relin.u_start = U0;
+  const ScreenEnergies u = screen_energies(m, b.x, b.x_end, b.R, b.R_end, !start_known);
+  if (!start_known) b.relin.u_start = u.u_lin_start;
   b.relin.k_start = 0.5 * mass_dot(m, b.v, b.v);
-  b.relin.u_end = U1;
+  b.relin.u_end = u.u_end;
   Eval out;
-  out.growth = U1 - UR1;
-  out.scale = std::max(b.relin.k_start + b.relin.u_start, 0.5 * mass_dot(m, b.v_next, b.v_next) + U1);
+  out.growth = u.u_end - u.u_lin_end;
+  out.scale = std::max(b.relin.k_start + b.relin.u_start, 0.5 * mass_dot(m, b.v_next, b.v_next) + u.u_end);
   return out;
 }
 
@@ -106,49 +86,17 @@ Eval screen(Body& b, double h) {
 // rotations (they define the damping in phi). Sets x_end, R_end; caches U(x_end).
 Eval evaluate(Body& b, const Vec3List& v, double h, const BodyTerms& d, const std::vector<Mat3>& R_start) {
   const FemModel& m = b.fem;
-  const bool corot = b.settings.corotational;
   end_state(b, v, h);
-  // U1 = U(x+); UL1, UL0 = the linearisation's quadratic energy at x+ and at x; vKv = v^T K v
-  // with its stiffness (the damping's K: R Ke R^T, without G); g* = the twist terms.
-  double U1 = 0, UL1 = 0, UL0 = 0, vKv = 0, vKv_start = 0, gvv = 0, gdd = 0, gll = 0;
-  const Mat3 I = Mat3::Identity();
-  const bool twist = !b.relin.modes.empty();
-  for (size_t e = 0; e < m.elements.size(); ++e) {
-    const TetElement& el = m.elements[e];
-    const Mat3& R = corot ? b.R[e] : I;
-    const Mat3 F1 = deformation_gradient(el, b.x_end);
-    if (corot) b.R_end[e] = proper_rotation(F1);
-    U1 += elastic_energy(el, m.lame, corot ? b.R_end[e] : I, F1);
-    UL1 += elastic_energy(el, m.lame, R, F1);
-    UL0 += elastic_energy(el, m.lame, R, deformation_gradient(el, b.x));
-    // v^T (R Ke R^T) v is twice the strain energy of the displacement v in the frame R.
-    const Mat3 Fv = deformation_gradient(el, v);
-    vKv += 2 * elastic_energy(el, m.lame, R, Fv + R);
-    if (d.beta != 0) {
-      const Mat3& Rs = corot ? R_start[e] : I;
-      vKv_start += 2 * elastic_energy(el, m.lame, Rs, Fv + Rs);
-    }
-    if (!twist) continue;
-    const TwistModes& t = b.relin.modes[e];
-    for (int32_t q = 0; q < t.count; ++q) {
-      double cv = 0, cl = 0;
-      for (int a = 0; a < 4; ++a) {
-        cv += t.q[q][a].dot(v[el.nodes[a]]);
-        cl += t.q[q][a].dot(b.relin.v_lin[el.nodes[a]]);
-      }
-      gvv += t.weight[q] * cv * cv;
-      gdd += t.weight[q] * (cv - cl) * (cv - cl);
-      gll += t.weight[q] * cl * cl;
-    }
-  }
+  const LinearisationEnergies u =
+      linearisation_energies(m, b.x, b.x_end, v, b.settings.corotational ? &b.R : nullptr, b.R_end, &R_start,
+                             d.beta != 0, b.relin.modes, b.relin.v_lin);
   // The linearisation is backward Euler on U_L(y) = U_R(y) + (y - x_lin)^T G (y - x_lin) / 2.
-  UL1 += 0.5 * h * h * gdd;
-  UL0 += 0.5 * h * h * gll;
+  const double U1 = u.u_end, UL1 = u.u_lin_end + 0.5 * h * h * u.gdd, UL0 = u.u_lin_start + 0.5 * h * h * u.gll;
   Vec3List& dv = b.relin.scratch;
   dv.resize(v.size());
   for (size_t i = 0; i < v.size(); ++i) dv[i] = v[i] - b.v[i];
   const double dvMdv = mass_dot(m, dv, dv), vMv = mass_dot(m, v, v);
-  const double dissipation = 0.5 * dvMdv + 0.5 * h * h * (vKv + gvv) + h * (d.alpha * vMv + d.beta * vKv);
+  const double dissipation = 0.5 * dvMdv + 0.5 * h * h * (u.vKv + u.gvv) + h * (d.alpha * vMv + d.beta * u.vKv);
   const double U0 = b.relin.u_start, K0 = b.relin.k_start;
   Eval out;
   out.growth = (U1 - UL1) - (U0 - UL0) - dissipation;
@@ -158,52 +106,35 @@ Eval evaluate(Body& b, const Vec3List& v, double h, const BodyTerms& d, const st
   double fv = 0;
   if (d.loads)
     for (size_t i = 0; i < v.size(); ++i) fv += b.f_ext[i].dot(v[i]);
-  out.phi = 0.5 * dvMdv + U1 - h * fv + 0.5 * h * (d.alpha * vMv + d.beta * vKv_start);
+  out.phi = 0.5 * dvMdv + U1 - h * fv + 0.5 * h * (d.alpha * vMv + d.beta * u.vKv_start);
   b.relin.u_end = U1;
   return out;
 }
 
 // The linearisation at x_end = x + h v_iter (whose rotations b.R are) gains the positive twist
-// stiffness G: A += h^2 G, and f(x_end) - H (y - x_end) = f_R(y) - G (y - x_end) adds h G v_iter
-// to f_int (b = M v + h (f_int + f_ext)).
+// stiffness G (fem/linearisation.hpp).
 void add_twist_stiffness(Body& b, double h) {
-  const FemModel& m = b.fem;
-  b.relin.modes.resize(m.elements.size());
   b.relin.v_lin = b.relin.v_iter;
-  for (size_t e = 0; e < m.elements.size(); ++e) {
-    const TetElement& el = m.elements[e];
-    TwistModes& t = b.relin.modes[e];
-    t = twist_modes(el, m.lame, deformation_gradient(el, b.x_end));
-    for (int32_t q = 0; q < t.count; ++q) {
-      double c = 0;
-      for (int a = 0; a < 4; ++a) c += t.q[q][a].dot(b.relin.v_lin[el.nodes[a]]);
-      const double w = t.weight[q];
-      for (int a = 0; a < 4; ++a) {
-        b.f_int[el.nodes[a]] += (h * w * c) * t.q[q][a];
-        for (int c2 = 0; c2 < 4; ++c2) b.A[m.slots[e][4 * a + c2]] += (h * h * w) * t.q[q][a] * t.q[q][c2].transpose();
-      }
-    }
-  }
+  mica::add_twist_stiffness(b.fem, b.x_end, b.relin.v_lin, h, b.relin.modes, b.A, b.f_int);
 }
 
 }  // namespace
 
-void World::start_rotations(Body& b) const {
+void World::start_rotations(const StepContext& ctx, Body& b) const {
   // The rotations computed after the last step's solve, if the positions are still those.
   b.relin.u_start_known = !b.x_end.empty() && b.x_end == b.x;
   if (b.relin.u_start_known) {
     std::swap(b.R, b.R_end);
     b.relin.u_start = b.relin.u_end;
-  } else if (pool_) {
-    compute_rotations(b.fem, b.x, b.R, *pool_);
   } else {
-    compute_rotations(b.fem, b.x, b.R);
+    compute_rotations(b.fem, b.x, b.R, ctx.pool);
   }
   b.x_end.clear();
 }
 
-void World::relinearise(const std::vector<Body*>& dynamic, double h, StageRunner& stage,
-                        const std::function<void()>& solve) {
+void World::relinearise(const StepContext& ctx, StageRunner& stage) {
+  const std::vector<Body*>& dynamic = ctx.dynamic;
+  const double h = ctx.h;
   const double tol = settings_.relinearise_tolerance;
   const int32_t max_solves = settings_.relinearise_max;
   if (max_solves < 2) return;
@@ -281,19 +212,19 @@ void World::relinearise(const std::vector<Body*>& dynamic, double h, StageRunner
     stage.run(Stage::Elements, true, [&] {
       for (Body* b : dynamic) {
         if (!b->settings.corotational) continue;  // the others' A and forces do not change
-        assemble_elements(*b, h, needs_damping(*b));
+        assemble_elements(ctx, *b);
         if (!at_start) add_twist_stiffness(*b, h);
       }
     });
     stage.run(Stage::Damping, std::any_of(dynamic.begin(), dynamic.end(), [&](Body* b) { return needs_damping(*b); }),
               [&] {
                 for (Body* b : dynamic)
-                  if (b->settings.corotational && needs_damping(*b)) add_damping(*b, h);
+                  if (b->settings.corotational && needs_damping(*b)) add_damping(ctx, *b);
               });
     // The statistics report the solve whose solution the step keeps; iterations add up.
     stats_.solver_residual = 0;
     stats_.converged = true;
-    stage.run(Stage::Solve, true, solve);
+    stage.run(Stage::Solve, true, [&] { solve(ctx); });
   };
   for (Body* b : dynamic) b->relin.v_iter = b->v_next;
   double phi_iter = cur.phi, best = cur.growth;
@@ -347,8 +278,7 @@ void World::relinearise(const std::vector<Body*>& dynamic, double h, StageRunner
         b->relin.v_iter = b->relin.v_best;
         end_state(*b, b->relin.v_iter, h);
         if (b->settings.corotational) {
-          if (pool_) compute_rotations(b->fem, b->x_end, b->R_end, *pool_);
-          else compute_rotations(b->fem, b->x_end, b->R_end);
+          compute_rotations(b->fem, b->x_end, b->R_end, ctx.pool);
         }
       }
     }

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "collision/contact_curvature.hpp"
+#include "core/assert.hpp"
 #include "world/world.hpp"
 
 namespace mica {
@@ -50,14 +51,24 @@ void World::step(double h) {
   }
 }
 
-void World::advance(double h) {
-  const auto start = step_start_ = std::chrono::steady_clock::now();
-  const Plan plan = this->plan();
-  std::vector<Body*>& dynamic = dynamic_;
-  dynamic.clear();
+StepContext World::begin_step(double h) {
+  StepContext ctx;
+  ctx.start = StepContext::Clock::now();
+  if (settings_.time_budget_ms > 0)
+    ctx.deadline = ctx.start + std::chrono::duration_cast<StepContext::Clock::duration>(
+                                   std::chrono::duration<double, std::milli>(settings_.time_budget_ms));
+  ctx.pool = pool_.get();
+  ctx.h = h;
+  ctx.plan = plan();
   bodies_.for_each([&](Id, Body& b) {
-    if (b.is_dynamic()) dynamic.push_back(&b);
+    if (b.is_dynamic()) ctx.dynamic.push_back(&b);
   });
+  return ctx;
+}
+
+void World::advance(double h) {
+  StepContext ctx = begin_step(h);
+  const Plan& plan = ctx.plan;
   stats_.solver_iterations = 0;
   stats_.solver_residual = 0;
   stats_.converged = true;
@@ -65,52 +76,41 @@ void World::advance(double h) {
 
   follow_devices();
   StageRunner stage(stats_);
-  stage.run(Stage::Collide, plan.collide, [&] { collide(dynamic, h); });
-  if (!plan.collide) {  // nothing to collide: drop last step's contacts and tool pointers (a tool may be gone)
-    contacts_.clear();
-    step_tools_.clear();
-  }
+  stage.run(Stage::Collide, plan.collide, [&] { collide(ctx); });
+  if (!plan.collide) contacts_.clear();  // nothing to collide: drop last step's contacts
   rows_.clear();
   lambda_.clear();
   stage.run(Stage::Loads, plan.loads, [&] {
-    for (Body* b : dynamic)
+    for (Body* b : ctx.dynamic)
       if (needs_loads(*b)) apply_loads(*b);
   });
   stage.run(Stage::Rotations, plan.rotations, [&] {
-    for (Body* b : dynamic)
-      if (b->settings.corotational) start_rotations(*b);
+    for (Body* b : ctx.dynamic)
+      if (b->settings.corotational) start_rotations(ctx, *b);
   });
   stage.run(Stage::Elements, plan.elements, [&] {
-    for (Body* b : dynamic) assemble_elements(*b, h, needs_damping(*b));
+    for (Body* b : ctx.dynamic) assemble_elements(ctx, *b);
   });
   stage.run(Stage::Damping, plan.damping, [&] {
-    for (Body* b : dynamic)
-      if (needs_damping(*b)) add_damping(*b, h);
+    for (Body* b : ctx.dynamic)
+      if (needs_damping(*b)) add_damping(ctx, *b);
   });
   stage.run(Stage::Constraints, plan.constraints, [&] {
-    for (Body* b : dynamic) build_projection(*b, h);
+    for (Body* b : ctx.dynamic) build_projection(ctx, *b);
   });
-  const std::function<void()> solve = [&] {
-    if (settings_.solver == SolverKind::Mica) {
-      solve_mica(dynamic, h);
-    } else if (!contacts_.empty()) {
-      solve_delassus(dynamic, h);
-    } else {
-      for (Body* b : dynamic) solve_velocities(*b, h);
-    }
-  };
-  stage.run(Stage::Solve, plan.solve, solve);
-  if (plan.rotations && plan.solve) relinearise(dynamic, h, stage, solve);
+  stage.run(Stage::Solve, plan.solve, [&] { solve(ctx); });
+  if (plan.rotations && plan.solve) relinearise(ctx, stage);
   stage.run(Stage::Integrate, plan.integrate, [&] {
-    for (Body* b : dynamic)
+    for (Body* b : ctx.dynamic)
       for (size_t i = 0; i < b->x.size(); ++i) b->x_next[i] = b->x[i] + h * b->v_next[i];
   });
-  check_finite(dynamic);  // throws before anything observable has changed
-  stage.run(Stage::Forces, plan.forces, [&] { compute_forces(dynamic, h); });
-  commit(dynamic);
+  check_finite(ctx);  // throws before anything observable has changed
+  stage.run(Stage::Forces, plan.forces, [&] { compute_forces(ctx); });
+  commit(ctx);
   publish_force_models();
   stats_.step_count += 1;
-  stats_.ms_last_step = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  stats_.ms_last_step =
+      std::chrono::duration<double, std::milli>(StepContext::Clock::now() - ctx.start).count();
 }
 
 void World::follow_devices() {
@@ -146,61 +146,57 @@ void World::apply_loads(Body& b) const {
   for (size_t i = 0; i < b.f_ext.size(); ++i) b.f_ext[i] = b.fem.node_mass[i] * settings_.gravity + b.node_forces[i];
 }
 
-void World::assemble_elements(Body& b, double h, bool damping) const {
+void World::assemble_elements(const StepContext& ctx, Body& b) const {
+  const double h = ctx.h;
+  const bool damping = needs_damping(b);
   const double beta = damping ? b.settings.rayleigh_beta : 0.0;
   const double alpha = damping ? b.settings.rayleigh_alpha : 0.0;
-  const Body::MatrixKey key{h, alpha, beta};
+  const SystemKey key{h, alpha, beta};
   // A linear body keeps A while h and the damping stay: only its forces are recomputed.
   const bool rebuild = b.settings.corotational || !b.matrix_current || !(key == b.matrix_key);
   const std::vector<Mat3>* R = b.settings.corotational ? &b.R : nullptr;
-  if (pool_ && !b.element_colours.empty()) {
-    if (rebuild) set_scaled_mass(b.fem, 1.0, b.A, *pool_);
-    assemble_elastic(b.fem, b.x, R, h * h + h * beta, rebuild ? &b.A : nullptr, b.f_int, b.element_colours, *pool_);
-  } else {
-    if (rebuild) set_scaled_mass(b.fem, 1.0, b.A);
-    assemble_elastic(b.fem, b.x, R, h * h + h * beta, rebuild ? &b.A : nullptr, b.f_int);
-  }
+  if (rebuild) set_scaled_mass(b.fem, 1.0, b.A, ctx.pool);
+  assemble_elastic(b.fem, b.x, R, h * h + h * beta, rebuild ? &b.A : nullptr, b.f_int, &b.element_colours, ctx.pool);
   if (rebuild) {
     b.matrix_key = key;
     b.matrix_current = !b.settings.corotational;
-    b.factor_current = false;
+    ++b.matrix_version;
   }
   b.matrix_rebuilt = rebuild;
-  add_contact_stiffness(b, h);
+  add_contact_stiffness(ctx, b);
 }
 
-void World::add_contact_stiffness(Body& b, double h) const {
+void World::add_contact_stiffness(const StepContext& ctx, Body& b) const {
   // h^2 K_c with K_c = F (-H)+ per contact of a rounded tool on a triangle, F the contact's force
   // in the last step (this step's force is the unknown: the lag keeps the system linear).
-  const auto it = std::find(dynamic_.begin(), dynamic_.end(), &b);
-  if (it == dynamic_.end()) return;
-  const int32_t index = int32_t(it - dynamic_.begin());
+  const int32_t index = ctx.index_of(&b);
+  MICA_ASSERT(index >= 0, "the elements stage assembles dynamic bodies only");
   thread_local ToolCore core;  // kept: a step allocates nothing here
   int32_t core_of = -1;
   for (const Contact& c : contacts_) {
     if (c.tool < 0 || (c.core_corner < 0 && c.core_edge < 0) || c.a.body != index) continue;
     const auto last = warm_start_.find(ContactRows::normal_row_key(c.key));
     if (last == warm_start_.end() || !(last->second > 0)) continue;
-    if (core_of != c.tool) tool_core(*step_tools_[size_t(c.tool)], core);
+    if (core_of != c.tool) tool_core(*ctx.tools[size_t(c.tool)], core);
     core_of = c.tool;
     const Tri& t = b.surface[size_t(c.triangle)];
     Mat9 K;
     if (!contact_curvature(core, c, t, b.x, K)) continue;
-    K *= h * last->second;  // h^2 F
+    K *= ctx.h * last->second;  // h^2 F
     for (int r = 0; r < 3; ++r)
       for (int s = 0; s < 3; ++s) b.A[size_t(b.fem.pattern.find(t[r], t[s]))] += K.block<3, 3>(3 * r, 3 * s);
     // A linear body keeps A between steps: this one is not its plain matrix any more.
     b.matrix_current = false;
-    b.factor_current = false;
+    ++b.matrix_version;
   }
 }
 
-void World::add_damping(Body& b, double h) const {
+void World::add_damping(const StepContext& ctx, Body& b) const {
   // C = alpha M + beta K: beta K is folded into the stiffness scale above; alpha M here.
-  if (b.matrix_rebuilt) add_scaled_mass(b.fem, h * b.settings.rayleigh_alpha, b.A);
+  if (b.matrix_rebuilt) add_scaled_mass(b.fem, ctx.h * b.settings.rayleigh_alpha, b.A);
 }
 
-void World::build_projection(Body& b, double h) const {
+void World::build_projection(const StepContext& ctx, Body& b) const {
   b.projection.reset(b.fem.node_count());
   lpcs_.for_each([&](Id, const Lpc& c) {
     if (&bodies_.get(c.body, "body") != &b) return;
@@ -215,21 +211,22 @@ void World::build_projection(Body& b, double h) const {
     const Eigen::Quaterniond& q = tool ? tool->orientation : hd.orientation;
     for (size_t k = 0; k < c.nodes.size(); ++k) {
       const Vec3 target = p + q * hd.offsets[k];
-      b.projection.constrain(c.nodes[k], c.constrained, (target - b.x[c.nodes[k]]) / h);
+      b.projection.constrain(c.nodes[k], c.constrained, (target - b.x[c.nodes[k]]) / ctx.h);
     }
   });
 }
 
-void World::form_rhs(Body& b, double h) const {
+void World::form_rhs(const StepContext& ctx, Body& b) const {
   // b = M v + h (f_int + f_ext)
   mass_multiply(b.fem, b.v, b.b);
   const bool loads = needs_loads(b);
-  for (size_t i = 0; i < b.b.size(); ++i) b.b[i] += h * (loads ? b.f_int[i] + b.f_ext[i] : b.f_int[i]);
+  for (size_t i = 0; i < b.b.size(); ++i) b.b[i] += ctx.h * (loads ? b.f_int[i] + b.f_ext[i] : b.f_int[i]);
 }
 
-void World::collide(const std::vector<Body*>& dynamic, double h) {
+void World::collide(StepContext& ctx) {
+  const double h = ctx.h;
   contacts_.clear();
-  step_tools_.clear();
+  ctx.tools.clear();
   // Tool velocities from the pose change the host made since the last step.
   tools_.for_each([&](Id, Tool& t) {
     t.velocity = (t.position - t.previous_position) / h;
@@ -237,27 +234,26 @@ void World::collide(const std::vector<Body*>& dynamic, double h) {
     t.angular_velocity = turn.axis() * (turn.angle() > M_PI ? turn.angle() - 2 * M_PI : turn.angle()) / h;
   });
   // Every body's surface as collision sees it; dynamic bodies' trees follow their nodes.
-  views_.clear();
+  std::vector<SurfaceView> views;
   bodies_.for_each([&](Id id, Body& b) {
-    const auto it = std::find(dynamic.begin(), dynamic.end(), &b);
-    const int32_t index = it == dynamic.end() ? -1 : int32_t(it - dynamic.begin());
+    const int32_t index = ctx.index_of(&b);
     double speed = 0;
     if (index >= 0) {
       b.bvh.refit(b.x);
       b.pseudo_normals.update(b.x, b.surface);
       for (int32_t i : b.surface_node_list) speed = std::max(speed, b.v[i].norm());
     }
-    views_.push_back(SurfaceView{index, id, &b.x, &b.surface, &b.surface_node_list, &b.bvh, &b.pseudo_normals,
-                                 b.surface_edge, h * speed});
+    views.push_back(SurfaceView{index, id, &b.x, &b.surface, &b.surface_node_list, &b.bvh, &b.pseudo_normals,
+                                b.surface_edge, h * speed});
   });
   tools_.for_each([&](Id tool_id, Tool& t) {
-    step_tools_.push_back(&t);
-    for (const SurfaceView& v : views_)
-      if (v.index >= 0) collide_tool(t, int32_t(step_tools_.size() - 1), tool_id, v, h, contacts_);
+    ctx.tools.push_back(&t);
+    for (const SurfaceView& v : views)
+      if (v.index >= 0) collide_tool(t, int32_t(ctx.tools.size() - 1), tool_id, v, h, contacts_);
   });
   if (!settings_.body_contact) return;
-  for (const SurfaceView& a : views_)
-    for (const SurfaceView& b : views_)
+  for (const SurfaceView& a : views)
+    for (const SurfaceView& b : views)
       if (a.index >= 0 && &a != &b && (b.index < 0 || bounds_overlap(a, b)))
         collide_bodies(a, b, settings_.body_margin, settings_.body_friction, contacts_);
 }
@@ -267,114 +263,42 @@ bool World::bounds_overlap(const SurfaceView& a, const SurfaceView& b) const {
   return a.bvh->bounds().inflated(reach).overlaps(b.bvh->bounds());
 }
 
-void World::solve_mica(const std::vector<Body*>& dynamic, double h) {
-  mica_bodies_.resize(dynamic.size());
-  for (size_t k = 0; k < dynamic.size(); ++k) {
-    Body& b = *dynamic[k];
-    form_rhs(b, h);
-    // The warm start: the last step's velocities (MICA's iterate carries its information in v:
-    // one PGS sweep makes an isolated row's impulse a function of v alone).
-    if (settings_.warm_start) b.v_next = b.v;
-    else for (Vec3& v : b.v_next) v.setZero();
-    mica_bodies_[k].colours = pool_ && !b.node_colours.empty() ? &b.node_colours : nullptr;
-    mica_bodies_[k].pattern = &b.fem.pattern;
-    mica_bodies_[k].A = &b.A;
-    mica_bodies_[k].b = &b.b;
-    mica_bodies_[k].projection = &b.projection;
-    mica_bodies_[k].v = &b.v_next;
-    mica_bodies_[k].node_mass = &b.fem.node_mass;
+void World::solve(const StepContext& ctx) {
+  solver_bodies_.resize(ctx.dynamic.size());
+  for (size_t k = 0; k < ctx.dynamic.size(); ++k) {
+    Body& b = *ctx.dynamic[k];
+    form_rhs(ctx, b);
+    b.v_next = b.v;  // the warm start (MICA without warm start zeroes it)
+    SolverBody& sb = solver_bodies_[k];
+    sb.key = b.key;
+    sb.fem = &b.fem;
+    sb.A = &b.A;
+    sb.b = &b.b;
+    sb.projection = &b.projection;
+    sb.v = &b.v_next;
+    sb.contact_impulse = &b.contact_impulse;
+    sb.colours = ctx.pool && !b.node_colours.empty() ? &b.node_colours : nullptr;
+    sb.rotation = b.settings.corotational ? &b.R : nullptr;
+    sb.system = b.matrix_key;
+    sb.matrix_version = b.matrix_version;
+    sb.constraint_version = b.lpc_version;
   }
-  // Warm start the impulses of contact rows that persist from the last step.
-  rows_.build(contacts_, h, settings_.max_recovery_speed);
+  // The impulses of contact rows that persist from the last step are the warm start.
+  rows_.build(contacts_, ctx.h, settings_.max_recovery_speed);
   lambda_.assign(rows_.size(), 0.0);
   for (size_t r = 0; settings_.warm_start && r < rows_.size(); ++r) {
     const auto it = warm_start_.find(rows_.key[r]);
     if (it != warm_start_.end()) lambda_[r] = it->second;
   }
-  MicaSettings ms;
-  ms.pool = pool_.get();
-  ms.tolerance = settings_.tolerance;
-  ms.max_iterations = settings_.max_iterations;
-  ms.pgs_sweeps = settings_.pgs_sweeps;
-  ms.paper_norm = settings_.paper_norm;
-  ms.relaxation = settings_.relaxation;
-  ms.refactor_after = settings_.refactor_after;
-  if (settings_.time_budget_ms > 0)  // what the stages before the solve left of the step's budget
-    ms.time_budget_ms = std::max(1e-6, settings_.time_budget_ms - std::chrono::duration<double, std::milli>(
-                                                                       std::chrono::steady_clock::now() - step_start_)
-                                                                       .count());
-  if (settings_.mica_sweep == MicaSweep::Factored) {
-    factored_bodies_.resize(dynamic.size());
-    for (size_t k = 0; k < dynamic.size(); ++k) {
-      Body& b = *dynamic[k];
-      const bool damped = needs_damping(b);
-      const std::vector<Mat3>* rotation = nullptr;
-      if (b.settings.corotational) {
-        compute_node_rotations(b.fem, b.R, b.node_rotation);
-        rotation = &b.node_rotation;
-      }
-      const LaggedFactor::Key key{h, damped ? b.settings.rayleigh_alpha : 0.0,
-                                  damped ? b.settings.rayleigh_beta : 0.0, b.lpc_version};
-      b.factor.update(b.fem, key, b.A, b.projection, rotation, rotation ? settings_.refactor_interval : 0);
-      factored_bodies_[k] = {&b.factor, rotation};
-    }
-    record(factored_mica_.solve(mica_bodies_, factored_bodies_, rows_, ms, lambda_));
-    row_diagonal_ = factored_mica_.row_diagonal();
-  } else {
-    record(mica_.solve(mica_bodies_, rows_, ms, lambda_));
-    row_diagonal_ = mica_.row_diagonal();
-  }
-  for (size_t k = 0; k < dynamic.size(); ++k) std::swap(dynamic[k]->contact_impulse, mica_bodies_[k].contact_impulse);
+  record(solver_->solve(ctx, solver_bodies_, rows_, lambda_));
 }
 
-void World::solve_delassus(const std::vector<Body*>& dynamic, double h) {
-  exact_bodies_.resize(dynamic.size());
-  for (size_t k = 0; k < dynamic.size(); ++k) {
-    Body& b = *dynamic[k];
-    form_rhs(b, h);
-    b.v_next = b.v;  // the warm start of an iterative solve
-    exact_bodies_[k] = ExactBody{&b.fem.pattern, &b.A, &b.b, &b.projection, &linear_solver(b), &b.v_next, {}};
-  }
-  rows_.build(contacts_, h, settings_.max_recovery_speed);
-  // The sweeps (friction, or a degenerate frictionless problem) start from the last step's
-  // impulses and stop at the time budget.
-  exact_warm_start_.assign(rows_.size(), 0.0);
-  for (size_t r = 0; settings_.warm_start && r < rows_.size(); ++r) {
-    const auto it = warm_start_.find(rows_.key[r]);
-    if (it != warm_start_.end()) exact_warm_start_[r] = it->second;
-  }
-  ExactContactSettings es;
-  es.warm_start = &exact_warm_start_;
-  es.deadline = deadline();
-  record(solve_contact_delassus(exact_bodies_, rows_, lambda_, row_diagonal_, es));
-  for (size_t k = 0; k < dynamic.size(); ++k) std::swap(dynamic[k]->contact_impulse, exact_bodies_[k].contact_impulse);
-}
-
-std::optional<std::chrono::steady_clock::time_point> World::deadline() const {
-  if (!(settings_.time_budget_ms > 0)) return std::nullopt;
-  return step_start_ + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                           std::chrono::duration<double, std::milli>(settings_.time_budget_ms));
-}
-
-LinearSolver& World::linear_solver(Body& b) {
-  if (settings_.solver == SolverKind::Pcg) {
-    b.pcg.configure(settings_.tolerance, settings_.max_iterations, deadline());
-    return b.pcg;
-  }
-  // CHOLMOD: analysed once; factored when A or the constraint set changed (a linear body with
-  // fixed constraints keeps its factor).
-  if (!b.direct.analyzed()) b.direct.analyze(b.fem.pattern);
-  if (!b.factor_current || b.factored_lpc_version != b.lpc_version) {
-    b.direct.factorize(ProjectedSystem{b.fem.pattern, b.A, b.projection});
-    b.factor_current = true;
-    b.factored_lpc_version = b.lpc_version;
-  }
-  return b.direct;
-}
-
-void World::compute_forces(const std::vector<Body*>& dynamic, double h) {
+void World::compute_forces(const StepContext& ctx) {
+  const double h = ctx.h;
+  const std::vector<double>& row_diagonal = solver_->row_diagonal();
+  MICA_ASSERT(row_diagonal.size() == rows_.size(), "the solver reports the compliance of each row it solved");
   // Tools: the force the tissue puts on the tool is -sum n lambda / h.
-  for (Tool* t : step_tools_) {
+  for (Tool* t : ctx.tools) {
     t->force.setZero();
     t->torque.setZero();
     t->contact_count = 0;
@@ -383,7 +307,7 @@ void World::compute_forces(const std::vector<Body*>& dynamic, double h) {
   for (size_t r = 0; r < rows_.size(); ++r) {
     const Contact& c = contacts_[rows_.contact[r]];
     if (c.tool < 0) continue;
-    Tool& t = *step_tools_[c.tool];
+    Tool& t = *ctx.tools[c.tool];
     const Vec3 f = -rows_.direction[r] * lambda_[r] / h;
     t.force += f;
     t.torque += (c.point - t.position).cross(f);
@@ -391,8 +315,8 @@ void World::compute_forces(const std::vector<Body*>& dynamic, double h) {
       t.contact_count += 1;
       // Around the pose it used, pushing the tool in by dx along n raises this row's impulse by
       // n.dx / (h W_rr): the force changes by -n n^T dx / (h^2 W_rr).
-      if (row_diagonal_.size() == rows_.size() && row_diagonal_[r] > 0)
-        t.stiffness -= rows_.direction[r] * rows_.direction[r].transpose() / (h * h * row_diagonal_[r]);
+      if (row_diagonal[r] > 0)
+        t.stiffness -= rows_.direction[r] * rows_.direction[r].transpose() / (h * h * row_diagonal[r]);
     }
   }
   // Constraints: the impulse r = (I - S)(A v - b - G^T lambda) holds the body; whoever holds
@@ -400,7 +324,7 @@ void World::compute_forces(const std::vector<Body*>& dynamic, double h) {
   lpcs_.for_each([&](Id, Lpc& c) {
     Body& b = bodies_.get(c.body, "body");
     c.reaction.setZero();
-    if (std::find(dynamic.begin(), dynamic.end(), &b) == dynamic.end()) return;
+    if (ctx.index_of(&b) < 0) return;
     for (int32_t i : c.nodes) {
       Vec3 Av = Vec3::Zero();
       for (int32_t k = b.fem.pattern.row_start[i]; k < b.fem.pattern.row_start[i + 1]; ++k)
@@ -408,14 +332,6 @@ void World::compute_forces(const std::vector<Body*>& dynamic, double h) {
       c.reaction -= c.constrained * (Av - b.b[i] - b.contact_impulse[i]) / h;
     }
   });
-}
-
-void World::solve_velocities(Body& b, double h) {
-  form_rhs(b, h);
-
-  b.v_next = b.v;  // the warm start of an iterative solve
-  for (Vec3& f : b.contact_impulse) f.setZero();  // no contact rows this step: no stale impulse in the reactions
-  record(linear_solver(b).solve(ProjectedSystem{b.fem.pattern, b.A, b.projection}, b.b, b.v_next));
 }
 
 void World::record(const SolveReport& report) {
@@ -426,16 +342,16 @@ void World::record(const SolveReport& report) {
   stats_.out_of_time = stats_.out_of_time || report.out_of_time;
 }
 
-void World::check_finite(const std::vector<Body*>& dynamic) const {
-  for (const Body* b : dynamic)
+void World::check_finite(const StepContext& ctx) const {
+  for (const Body* b : ctx.dynamic)
     if (!(flat(b->v_next).allFinite() && flat(b->x_next).allFinite()))
       fail(Errc::Numerical, b->name + ": the step produced non-finite velocities or positions; the step was undone");
   for (double l : lambda_)
     if (!std::isfinite(l)) fail(Errc::Numerical, "a contact impulse is not finite; the step was undone");
 }
 
-void World::commit(const std::vector<Body*>& dynamic) {
-  for (Body* b : dynamic) {
+void World::commit(const StepContext& ctx) {
+  for (Body* b : ctx.dynamic) {
     std::swap(b->x, b->x_next);
     std::swap(b->v, b->v_next);
   }

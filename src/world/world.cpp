@@ -13,22 +13,35 @@ void require_finite(const Vec3& v, const std::string& what) {
 }
 }  // namespace
 
+void validate(const WorldSettings& s) {
+  auto require = [](bool ok, const std::string& message) {
+    if (!ok) fail(Errc::InvalidArgument, message);
+  };
+  require_finite(s.gravity, "gravity");
+  require(s.tolerance > 0 && std::isfinite(s.tolerance), "tolerance must be finite and > 0");
+  require(s.max_iterations >= 1, "max_iterations must be >= 1");
+  require(s.pgs_sweeps >= 1, "pgs_sweeps must be >= 1");
+  require(s.max_recovery_speed > 0 && std::isfinite(s.max_recovery_speed),
+          "max_recovery_speed must be finite and > 0 m/s");
+  require(s.relaxation > 0 && s.relaxation < 2, "relaxation must be in (0, 2), got " + std::to_string(s.relaxation));
+  require(s.time_budget_ms >= 0 && std::isfinite(s.time_budget_ms),
+          "time_budget_ms must be finite and >= 0 (0: no budget)");
+  require(s.refactor_interval >= 0, "refactor_interval must be >= 0 (0: no background refresh), got " +
+                                        std::to_string(s.refactor_interval));
+  require(s.body_margin >= 0 && std::isfinite(s.body_margin), "the body contact margin must be finite and >= 0 m");
+  require(s.body_friction >= 0 && std::isfinite(s.body_friction),
+          "the body friction coefficient must be finite and >= 0");
+  require(s.threads >= 0 && s.threads <= kMaxThreads, "threads must be in 0.." + std::to_string(kMaxThreads) +
+                                                          " (0: every CPU), got " + std::to_string(s.threads));
+  require(s.relinearise_tolerance >= 0 && std::isfinite(s.relinearise_tolerance),
+          "relinearise_tolerance must be finite and >= 0");
+}
+
 World::World(const WorldSettings& settings) : settings_(settings) {
-  require_finite(settings.gravity, "gravity");
-  if (!(settings.tolerance > 0) || !std::isfinite(settings.tolerance))
-    fail(Errc::InvalidArgument, "tolerance must be finite and > 0");
-  if (settings.max_iterations < 1) fail(Errc::InvalidArgument, "max_iterations must be >= 1");
-  if (!(settings.body_margin >= 0) || !std::isfinite(settings.body_margin))
-    fail(Errc::InvalidArgument, "the body contact margin must be finite and >= 0 m");
-  if (!(settings.body_friction >= 0) || !std::isfinite(settings.body_friction))
-    fail(Errc::InvalidArgument, "the body friction coefficient must be finite and >= 0");
-  if (settings.threads < 0 || settings.threads > kMaxThreads)
-    fail(Errc::InvalidArgument, "threads must be in 0.." + std::to_string(kMaxThreads) + " (0: every CPU), got " +
-                                    std::to_string(settings.threads));
+  validate(settings);
   const int32_t threads = ThreadPool::resolve(settings.threads);
   if (threads > 1) pool_ = std::make_unique<ThreadPool>(threads);
-  if (!(settings.relinearise_tolerance >= 0) || !std::isfinite(settings.relinearise_tolerance))
-    fail(Errc::InvalidArgument, "relinearise_tolerance must be finite and >= 0");
+  solver_ = make_velocity_solver(settings.solver, settings.mica_sweep, settings);
 }
 
 void World::set_gravity(const Vec3& g) {
@@ -44,7 +57,7 @@ Id World::add_body(const TetMesh& mesh, const BodySettings& settings, const Vec3
   if (!(beta >= 0) || !std::isfinite(beta)) fail(Errc::InvalidArgument, "rayleigh_beta must be finite and >= 0");
   TetMesh placed = mesh;  // the rest shape sits where the body is placed
   for (Vec3& p : placed.nodes) p += translation;
-  auto body = std::make_unique<Body>(placed, settings, "body " + std::to_string(bodies_created_));
+  auto body = std::make_unique<Body>(placed, settings, "body " + std::to_string(bodies_created_), uint64_t(bodies_created_));
   const QualityReport& q = body->fem.quality;
   if (!q.slivers.empty() && settings_.log)
     settings_.log(LogLevel::Warning, body->name + ": " + std::to_string(q.slivers.size()) +
@@ -70,8 +83,11 @@ void World::remove_body(Id id) {
     if (c.body == id) doomed.push_back(lpc);
   });
   for (Id lpc : doomed) lpcs_.erase(lpc);
+  solver_->forget(body(id).key);  // its factors (one may be in the making on the body's pattern) first
   bodies_.erase(id);
 }
+
+int64_t World::factorizations(Id id) const { return solver_->factorizations(body(id).key); }
 
 void World::set_node_forces(Id id, const std::vector<int32_t>& nodes, const Vec3List& forces) {
   Body& b = body(id);

@@ -12,44 +12,27 @@
 #include "core/thread_pool.hpp"
 #include "collision/contact.hpp"
 #include "haptics/device_link.hpp"
-#include "solver/exact_contact_solver.hpp"
-#include "solver/factored_mica.hpp"
-#include "solver/mica_solver.hpp"
+#include "solver/velocity_solver.hpp"
 #include "world/body.hpp"
 #include "world/slot_map.hpp"
 #include "world/stats.hpp"
+#include "world/step_context.hpp"
 
 namespace mica {
 
-enum class SolverKind { Direct, Pcg, Mica };
-// How MICA anticipates and updates velocities: the paper's block Gauss-Seidel on the diagonal
-// blocks, or the factor of the rest system warped by node rotations (solver/factored_mica.hpp).
-enum class MicaSweep { GaussSeidel, Factored };
 enum class LogLevel { Error, Warning, Info };
 
 constexpr int32_t kMaxThreads = 1024;  // WorldSettings::threads above this is refused
 
-struct WorldSettings {
+// The solver's settings (tolerance, max_iterations, warm_start, pgs_sweeps, paper_norm,
+// relaxation, refactor_interval, refactor_after: solver/velocity_solver.hpp) and the world's.
+struct WorldSettings : SolverSettings {
   Vec3 gravity{0, -9.81, 0};
   SolverKind solver = SolverKind::Direct;
-  int32_t max_iterations = 200;
-  double tolerance = 1e-8;
-  bool plan_all_stages = false;  // run every stage even when its effect is absent
-  int32_t pgs_sweeps = 1;          // MICA: PGS sweeps over the contacts per iteration
-  double max_recovery_speed = 1.0; // m/s, clamps the recovery of penetration (normal_bias)
-  bool paper_norm = false;         // MICA: stop on the paper's 2-norm of the change
-  double relaxation = 1.0;         // MICA: MBGS over-relaxation omega in (0, 2)
   MicaSweep mica_sweep = MicaSweep::GaussSeidel;
-  // Factored sweep: refresh each co-rotational body's factor from its current system every this
-  // many steps, factored on a background thread and adopted that many steps later (0: refactor
-  // only when the step size, damping or constraint set changes).
-  int32_t refactor_interval = 0;
-  // Factored sweep: a solve that has used this many conjugate-gradient iterations refactors the
-  // current system and goes on with it (about what a factorization costs on a body of some
-  // thousand nodes; 0: never).
-  int32_t refactor_after = 100;
-  double time_budget_ms = 0;       // iterative solvers: > 0 stops the solve after this much wall-clock time
-  bool warm_start = true;          // MICA: start from the last step's velocities and impulses (else zero)
+  bool plan_all_stages = false;  // run every stage even when its effect is absent
+  double max_recovery_speed = 1.0; // m/s, clamps the recovery of penetration (normal_bias)
+  double time_budget_ms = 0;       // > 0: every iterative solve of a step stops this long after the step began
   bool body_contact = true;        // contact between bodies (and with static bodies)
   double body_margin = 1e-3;       // m, contacts between bodies are made for gaps below this
   double body_friction = 0;        // Coulomb coefficient between bodies
@@ -102,12 +85,8 @@ struct Lpc {
   Vec3 reaction = Vec3::Zero();  // N: the force on whoever holds the constraint (the user), last step
 };
 
-// Which stages the scene calls for (each body also checks its own need inside a stage).
-struct Plan {
-  bool loads = false, rotations = false, elements = false, damping = false;
-  bool constraints = false, solve = false, integrate = false;
-  bool collide = false, forces = false;
-};
+// Throws Error(InvalidArgument) naming the first setting out of its domain.
+void validate(const WorldSettings& settings);
 
 class World {
  public:
@@ -121,6 +100,8 @@ class World {
   Body& body(Id id) { return bodies_.get(id, "body"); }
   const Body& body(Id id) const { return bodies_.get(id, "body"); }
   void set_node_forces(Id body, const std::vector<int32_t>& nodes, const Vec3List& forces);
+  // Numeric factorizations the solver has made of this body's systems so far.
+  int64_t factorizations(Id body) const;
 
   Id add_lpc(Id body, const std::vector<int32_t>& nodes, const LpcSpec& spec);
   void remove_lpc(Id id);
@@ -145,6 +126,7 @@ class World {
   const DeviceLink& device(Id id) const { return devices_.get(id, "device"); }
   DeviceLink* find_device(Id id) noexcept { return devices_.find(id); }  // the servo path: no throw
 
+  // The last step's contacts, their rows of G and the impulses on them.
   const std::vector<Contact>& contacts() const { return contacts_; }
   const ContactRows& contact_rows() const { return rows_; }
   const std::vector<double>& impulses() const { return lambda_; }  // per contact row, N s
@@ -161,30 +143,27 @@ class World {
   void for_each_body(F&& f) const { bodies_.for_each(f); }
 
  private:
-  void follow_devices();
-  void publish_force_models();
-  void collide(const std::vector<Body*>& dynamic, double h);
-  bool bounds_overlap(const SurfaceView& a, const SurfaceView& b) const;
-  void solve_mica(const std::vector<Body*>& dynamic, double h);
-  void solve_delassus(const std::vector<Body*>& dynamic, double h);
-  LinearSolver& linear_solver(Body& b);
-  void compute_forces(const std::vector<Body*>& dynamic, double h);
-  void apply_loads(Body& b) const;
-  void assemble_elements(Body& b, double h, bool damping) const;
-  void add_damping(Body& b, double h) const;
-  void add_contact_stiffness(Body& b, double h) const;
-  // The end of the step's time budget (none without one).
-  std::optional<std::chrono::steady_clock::time_point> deadline() const;
-  void build_projection(Body& b, double h) const;
-  void form_rhs(Body& b, double h) const;
-  void solve_velocities(Body& b, double h);
-  // Co-rotational re-linearisation (relinearise.cpp).
-  void start_rotations(Body& b) const;
-  void relinearise(const std::vector<Body*>& dynamic, double h, StageRunner& stage, const std::function<void()>& solve);
+  // The stages of a step (step.cpp), in the order advance() runs them.
   void advance(double h);
+  StepContext begin_step(double h);
+  void follow_devices();
+  void collide(StepContext& ctx);
+  bool bounds_overlap(const SurfaceView& a, const SurfaceView& b) const;
+  void apply_loads(Body& b) const;
+  void assemble_elements(const StepContext& ctx, Body& b) const;
+  void add_contact_stiffness(const StepContext& ctx, Body& b) const;
+  void add_damping(const StepContext& ctx, Body& b) const;
+  void build_projection(const StepContext& ctx, Body& b) const;
+  void form_rhs(const StepContext& ctx, Body& b) const;
+  void solve(const StepContext& ctx);
+  // Co-rotational re-linearisation (relinearise.cpp).
+  void start_rotations(const StepContext& ctx, Body& b) const;
+  void relinearise(const StepContext& ctx, StageRunner& stage);
   void record(const SolveReport& report);
-  void check_finite(const std::vector<Body*>& dynamic) const;
-  void commit(const std::vector<Body*>& dynamic);
+  void check_finite(const StepContext& ctx) const;
+  void compute_forces(const StepContext& ctx);
+  void commit(const StepContext& ctx);
+  void publish_force_models();
 
   bool needs_loads(const Body& b) const;
   bool needs_damping(const Body& b) const;
@@ -194,28 +173,22 @@ class World {
   SlotMap<Lpc, IdKind::Lpc> lpcs_;
   SlotMap<Tool, IdKind::Tool> tools_;
   SlotMap<DeviceLink, IdKind::Device> devices_;
-  std::vector<double> row_diagonal_;                // W_rr (or B_rr) per row: the compliance a row sees
-  std::vector<Body*> dynamic_;                      // this step's dynamic bodies
+  // The last step's results, and what the next step takes from them.
+  std::vector<Contact> contacts_;
+  ContactRows rows_;                                // the rows of G
+  std::vector<double> lambda_;                      // impulse per row, N s
+  std::unordered_map<uint64_t, double> warm_start_; // impulses by row key
   struct {  // relinearise: the energy (J) the steps since it last went down added, net
     double committed = 0, pending = 0;
     int64_t pending_step = -1;  // the step whose completion commits `pending`
   } debt_;
-  std::vector<Tool*> step_tools_;
-  std::chrono::steady_clock::time_point step_start_;  // for the time budget
-  std::vector<SurfaceView> views_;
-  std::vector<Contact> contacts_;
-  ContactRows rows_;                                // this step's rows of G
-  std::vector<double> lambda_;                      // impulse per row, N s
-  std::unordered_map<uint64_t, double> warm_start_; // last step's impulses by row key
-  std::vector<double> exact_warm_start_;            // the same per row of this step, for the exact solver
-  MicaSolver mica_;
-  FactoredMicaSolver factored_mica_;
-  std::vector<MicaBody> mica_bodies_;
-  std::vector<FactoredBody> factored_bodies_;
-  std::vector<ExactBody> exact_bodies_;
   WorldStats stats_;
   int64_t bodies_created_ = 0;
   std::unique_ptr<ThreadPool> pool_;                // threads > 1 only; the step's parallel loops
+  // Chosen once from the settings; keeps per-body factors (some factored in the background on
+  // the bodies' patterns), so it goes before the bodies do.
+  std::unique_ptr<VelocitySolver> solver_;
+  std::vector<SolverBody> solver_bodies_;           // the solver's view of the dynamic bodies, rebuilt per solve
 };
 
 }  // namespace mica

@@ -102,7 +102,7 @@ static void test_parallel_rotations_are_the_serial_ones(void**) {
   std::vector<Mat3> serial(d.model.elements.size()), parallel(d.model.elements.size());
   compute_rotations(d.model, d.x, serial);
   ThreadPool pool(2);
-  compute_rotations(d.model, d.x, parallel, pool);
+  compute_rotations(d.model, d.x, parallel, &pool);
   for (size_t e = 0; e < serial.size(); ++e) assert_true(serial[e] == parallel[e]);  // bit for bit
 }
 
@@ -120,10 +120,10 @@ static void test_parallel_assembly_matches_serial(void**) {
   set_scaled_mass(d.model, 1.0, A1);
   assemble_elastic(d.model, d.x, &R, k_scale, &A1, f1);
   ThreadPool two(2), three(3);
-  set_scaled_mass(d.model, 1.0, A2, two);
-  assemble_elastic(d.model, d.x, &R, k_scale, &A2, f2, colours, two);
-  set_scaled_mass(d.model, 1.0, A3, three);
-  assemble_elastic(d.model, d.x, &R, k_scale, &A3, f3, colours, three);
+  set_scaled_mass(d.model, 1.0, A2, &two);
+  assemble_elastic(d.model, d.x, &R, k_scale, &A2, f2, &colours, &two);
+  set_scaled_mass(d.model, 1.0, A3, &three);
+  assemble_elastic(d.model, d.x, &R, k_scale, &A3, f3, &colours, &three);
   double a_scale = 0, f_scale = 0;
   for (const Mat3& a : A1) a_scale = std::max(a_scale, a.cwiseAbs().maxCoeff());
   for (const Vec3& f : f1) f_scale = std::max(f_scale, f.cwiseAbs().maxCoeff());
@@ -137,7 +137,7 @@ static void test_parallel_assembly_matches_serial(void**) {
   // Forces only (a linear body keeping its matrix), linear model (no rotations).
   Vec3List g1(nn), g2(nn);
   assemble_elastic(d.model, d.x, nullptr, k_scale, nullptr, g1);
-  assemble_elastic(d.model, d.x, nullptr, k_scale, nullptr, g2, colours, two);
+  assemble_elastic(d.model, d.x, nullptr, k_scale, nullptr, g2, &colours, &two);
   assert_le(max_diff(g1, g2), 1e-12 * f_scale);
 }
 
@@ -156,23 +156,26 @@ static void test_parallel_step_pieces_do_not_allocate(void**) {
   projection.reset(m.node_count());
   ContactRows rows;
   std::vector<double> lambda;
-  MicaSolver solver;
-  std::vector<MicaBody> bodies(1);
-  bodies[0].pattern = &m.pattern;
+  SolverSettings ss;
+  ss.max_iterations = 20;
+  MicaSolver solver(ss);
+  Vec3List impulse(d.x.size(), Vec3::Zero());
+  std::vector<SolverBody> bodies(1);
+  bodies[0].fem = &m;
   bodies[0].A = &A;
   bodies[0].b = &b;
   bodies[0].projection = &projection;
   bodies[0].v = &v;
+  bodies[0].contact_impulse = &impulse;
   bodies[0].colours = &nodes;
   ThreadPool pool(2);
-  MicaSettings ms;
-  ms.pool = &pool;
-  ms.max_iterations = 20;
+  SolveContext ctx;
+  ctx.pool = &pool;
   auto step = [&] {
-    compute_rotations(m, d.x, R, pool);
-    set_scaled_mass(m, 1.0, A, pool);
-    assemble_elastic(m, d.x, &R, 1e-4, &A, f, elements, pool);
-    solver.solve(bodies, rows, ms, lambda);
+    compute_rotations(m, d.x, R, &pool);
+    set_scaled_mass(m, 1.0, A, &pool);
+    assemble_elastic(m, d.x, &R, 1e-4, &A, f, &elements, &pool);
+    solver.solve(ctx, bodies, rows, lambda);
   };
   step();  // the first solve sizes the solver's buffers
   mica_test::start_counting_allocations();

@@ -28,7 +28,7 @@ void count_tick(void* context) {
 }  // namespace
 
 // Timing-independent: every 1 ms deadline over the run is either ticked or skipped (never
-// burst), and the reported rate agrees with the counted ticks. How many ticks a loaded machine
+// burst). How many ticks a loaded machine
 // manages is a benchmark's business (bench/bench_servo.c), not a unit test's.
 static void test_accounts_for_every_deadline(void**) {
   Counter counter;
@@ -43,13 +43,11 @@ static void test_accounts_for_every_deadline(void**) {
   assert_false(servo.running());
 
   const int64_t ticks = counter.ticks.load();
-  printf("# %lld ticks in %.3f s, measured rate %.1f Hz, %lld deadlines skipped\n", (long long)ticks, elapsed,
-         servo.measured_rate(), (long long)servo.skipped());
+  printf("# %lld ticks in %.3f s, %lld deadlines skipped\n", (long long)ticks, elapsed, (long long)servo.skipped());
   assert_true(ticks > 0);
   assert_int_equal(servo.ticks(), ticks);
   const double deadlines = double(ticks + servo.skipped());
   assert_le(deadlines, 1e3 * elapsed + 2);  // never more ticks than the grid has deadlines
-  assert_true(servo.measured_rate() > 0 && std::isfinite(servo.measured_rate()));
   // No more ticks after stop().
   std::this_thread::sleep_for(std::chrono::milliseconds(5));
   assert_int_equal(counter.ticks.load(), ticks);

@@ -82,7 +82,7 @@ static void test_results_do_not_depend_on_timing(void**) {
     assert_int_equal(a.size(), b.size());
     assert_memory_equal(a.data(), b.data(), a.size() * sizeof(Vec3));
   }
-  const int64_t n = fast.world->body(fast.body).factor.factorizations();
+  const int64_t n = fast.world->factorizations(fast.body);
   print_message("24 steps, refresh every 3 solves: %lld factorizations, %lld iterations\n", (long long)n,
                 (long long)fast.iterations);
   assert_true(n >= 24 / 3);  // refreshed in the background (and once more at the constraint change)
@@ -99,7 +99,7 @@ static void test_refresh_saves_iterations(void**) {
   }
   print_message("20 steps: %lld iterations with the first step's factor, %lld refreshed every 2 solves\n",
                 (long long)frozen.iterations, (long long)refreshed.iterations);
-  assert_int_equal(frozen.world->body(frozen.body).factor.factorizations(), 1);
+  assert_int_equal(frozen.world->factorizations(frozen.body), 1);
   assert_true(refreshed.iterations < frozen.iterations);
 }
 
@@ -120,11 +120,11 @@ static void test_long_solve_refactors(void**) {
     }
     assert_true(diff <= 1e-6 * size);  // both converged to 1e-8 on the same step
   }
-  const int64_t n = soon.world->body(soon.body).factor.factorizations();
+  const int64_t n = soon.world->factorizations(soon.body);
   print_message("20 steps: %lld iterations never refactoring, %lld refactoring after 8 (%lld factorizations, "
                 "at most %d iterations in a step)\n",
                 (long long)never.iterations, (long long)soon.iterations, (long long)n, worst);
-  assert_int_equal(never.world->body(never.body).factor.factorizations(), 1);
+  assert_int_equal(never.world->factorizations(never.body), 1);
   assert_true(n > 1);
   assert_true(soon.iterations < never.iterations);
 }

@@ -1,7 +1,11 @@
 // MICA against the exact reference (MICA_SOLVER_DIRECT: CHOLMOD, the exact Delassus matrix and
-// its complementarity problem solved to round-off), stepping the same scene side by side; and
-// the physics of the forces a user feels.
-#include "test_util.hpp"
+// its complementarity problem solved to round-off), stepping the same scene side by side; the
+// solver alone against the exact one on one problem (solver_problem.hpp); and the physics of the
+// forces a user feels.
+#include "solver/exact_contact_solver.hpp"  // before cmocka (test_util.hpp)
+#include "solver/mica_solver.hpp"
+#include "solver/node_colouring.hpp"
+#include "solver/solver_problem.hpp"
 
 using namespace mica;
 
@@ -464,6 +468,40 @@ static void test_time_budget_stops_the_solve(void**) {
   }
 }
 
+// The solver alone, through the contract: the paper's sweep in node order and the colour-ordered
+// sweep on two threads reach the exact solution (different iterates, one fixed point).
+static void test_solver_matches_exact(void**) {
+  for (double mu : {0.0, 0.5}) {
+    mica_test::SolverProblem exact(mu);
+    ExactContactSolver reference(LinearMethod::Direct);
+    exact.solve(reference);
+    SolverSettings s;
+    s.tolerance = 1e-11;
+    s.max_iterations = 200000;
+    for (bool coloured : {false, true}) {
+      mica_test::SolverProblem p(mu);
+      MicaSolver solver(s);
+      ThreadPool pool(2);
+      SolveContext ctx;
+      const Colouring colours = colour_nodes(p.fem.pattern, 8);
+      std::vector<SolverBody> bodies{p.body()};
+      if (coloured) {
+        ctx.pool = &pool;
+        bodies[0].colours = &colours;
+      }
+      const SolveReport r = solver.solve(ctx, bodies, p.rows, p.lambda);
+      assert_true(r.converged);
+      mica_test::check_solution(p, 1e-8);
+      const double dv = mica_test::relative_difference(p.v, exact.v);
+      const double dl = mica_test::relative_difference(p.lambda, exact.lambda);
+      print_message("mu %.1f, %s sweep: %d iterations; against the exact solver v %.3g, lambda %.3g\n", mu,
+                    coloured ? "coloured" : "natural", r.iterations, dv, dl);
+      assert_le(dv, 1e-7);
+      assert_le(dl, 1e-7);
+    }
+  }
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_grasp_drag_matches_reference),
@@ -478,6 +516,7 @@ int main(void) {
       cmocka_unit_test(test_warm_start_saves_iterations),
       cmocka_unit_test(test_converged_steps_are_solved),
       cmocka_unit_test(test_time_budget_stops_the_solve),
+      cmocka_unit_test(test_solver_matches_exact),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -1,0 +1,127 @@
+// The velocity solve of a step, one contract for every method. Per body k (a SolverBody)
+//   A_k v_k = b_k + G_k^T lambda   on the free directions S_k,   (I - S_k) v_k = z_k,
+// and per contact (ContactRows) 0 <= lambda_n _|_ G_n v + bias_n >= 0 with the tangent pair on
+// Coulomb's disk |lambda_t| <= mu lambda_n. A solver owns whatever it keeps between steps
+// (factorizations, workspaces), keyed by SolverBody::key; the world picks one solver when it is
+// made (make_velocity_solver) and calls solve() once per solve of a step.
+//
+// Adding a solver: a class here in solver/ and a case in make_velocity_solver.
+#pragma once
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <unordered_map>
+#include <vector>
+
+#include "core/colouring.hpp"
+#include "core/thread_pool.hpp"
+#include "fem/fem_model.hpp"
+#include "solver/contact_rows.hpp"
+#include "solver/projected_system.hpp"
+
+namespace mica {
+
+enum class SolverKind { Direct, Pcg, Mica };
+// How MICA anticipates and updates velocities: the paper's block Gauss-Seidel on the diagonal
+// blocks, or the factor of the rest system warped by node rotations (solver/factored_mica.hpp).
+enum class MicaSweep { GaussSeidel, Factored };
+
+// What every solve of a world shares (the first part of WorldSettings).
+struct SolverSettings {
+  double tolerance = 1e-8;      // the stopping test's (each solver's header says on what)
+  int32_t max_iterations = 200;
+  bool warm_start = true;       // MICA: start from the last step's velocities and impulses (else zero)
+  int32_t pgs_sweeps = 1;       // MICA: PGS sweeps over the contact rows per iteration
+  bool paper_norm = false;      // MICA: stop on the paper's 2-norm of the change of (v, lambda) instead
+  double relaxation = 1.0;      // MICA: MBGS over-relaxation omega in (0, 2); 1 is the paper's Gauss-Seidel
+  // Factored sweep: refresh each co-rotational body's factor from its current system every this
+  // many steps, factored on a background thread and adopted that many steps later (0: refactor
+  // only when the step size, damping or constraint set changes).
+  int32_t refactor_interval = 0;
+  // Factored sweep: a solve that has used this many conjugate-gradient iterations refactors the
+  // current system and goes on with it (about what a factorization costs on a body of some
+  // thousand nodes; 0: never).
+  int32_t refactor_after = 100;
+};
+
+// What one solve may use of its step.
+struct SolveContext {
+  using Clock = std::chrono::steady_clock;
+  std::optional<Clock::time_point> deadline;  // iterative solves stop here (out_of_time)
+  ThreadPool* pool = nullptr;                 // null: serial
+};
+
+// What a body's A was assembled for: a change of any of these is a new system.
+struct SystemKey {
+  double h = 0, alpha = 0, beta = 0;
+  bool operator==(const SystemKey& o) const { return h == o.h && alpha == o.alpha && beta == o.beta; }
+};
+
+// One body's system as the solver sees it.
+struct SolverBody {
+  uint64_t key = 0;                          // the body's caches in the solver (unique per world)
+  const FemModel* fem = nullptr;             // the pattern of A, node masses, elements
+  const BlockValues* A = nullptr;
+  const Vec3List* b = nullptr;
+  const Projection* projection = nullptr;
+  Vec3List* v = nullptr;                     // in: the warm start; out: the velocities
+  Vec3List* contact_impulse = nullptr;       // out: G^T lambda per node, N s
+  const Colouring* colours = nullptr;        // node blocks for a parallel sweep (node_colouring.hpp), or null
+  const std::vector<Mat3>* rotation = nullptr;  // element rotations A is built with (null: linear model)
+  SystemKey system;
+  uint64_t matrix_version = 0;      // changes whenever the values of A change
+  uint64_t constraint_version = 0;  // changes whenever the body's constraint set changes
+
+  const BlockPattern& pattern() const { return fem->pattern; }
+  int32_t node_count() const { return fem->node_count(); }
+  ProjectedSystem projected() const { return {fem->pattern, *A, *projection}; }
+};
+
+class VelocitySolver {
+ public:
+  virtual ~VelocitySolver() = default;
+  // lambda: in, the warm start per row (the last step's impulses, or zero); out, the impulses
+  // (N s). Writes each body's v and contact_impulse.
+  virtual SolveReport solve(const SolveContext& ctx, std::vector<SolverBody>& bodies, const ContactRows& rows,
+                            std::vector<double>& lambda) = 0;
+  // The compliance each row of the last solve saw (its diagonal of G A^-1 G^T or of the
+  // solver's approximation of it), 0 for a row nothing can move along.
+  virtual const std::vector<double>& row_diagonal() const = 0;
+  // Drops what the solver keeps for a body (before the body goes).
+  virtual void forget(uint64_t /*key*/) {}
+  // Numeric factorizations made for a body so far (0 for a solver that does not factor).
+  virtual int64_t factorizations(uint64_t /*key*/) const { return 0; }
+};
+
+// A solver that keeps a Cache per body (factors, workspaces), by SolverBody::key, made on first
+// use and dropped by forget(); Cache::factorizations() counts the factorizations it made.
+template <class Cache>
+class CachingVelocitySolver : public VelocitySolver {
+ public:
+  void forget(uint64_t key) override { caches_.erase(key); }
+  int64_t factorizations(uint64_t key) const override {
+    const auto it = caches_.find(key);
+    return it == caches_.end() ? 0 : it->second->factorizations();
+  }
+
+ protected:
+  Cache& cache_of(const SolverBody& body) {
+    std::unique_ptr<Cache>& cache = caches_[body.key];
+    if (!cache) cache = std::make_unique<Cache>();
+    return *cache;
+  }
+
+ private:
+  std::unordered_map<uint64_t, std::unique_ptr<Cache>> caches_;
+};
+
+std::unique_ptr<VelocitySolver> make_velocity_solver(SolverKind kind, MicaSweep sweep, const SolverSettings& settings);
+
+// v_k of every body from the warm start to zero (MICA without warm start).
+void zero_velocities(std::vector<SolverBody>& bodies);
+// contact_impulse of every body = G^T lambda.
+void scatter_contact_impulses(const ContactRows& rows, const std::vector<double>& lambda,
+                              std::vector<SolverBody>& bodies);
+
+}  // namespace mica

@@ -1,0 +1,35 @@
+// What one step works with, built once at its start (World::advance) and handed to its stages:
+// the step size, the one deadline of the step's time budget, the thread pool (null: serial), the
+// plan, the dynamic bodies and the tools collision numbered. The solver sees the SolveContext part.
+#pragma once
+#include <algorithm>
+#include <vector>
+
+#include "collision/tool.hpp"
+#include "solver/velocity_solver.hpp"
+#include "world/body.hpp"
+
+namespace mica {
+
+// Which stages the scene calls for (each body also checks its own need inside a stage).
+struct Plan {
+  bool loads = false, rotations = false, elements = false, damping = false;
+  bool constraints = false, solve = false, integrate = false;
+  bool collide = false, forces = false;
+};
+
+struct StepContext : SolveContext {
+  double h = 0;                  // s
+  Clock::time_point start;       // when the step began (the budget counts from here)
+  Plan plan;
+  std::vector<Body*> dynamic;    // the bodies that move; Contact::a.body / b.body index this list
+  std::vector<Tool*> tools;      // every tool, in collision's order; Contact::tool indexes it
+
+  // The index of b among the dynamic bodies, -1 for a static body.
+  int32_t index_of(const Body* b) const {
+    const auto it = std::find(dynamic.begin(), dynamic.end(), b);
+    return it == dynamic.end() ? -1 : int32_t(it - dynamic.begin());
+  }
+};
+
+}  // namespace mica

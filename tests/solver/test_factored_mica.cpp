@@ -1,0 +1,111 @@
+// The factored MICA solver against the exact one on the same problem, through the solver
+// contract: velocities and impulses agree to the tolerance, with and without friction, from a
+// cold and a warm start, with the factor of the current system and with one warped from an
+// earlier one; a body's factor is made once per system key and dropped with the body.
+#include "solver/exact_contact_solver.hpp"  // before cmocka (test_util.hpp)
+#include "solver/factored_mica.hpp"
+#include "solver/solver_problem.hpp"
+
+using namespace mica;
+using namespace mica_test;
+
+namespace {
+
+SolverSettings tight() {
+  SolverSettings s;
+  s.tolerance = 1e-10;
+  s.max_iterations = 100000;
+  s.refactor_after = 0;
+  return s;
+}
+
+void compare(SolverProblem& mica, double mu, double tol, const char* what) {
+  SolverProblem exact(mu);
+  ExactContactSolver reference(LinearMethod::Direct);
+  exact.solve(reference);
+  const double dv = relative_difference(mica.v, exact.v), dl = relative_difference(mica.lambda, exact.lambda);
+  print_message("%s, mu %.1f: against the exact solver v %.3g, lambda %.3g\n", what, mu, dv, dl);
+  assert_le(dv, tol);
+  assert_le(dl, tol);
+}
+
+}  // namespace
+
+static void test_matches_exact(void**) {
+  for (double mu : {0.0, 0.5}) {
+    SolverProblem p(mu);
+    FactoredMicaSolver solver(tight());
+    const SolveReport r = p.solve(solver);
+    assert_true(r.converged);
+    assert_le(r.momentum_residual, 1e-10);
+    check_solution(p, 1e-8);
+    compare(p, mu, 1e-7, "cold start");
+    assert_int_equal(solver.row_diagonal().size(), p.rows.size());
+  }
+}
+
+// The second solve starts from the first one's impulses (and velocities): fewer iterations, the
+// same answer.
+static void test_warm_start(void**) {
+  SolverProblem p(0.3);
+  FactoredMicaSolver solver(tight());
+  const SolveReport cold = p.solve(solver);
+  const std::vector<double> lambda = p.lambda;
+  p.v.assign(p.v.size(), Vec3(0, 0.05, 0));
+  const SolveReport warm = p.solve(solver);
+  print_message("iterations: cold %d, warm %d\n", cold.iterations, warm.iterations);
+  assert_true(warm.iterations <= cold.iterations);
+  compare(p, 0.3, 1e-7, "warm start");
+}
+
+// The factor of an earlier system (the body sheared less), warped by the node rotations since:
+// more iterations, the same answer; the factor is not made again for the same key.
+static void test_lagged_factor_converges_to_exact(void**) {
+  SolverProblem earlier(0.0), p(0.0);
+  // The earlier system: the rest shape (R = I).
+  compute_rotations(earlier.fem, earlier.fem.rest, earlier.R);
+  set_scaled_mass(earlier.fem, 1.0, earlier.A);
+  assemble_elastic(earlier.fem, earlier.fem.rest, &earlier.R, SolverProblem::kH * SolverProblem::kH, &earlier.A,
+                   earlier.f_int);
+  FactoredMicaSolver solver(tight());
+  earlier.solve(solver);
+  assert_int_equal(solver.factorizations(1), 1);
+  const SolveReport r = p.solve(solver);  // key 1 again: the same body, a turned system
+  assert_int_equal(solver.factorizations(1), 1);
+  assert_true(r.converged);
+  compare(p, 0.0, 1e-7, "lagged factor");
+  // Refactoring once a solve has used 2 iterations: a second factorization, the same answer.
+  SolverSettings s = tight();
+  s.refactor_after = 2;
+  FactoredMicaSolver eager(s);
+  earlier.solve(eager);
+  SolverProblem q(0.0);
+  q.solve(eager);
+  assert_int_equal(eager.factorizations(1), 2);
+  compare(q, 0.0, 1e-7, "refactored");
+  eager.forget(1);
+  assert_int_equal(eager.factorizations(1), 0);
+}
+
+// A system key or constraint version that changes makes the factor again at once.
+static void test_new_key_factors_again(void**) {
+  SolverProblem p;
+  FactoredMicaSolver solver(tight());
+  std::vector<SolverBody> bodies{p.body(3)};
+  solver.solve({}, bodies, p.rows, p.lambda);
+  bodies[0].constraint_version = 1;
+  solver.solve({}, bodies, p.rows, p.lambda);
+  bodies[0].system.h = 0.02;  // a new key (A itself unchanged: the solve is still the same problem)
+  solver.solve({}, bodies, p.rows, p.lambda);
+  assert_int_equal(solver.factorizations(3), 3);
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_matches_exact),
+      cmocka_unit_test(test_warm_start),
+      cmocka_unit_test(test_lagged_factor_converges_to_exact),
+      cmocka_unit_test(test_new_key_factors_again),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}

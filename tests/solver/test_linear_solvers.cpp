@@ -1,0 +1,89 @@
+// The linear solvers of one body's projected system (S A S + I - S) y = S (b - A z), v = y + z:
+// CHOLMOD (DirectSolver) against a dense Cholesky of the same matrix, and projected PCG
+// (PcgSolver) against CHOLMOD, for solve and solve_homogeneous; PCG stops at its deadline.
+#include "solver/direct_solver.hpp"  // before cmocka (test_util.hpp)
+#include "solver/pcg.hpp"
+#include "solver/solver_problem.hpp"
+
+using namespace mica;
+using namespace mica_test;
+
+namespace {
+
+// The dense projected matrix P = S A S + I - S.
+Eigen::MatrixXd dense_projected(const SolverProblem& p) {
+  const ProjectedSystem sys{p.fem.pattern, p.A, p.projection};
+  const int32_t n = p.fem.node_count();
+  Eigen::MatrixXd P = Eigen::MatrixXd::Zero(3 * n, 3 * n);
+  for (int32_t i = 0; i < n; ++i)
+    for (int32_t k = p.fem.pattern.row_start[i]; k < p.fem.pattern.row_start[i + 1]; ++k)
+      P.block<3, 3>(3 * i, 3 * p.fem.pattern.col[k]) = sys.block(i, k);
+  return P;
+}
+
+}  // namespace
+
+static void test_direct_matches_dense(void**) {
+  SolverProblem p(0, 2, false);
+  for (int32_t i : p.projection.nodes) p.projection.z[i] = Vec3(0, 0.01, 0);  // a prescribed velocity
+  const ProjectedSystem sys{p.fem.pattern, p.A, p.projection};
+  DirectSolver direct;
+  direct.analyze(p.fem.pattern);
+  direct.factorize(sys);
+  Vec3List v(p.v.size(), Vec3::Zero()), rhs(p.v.size()), tmp(p.v.size());
+  direct.solve(sys, p.b, v);
+  sys.right_hand_side(p.b, rhs, tmp);
+  const Eigen::VectorXd y = dense_projected(p).llt().solve(flat(rhs));
+  Vec3List expected(v.size());
+  flat(expected) = y;
+  for (int32_t i : p.projection.nodes) expected[i] += p.projection.z[i];
+  const double d = relative_difference(v, expected);
+  print_message("CHOLMOD against dense Cholesky: %.3g\n", d);
+  assert_le(d, 1e-12);
+  // The homogeneous solve: the response to a force, zero on the prescribed directions.
+  Vec3List f(v.size(), Vec3(1, -2, 0.5)), response(v.size());
+  direct.solve_homogeneous(sys, f, response);
+  for (int32_t i : p.projection.nodes) assert_true(response[i].isZero(0));
+  assert_int_equal(direct.factorizations(), 1);
+}
+
+static void test_pcg_matches_direct(void**) {
+  SolverProblem p(0, 3, false);
+  const ProjectedSystem sys{p.fem.pattern, p.A, p.projection};
+  DirectSolver direct;
+  direct.analyze(p.fem.pattern);
+  direct.factorize(sys);
+  PcgSolver pcg;
+  pcg.configure(1e-13, 10000);
+  Vec3List exact(p.v.size(), Vec3::Zero()), v = p.v;
+  direct.solve(sys, p.b, exact);
+  const SolveReport r = pcg.solve(sys, p.b, v);
+  assert_true(r.converged);
+  assert_le(relative_difference(v, exact), 1e-10);
+  Vec3List f(v.size(), Vec3(0, 1, 0)), y_exact(v.size()), y(v.size());
+  direct.solve_homogeneous(sys, f, y_exact);
+  assert_true(pcg.solve_homogeneous(sys, f, y).converged);
+  print_message("PCG against CHOLMOD: %d iterations, v %.3g, response %.3g\n", r.iterations,
+                relative_difference(v, exact), relative_difference(y, y_exact));
+  assert_le(relative_difference(y, y_exact), 1e-10);
+}
+
+// A deadline already past: one iteration, then out of time (not converged).
+static void test_pcg_stops_at_its_deadline(void**) {
+  SolverProblem p(0, 3, false);
+  PcgSolver pcg;
+  pcg.configure(1e-13, 10000, PcgSolver::Clock::now());
+  const SolveReport r = pcg.solve(ProjectedSystem{p.fem.pattern, p.A, p.projection}, p.b, p.v);
+  assert_int_equal(r.iterations, 1);
+  assert_true(r.out_of_time);
+  assert_false(r.converged);
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_direct_matches_dense),
+      cmocka_unit_test(test_pcg_matches_direct),
+      cmocka_unit_test(test_pcg_stops_at_its_deadline),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}
