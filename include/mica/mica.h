@@ -442,10 +442,12 @@ MICA_API mica_status mica_tool_get_force(const mica_world* world, mica_tool_id t
 /** @name Stepping
  *  @{ */
 
-/** Advances the world by `dt` seconds (0 < dt <= 1) with one implicit step.
+/** Advances the world by `dt` seconds (1e-9 <= dt <= 1; a shorter step would take forces,
+ *  impulse / dt, out of double precision) with one implicit step.
  *  Returns MICA_WARN_NOT_CONVERGED when an iterative solver stopped at its cap (the step is
- *  kept; see mica_world_get_stats()), MICA_ERR_NUMERICAL when the result was not finite
- *  (the step is undone). The world's thread. */
+ *  kept; see mica_world_get_stats()), MICA_ERR_NUMERICAL when the result (positions,
+ *  velocities, tool forces, constraint reactions) was not finite. A step that fails is undone
+ *  whole: tool poses taken from devices and the solvers' schedules included. The world's thread. */
 MICA_API mica_status mica_step(mica_world* world, double dt);
 /** @} */
 

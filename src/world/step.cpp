@@ -3,6 +3,7 @@
 // under the projection constraints (I - S) v+ = z. Each stage runs only when the plan holds it.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "collision/contact_curvature.hpp"
 #include "world/world.hpp"
@@ -40,14 +41,46 @@ bool World::needs_loads(const Body& b) const {
 bool World::needs_damping(const Body& b) const { return settings_.plan_all_stages || b.has_damping(); }
 
 void World::step(double h) {
-  if (!(h > 0 && h <= 1)) fail(Errc::InvalidArgument, "the time step must be in (0, 1] s, got " + std::to_string(h));
-  const WorldStats saved = stats_;  // a failed step leaves even the statistics as they were
+  if (!(h >= kMinTimeStep && h <= 1)) {
+    char text[64];
+    std::snprintf(text, sizeof text, "%.17g", h);
+    fail(Errc::InvalidArgument, "the time step must be in [1e-9, 1] s, got " + std::string(text));
+  }
+  // A failed step leaves the world as it was: the statistics, what the step writes before it
+  // can fail (tool poses from devices, tool forces, constraint reactions, the relinearisation's
+  // energy debt), and each body's factor schedule.
+  const WorldStats saved = stats_;
+  const auto saved_debt = debt_;
+  saved_tools_.clear();
+  tools_.for_each([&](Id, Tool& t) {
+    saved_tools_.push_back({&t, t.position, t.orientation, t.velocity, t.angular_velocity, t.force, t.torque,
+                            t.stiffness, t.contact_count});
+  });
+  saved_reactions_.clear();
+  lpcs_.for_each([&](Id, Lpc& c) { saved_reactions_.push_back(c.reaction); });
+  bodies_.for_each([&](Id, Body& b) { b.factor.begin(); });
   try {
     advance(h);
   } catch (...) {
     stats_ = saved;
+    debt_ = saved_debt;
+    for (const SavedTool& s : saved_tools_) {
+      Tool& t = *s.tool;
+      t.position = s.position;
+      t.orientation = s.orientation;
+      t.velocity = s.velocity;
+      t.angular_velocity = s.angular_velocity;
+      t.force = s.force;
+      t.torque = s.torque;
+      t.stiffness = s.stiffness;
+      t.contact_count = s.contact_count;
+    }
+    size_t k = 0;
+    lpcs_.for_each([&](Id, Lpc& c) { c.reaction = saved_reactions_[k++]; });
+    bodies_.for_each([&](Id, Body& b) { b.factor.rollback(); });
     throw;
   }
+  bodies_.for_each([&](Id, Body& b) { b.factor.commit(); });
 }
 
 void World::advance(double h) {
@@ -107,6 +140,7 @@ void World::advance(double h) {
   });
   check_finite(dynamic);  // throws before anything observable has changed
   stage.run(Stage::Forces, plan.forces, [&] { compute_forces(dynamic, h); });
+  check_forces();
   commit(dynamic);
   publish_force_models();
   stats_.step_count += 1;
@@ -117,7 +151,9 @@ void World::follow_devices() {
   // Each device's newest pose moves its tool before the step (the servo thread wrote it).
   devices_.for_each([&](Id, DeviceLink& link) {
     ScenePose pose;
-    if (link.settings().tool && link.latest_pose(pose)) {
+    // (The servo path publishes only finite unit poses; checked again: a tool never gets NaN.)
+    if (link.settings().tool && link.latest_pose(pose) && pose.position.allFinite() &&
+        pose.orientation.coeffs().allFinite() && std::fabs(pose.orientation.norm() - 1) < 1e-6) {
       Tool& t = tool(link.settings().tool);
       t.position = pose.position;
       t.orientation = pose.orientation;
@@ -263,6 +299,7 @@ void World::collide(const std::vector<Body*>& dynamic, double h) {
 }
 
 bool World::bounds_overlap(const SurfaceView& a, const SurfaceView& b) const {
+  if (a.bvh->empty() || b.bvh->empty()) return false;  // no surface (validate_topology refuses one): no contact
   const double reach = std::max(settings_.body_margin + a.travel + b.travel, b.depth);
   return a.bvh->bounds().inflated(reach).overlaps(b.bvh->bounds());
 }
@@ -336,6 +373,13 @@ void World::solve_delassus(const std::vector<Body*>& dynamic, double h) {
     exact_bodies_[k] = ExactBody{&b.fem.pattern, &b.A, &b.b, &b.projection, &linear_solver(b), &b.v_next, {}};
   }
   rows_.build(contacts_, h, settings_.max_recovery_speed);
+  if (rows_.size() > kExactRowsWarning && !warned_exact_rows_ && settings_.log) {
+    warned_exact_rows_ = true;  // once per world
+    settings_.log(LogLevel::Warning,
+                  std::to_string(rows_.size()) + " contact rows in one step: the exact solvers (DIRECT, PCG) form a dense "
+                  "Delassus matrix with one linear solve per row, which takes seconds above some hundred rows "
+                  "(docs/solvers.md); MICA_SOLVER_MICA scales to such contact sets");
+  }
   // The sweeps (friction, or a degenerate frictionless problem) start from the last step's
   // impulses and stop at the time budget.
   exact_warm_start_.assign(rows_.size(), 0.0);
@@ -432,6 +476,19 @@ void World::check_finite(const std::vector<Body*>& dynamic) const {
       fail(Errc::Numerical, b->name + ": the step produced non-finite velocities or positions; the step was undone");
   for (double l : lambda_)
     if (!std::isfinite(l)) fail(Errc::Numerical, "a contact impulse is not finite; the step was undone");
+}
+
+void World::check_forces() const {
+  tools_.for_each([&](Id, const Tool& t) {
+    if (!(t.force.allFinite() && t.torque.allFinite() && t.stiffness.allFinite()))
+      fail(Errc::Numerical, "a tool force is not finite (the time step is too small, or the contact too stiff, "
+                            "for double precision); the step was undone");
+  });
+  lpcs_.for_each([&](Id, const Lpc& c) {
+    if (!c.reaction.allFinite())
+      fail(Errc::Numerical, "a constraint reaction is not finite (the time step is too small for double "
+                            "precision); the step was undone");
+  });
 }
 
 void World::commit(const std::vector<Body*>& dynamic) {

@@ -28,6 +28,12 @@ enum class MicaSweep { GaussSeidel, Factored };
 enum class LogLevel { Error, Warning, Info };
 
 constexpr int32_t kMaxThreads = 1024;  // WorldSettings::threads above this is refused
+// The shortest time step World::step takes (s): below it forces (impulse / h) and stiffnesses
+// (1 / h^2) leave double precision.
+constexpr double kMinTimeStep = 1e-9;
+// Above this many contact rows in one step the exact solvers (dense Delassus matrix, one linear
+// solve per row) take seconds; the world logs a warning the first time.
+constexpr size_t kExactRowsWarning = 500;
 
 struct WorldSettings {
   Vec3 gravity{0, -9.81, 0};
@@ -144,6 +150,11 @@ class World {
   DeviceLink& device(Id id) { return devices_.get(id, "device"); }
   const DeviceLink& device(Id id) const { return devices_.get(id, "device"); }
   DeviceLink* find_device(Id id) noexcept { return devices_.find(id); }  // the servo path: no throw
+  const DeviceLink* find_device(Id id) const noexcept { return devices_.find(id); }
+  // Any thread: while the guard lives, a device found above is not deleted by remove_device on the
+  // world's thread (which waits for it); creation never moves a device. Never blocks.
+  using DeviceReadGuard = SlotMap<DeviceLink, IdKind::Device>::ReadGuard;
+  DeviceReadGuard device_read_guard() const { return DeviceReadGuard(devices_); }
 
   const std::vector<Contact>& contacts() const { return contacts_; }
   const ContactRows& contact_rows() const { return rows_; }
@@ -184,6 +195,7 @@ class World {
   void advance(double h);
   void record(const SolveReport& report);
   void check_finite(const std::vector<Body*>& dynamic) const;
+  void check_forces() const;
   void commit(const std::vector<Body*>& dynamic);
 
   bool needs_loads(const Body& b) const;
@@ -214,7 +226,18 @@ class World {
   std::vector<FactoredBody> factored_bodies_;
   std::vector<ExactBody> exact_bodies_;
   WorldStats stats_;
+  struct SavedTool {  // step(): what a failed step puts back
+    Tool* tool;
+    Vec3 position;
+    Eigen::Quaterniond orientation;
+    Vec3 velocity, angular_velocity, force, torque;
+    Mat3 stiffness;
+    int32_t contact_count;
+  };
+  std::vector<SavedTool> saved_tools_;
+  Vec3List saved_reactions_;
   int64_t bodies_created_ = 0;
+  bool warned_exact_rows_ = false;
   std::unique_ptr<ThreadPool> pool_;                // threads > 1 only; the step's parallel loops
 };
 
