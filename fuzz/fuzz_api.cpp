@@ -56,7 +56,10 @@ struct Bytes {
     for (int k = 0; k < 4; ++k) v = (v << 8) | u8();
     return v;
   }
-  uint64_t u64() { return (uint64_t(u32()) << 32) | u32(); }
+  uint64_t u64() {
+    const uint64_t high = u32();
+    return (high << 32) | u32();
+  }
   bool coin() { return u8() & 1; }
   // A double: mostly plausible (a few cm, a few units), often adversarial.
   double d() {
@@ -345,7 +348,14 @@ class Program {
     compare(what, a >= 0);
   }
 
+  // MICA_FUZZ_TRACE=1: each call and its status on stderr (for reading a seed or a crasher).
+  static bool tracing() {
+    static const bool on = std::getenv("MICA_FUZZ_TRACE") != nullptr;
+    return on;
+  }
+
   void check_status(const char* what, mica_status s) {
+    if (tracing()) std::fprintf(stderr, "%-28s %3d %s\n", what, s, s < 0 ? mica_world_last_error(w_[0]) : "");
     if (!documented(s)) bug(std::string(what) + " returned " + std::to_string(s) + ", not a documented status");
     if (s == MICA_ERR_INTERNAL) bug(std::string(what) + ": MICA_ERR_INTERNAL: " + mica_world_last_error(w_[0]));
   }
@@ -599,7 +609,8 @@ class Program {
   void quaternion(double q[4]) {
     if (in_.u8() < 200) {
       q[0] = 1, q[1] = q[2] = q[3] = 0;
-      q[in_.u8() % 4] += in_.d();
+      const int k = in_.u8() % 4;  // read before the value (C++17 evaluates += right to left)
+      q[k] += in_.d();
     } else {
       for (int k = 0; k < 4; ++k) q[k] = in_.d();
     }
@@ -782,7 +793,9 @@ class Program {
     double point[3] = {in_.d(), in_.d(), in_.d()}, normal[3] = {in_.d(), in_.d(), in_.d()};
     std::vector<int32_t> out(1000);
     int32_t count = -1;
-    const mica_status s = mica_body_select_nodes_by_plane(w_[0], body, point, normal, in_.d(), in_.u8() % 3,
+    const double tolerance = in_.d();
+    const int32_t use_rest = in_.u8() % 3;
+    const mica_status s = mica_body_select_nodes_by_plane(w_[0], body, point, normal, tolerance, use_rest,
                                                           out.data(), 1000, &count);
     check_status("mica_body_select_nodes_by_plane", s);
     if (s < 0 && !*mica_world_last_error(w_[0])) bug("mica_body_select_nodes_by_plane failed with no message");

@@ -140,9 +140,9 @@ def from_file(which):
 
 
 def raw_duplicate():
-    b = u8(OPS['raw']) + body_def() + u8(4) + u8(2)
+    b = u8(OPS['raw']) + body_def() + u8(5) + u8(3)
     b += u8(0) * 36  # the corners of a 5 cm cube
-    tets = [0, 1, 2, 4, 0, 1, 2, 4] + [0] * 24
+    tets = [0, 1, 2, 4, 1, 3, 2, 4, 0, 1, 2, 4] + [0] * 20  # the first tet twice
     for t in tets:
         b += u8(0) + u8(t)
     b += u8(0) + u8(0)

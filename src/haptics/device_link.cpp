@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 #include "core/error.hpp"
@@ -40,11 +41,15 @@ bool unit_orientation(Eigen::Quaterniond& q) {
 // stiffness cap of the force model.
 DeviceInfo checked(const DeviceInfo& info, const DeviceSettings& settings) {
   const auto check = [](double value, double most, const char* what, const char* unit, const char* advice) {
-    if (!(std::isfinite(value) && value > 0 && value <= most))
-      fail(Errc::Device, std::string("the device reports a ") + what + " of " + std::to_string(value) + " " + unit +
-                             (std::isfinite(most) ? ", outside (0, " + std::to_string(most) + "] " + unit
-                                                  : std::string(": it must be finite and > 0")) +
-                             advice);
+    if (std::isfinite(value) && value > 0 && value <= most) return;
+    char text[256];
+    if (std::isfinite(most))
+      std::snprintf(text, sizeof text, "the device reports a %s of %g %s, outside (0, %g] %s%s", what, value, unit, most,
+                    unit, advice);
+    else
+      std::snprintf(text, sizeof text, "the device reports a %s of %g %s: it must be finite and > 0%s", what, value,
+                    unit, advice);
+    fail(Errc::Device, text);
   };
   if (settings.safety.max_force == 0)
     check(info.max_force, kDeviceMaxForceLimit, "max_force", "N",
