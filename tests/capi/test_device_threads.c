@@ -2,8 +2,9 @@
  * creates, steps and destroys: mica_device_get_stats (any thread) and mica_device_get_info (any
  * thread but the servo thread) on two reader threads, mica_device_poll on a servo thread, while
  * the world's thread creates and destroys devices (0.4: creating one moved the device table
- * under the readers, a heap-use-after-free under ASan in 5 runs of 5). Labelled `threads`: CI
- * runs it under ThreadSanitizer. */
+ * under the readers, a heap-use-after-free under ASan in 5 runs of 5). And the functions
+ * documented "any thread", on four threads at once. Labelled `threads`: CI runs it under
+ * ThreadSanitizer. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -105,9 +106,47 @@ static void test_readers_while_devices_come_and_go(void** state) {
   mica_world_destroy(s.world);
 }
 
+/* The functions documented "any thread", on four threads at once: version, status and stage
+ * names, the def initialisers, world creation (good and bad) and the per-thread message. */
+static void* any_thread(void* arg) {
+  long* bad = arg;
+  for (int k = 0; k < 40; ++k) {
+    if (mica_version() != MICA_VERSION_NUMBER) ++*bad;
+    if (!mica_status_string(-(k % 20))[0] || !mica_stage_name(k % 12)[0]) ++*bad;
+    mica_body_def bd;
+    mica_tool_def td;
+    mica_lpc_def ld;
+    mica_device_def dd;
+    if (mica_body_def_init(&bd, sizeof bd) != MICA_OK || mica_tool_def_init(&td, sizeof td) != MICA_OK ||
+        mica_lpc_def_init(&ld, sizeof ld) != MICA_OK || mica_device_def_init(&dd, sizeof dd) != MICA_OK)
+      ++*bad;
+    mica_world_def wd = mica_world_def_default();
+    if (k % 2) wd.tolerance = -1; /* refused: the message is this thread's */
+    mica_world* w = NULL;
+    const mica_status st = mica_world_create(&wd, &w);
+    if (k % 2) {
+      if (st != MICA_ERR_INVALID_ARGUMENT || w || !strstr(mica_world_last_error(NULL), "tolerance")) ++*bad;
+    } else {
+      if (st != MICA_OK || !w) ++*bad;
+      mica_world_destroy(w);
+    }
+  }
+  return NULL;
+}
+
+static void test_any_thread_functions(void** state) {
+  (void)state;
+  pthread_t t[4];
+  long bad[4] = {0, 0, 0, 0};
+  for (int i = 0; i < 4; ++i) assert_int_equal(pthread_create(&t[i], NULL, any_thread, &bad[i]), 0);
+  for (int i = 0; i < 4; ++i) pthread_join(t[i], NULL);
+  for (int i = 0; i < 4; ++i) assert_int_equal(bad[i], 0);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_readers_while_devices_come_and_go),
+      cmocka_unit_test(test_any_thread_functions),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
