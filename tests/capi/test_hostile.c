@@ -194,15 +194,30 @@ static void hostile_init(hostile* h) {
   h->orientation[0] = 1;
 }
 
-static mica_status add_hostile(mica_world* w, hostile* h, mica_tool_id tool, double scale, mica_device_id* out) {
+/* A device definition driving `tool` through h's callbacks (the table is copied at creation). */
+static mica_device_def hostile_def(hostile* h, mica_tool_id tool) {
   static mica_device_callbacks cb;
   cb = (mica_device_callbacks){sizeof cb, 0, h, NULL, NULL, hostile_info, hostile_read, hostile_write};
   mica_device_def dd = mica_device_def_default();
   dd.backend = MICA_DEVICE_CALLBACKS;
   dd.callbacks = &cb;
   dd.tool = tool;
+  return dd;
+}
+
+static mica_status add_hostile(mica_world* w, hostile* h, mica_tool_id tool, double scale, mica_device_id* out) {
+  mica_device_def dd = hostile_def(h, tool);
   dd.scale = scale;
   return mica_device_create(w, &dd, out);
+}
+
+/* A block, a 1 cm sphere resting on it, and a fresh hostile device state. */
+static mica_world* hostile_scene(int32_t solver, mica_tool_id* tool, hostile* h) {
+  mica_world* w = make_world(solver);
+  add_block(w);
+  *tool = add_sphere(w, 0.0);
+  hostile_init(h);
+  return w;
 }
 
 static void assert_unit_pose(mica_world* w, mica_tool_id tool) {
@@ -218,11 +233,9 @@ static void assert_unit_pose(mica_world* w, mica_tool_id tool) {
 
 static void test_device_poses_are_validated(void** state) {
   (void)state;
-  mica_world* w = make_world(MICA_SOLVER_DIRECT);
-  add_block(w);
-  const mica_tool_id tool = add_sphere(w, 0.0);
   hostile h;
-  hostile_init(&h);
+  mica_tool_id tool = 0;
+  mica_world* w = hostile_scene(MICA_SOLVER_DIRECT, &tool, &h);
   h.position[1] = 0.01 - 0.01; /* the sphere 1 cm deep */
   mica_device_id device = 0;
   assert_int_equal(add_hostile(w, &h, tool, 1.0, &device), MICA_OK);
@@ -461,11 +474,9 @@ static void test_loaders_refuse_special_and_huge_files(void** state) {
 typedef void (*mutate_fn)(hostile* h, int k);
 
 static void run_hostile(const char* name, mutate_fn mutate, int polls, int expect_failures) {
-  mica_world* w = make_world(MICA_SOLVER_MICA);
-  add_block(w);
-  const mica_tool_id tool = add_sphere(w, 0.0);
   hostile h;
-  hostile_init(&h);
+  mica_tool_id tool = 0;
+  mica_world* w = hostile_scene(MICA_SOLVER_MICA, &tool, &h);
   mica_device_id device = 0;
   assert_int_equal(add_hostile(w, &h, tool, 1.0, &device), MICA_OK);
   mica_device_info info = {sizeof info};
@@ -566,17 +577,10 @@ static void test_hostile_device_modes(void** state) {
 /* After a 50 ms stall the rate limit allows the growth of two servo periods, not of 50 ms. */
 static void test_rate_limit_after_a_stall(void** state) {
   (void)state;
-  mica_world* w = make_world(MICA_SOLVER_MICA);
-  add_block(w);
-  const mica_tool_id tool = add_sphere(w, 0.0);
   hostile h;
-  hostile_init(&h);
-  mica_device_def dd = mica_device_def_default();
-  static mica_device_callbacks cb;
-  cb = (mica_device_callbacks){sizeof cb, 0, &h, NULL, NULL, hostile_info, hostile_read, hostile_write};
-  dd.backend = MICA_DEVICE_CALLBACKS;
-  dd.callbacks = &cb;
-  dd.tool = tool;
+  mica_tool_id tool = 0;
+  mica_world* w = hostile_scene(MICA_SOLVER_MICA, &tool, &h);
+  mica_device_def dd = hostile_def(&h, tool);
   dd.force_mode = MICA_FORCE_HOLD;
   dd.filter_window = 1;
   dd.max_force_rate = 1000;  /* N/s: 1 N per ms */
@@ -611,11 +615,9 @@ static void test_rate_limit_after_a_stall(void** state) {
 /* A device claiming absurd figures is refused at creation; one with sane figures is not. */
 static void test_absurd_nominal_figures(void** state) {
   (void)state;
-  mica_world* w = make_world(MICA_SOLVER_MICA);
-  add_block(w);
-  const mica_tool_id tool = add_sphere(w, 0.0);
   hostile h;
-  hostile_init(&h);
+  mica_tool_id tool = 0;
+  mica_world* w = hostile_scene(MICA_SOLVER_MICA, &tool, &h);
   h.has_info = 1;
   h.info.struct_size = sizeof h.info;
   strcpy(h.info.name, "hostile");
