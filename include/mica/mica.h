@@ -251,7 +251,10 @@ MICA_API mica_status mica_body_create(mica_world* world, const mica_body_def* de
                                       mica_body_id* out_body);
 
 /** Creates a body from a mesh file: Gmsh .msh (2.2 or 4.1 ASCII) or a TetGen .node/.ele
- *  pair (either name). The world's thread. */
+ *  pair (either name). Only regular files of at most 256 MiB are read: a FIFO, a device (such
+ *  as /dev/zero), a directory or a larger file gives MICA_ERR_IO. A mesh with a repeated tet,
+ *  a face shared by three tets or no boundary surface gives MICA_ERR_BAD_MESH (as does
+ *  mica_body_create). The world's thread. */
 MICA_API mica_status mica_body_create_from_file(mica_world* world, const mica_body_def* def,
                                                 const char* path, mica_body_id* out_body);
 
