@@ -421,7 +421,7 @@ class Program {
     mica_world_destroy(probe);
     // The twins: deterministic (no time budget, one thread), every other choice kept if valid.
     mica_world_def t = mica_world_def_default();
-    if (s >= 0) {
+    if (s >= 0 && def.struct_size == sizeof def) {  // (a shorter def left the later fields unread)
       t = def;
       t.struct_size = sizeof t;
       t.header_version = MICA_VERSION_NUMBER;
