@@ -53,7 +53,7 @@ def body_def(density=None, static=False):
 
 
 def box(lo=(-0.05, -0.1, -0.05), cells=(1, 1, 1), per=5, size=0.1, **kw):
-    cell_index = {1: 0, 2: 1, 3: 2}
+    cell_index = {1: 0, 2: 1}
     b = u8(OPS['box']) + body_def(**kw)
     for k in range(3):
         b += d(lo[k]) + u8(0) + u8(min(19, max(0, round((size - 0.005) / 0.005))))  # hi = lo + size
