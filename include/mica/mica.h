@@ -176,9 +176,10 @@ typedef struct mica_world_def {
    *  nidus benchmark (a tool crushing a few elements) it did not pay reliably (0.83-1.29x in
    *  five runs, docs/performance.md).
    *  Default 0: factor when the time step, damping or constraint set changes, and when a solve
-   *  drags on. Costs a second core while it runs, and a second factor's memory. (With or without a refresh:
-   *  so that a failed step can be undone, a factor replaced within a step is kept until the
-   *  step ends and then reused as the next one's storage: one factor's memory more.) */
+   *  drags on. Costs a second core while it runs, and a second factor's memory. (With or
+   *  without a refresh, so that a failed step can be undone, a factor replaced within a step
+   *  is kept until the step ends and then reused as the next one's storage: one factor's
+   *  memory more.) */
   int32_t refactor_interval;
 } mica_world_def;
 
