@@ -314,11 +314,15 @@ class Program {
 
   void run() {
     make_worlds();
-    for (int op = 0; op < kMaxOps && !in_.done(); ++op) one_op();
+    for (int op = 0; op < kMaxOps && !in_.done() && step_seconds_ < kStepSeconds; ++op) one_op();
   }
 
  private:
   static constexpr int kMaxOps = 48, kMaxSteps = 10, kMaxBodies = 3, kMaxDevices = 4;
+  // A program stops once its steps have taken this long (s, both worlds): a valid scene can be
+  // slow (the exact solvers on many body contacts with friction, docs/solvers.md), and the
+  // fuzzer is after wrong answers, not long ones (libFuzzer's timeout is 10 s, under ASan).
+  static constexpr double kStepSeconds = 2.0;
 
   static bool documented(mica_status s) { return s >= MICA_ERR_OUT_OF_MEMORY && s <= MICA_WARN_DEVICE; }
 
@@ -667,7 +671,9 @@ class Program {
     if (steps_ >= kMaxSteps) return;
     ++steps_;
     const double dt = in_.u8() < 200 ? 0.001 * (1 + in_.u8() % 30) : in_.d();
+    const auto start = std::chrono::steady_clock::now();
     both("mica_step", [&](mica_world* w, int) { return mica_step(w, dt); });
+    step_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   }
 
   void create_device() {
@@ -819,6 +825,7 @@ class Program {
   Pools pools_;
   std::deque<Script> scripts_[2];  // stable addresses: the devices keep pointers
   int steps_ = 0;
+  double step_seconds_ = 0;
 };
 
 }  // namespace
