@@ -46,38 +46,11 @@ void World::step(double h) {
     std::snprintf(text, sizeof text, "%.17g", h);
     fail(Errc::InvalidArgument, "the time step must be in [1e-9, 1] s, got " + std::string(text));
   }
-  // A failed step leaves the world as it was: the statistics, what the step writes before it
-  // can fail (tool poses from devices, tool forces, constraint reactions, the relinearisation's
-  // energy debt), and each body's factor schedule.
-  const WorldStats saved = stats_;
-  const auto saved_debt = debt_;
-  saved_tools_.clear();
-  tools_.for_each([&](Id, Tool& t) {
-    saved_tools_.push_back({&t, t.position, t.orientation, t.velocity, t.angular_velocity, t.force, t.torque,
-                            t.stiffness, t.contact_count});
-  });
-  saved_reactions_.clear();
-  lpcs_.for_each([&](Id, Lpc& c) { saved_reactions_.push_back(c.reaction); });
-  bodies_.for_each([&](Id, Body& b) { b.factor.begin(); });
+  save_undo();  // a failed step leaves the world as it was (undo.cpp)
   try {
     advance(h);
   } catch (...) {
-    stats_ = saved;
-    debt_ = saved_debt;
-    for (const SavedTool& s : saved_tools_) {
-      Tool& t = *s.tool;
-      t.position = s.position;
-      t.orientation = s.orientation;
-      t.velocity = s.velocity;
-      t.angular_velocity = s.angular_velocity;
-      t.force = s.force;
-      t.torque = s.torque;
-      t.stiffness = s.stiffness;
-      t.contact_count = s.contact_count;
-    }
-    size_t k = 0;
-    lpcs_.for_each([&](Id, Lpc& c) { c.reaction = saved_reactions_[k++]; });
-    bodies_.for_each([&](Id, Body& b) { b.factor.rollback(); });
+    undo();
     throw;
   }
   bodies_.for_each([&](Id, Body& b) { b.factor.commit(); });

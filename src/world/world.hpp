@@ -196,6 +196,9 @@ class World {
   void record(const SolveReport& report);
   void check_finite(const std::vector<Body*>& dynamic) const;
   void check_forces() const;
+  // Undoing a failed step (undo.cpp): what the step may write before it fails.
+  void save_undo();
+  void undo();
   void commit(const std::vector<Body*>& dynamic);
 
   bool needs_loads(const Body& b) const;
@@ -226,7 +229,9 @@ class World {
   std::vector<FactoredBody> factored_bodies_;
   std::vector<ExactBody> exact_bodies_;
   WorldStats stats_;
-  struct SavedTool {  // step(): what a failed step puts back
+  WorldStats saved_stats_;
+  decltype(debt_) saved_debt_;
+  struct SavedTool {  // save_undo(): what a failed step puts back
     Tool* tool;
     Vec3 position;
     Eigen::Quaterniond orientation;
