@@ -318,7 +318,7 @@ class Program {
   }
 
  private:
-  static constexpr int kMaxOps = 48, kMaxSteps = 10, kMaxBodies = 3, kMaxDevices = 4;
+  static constexpr int kMaxOps = 48, kMaxSteps = 10, kMaxBodies = 2, kMaxDevices = 4;
   // A program stops once its steps have taken this long (s, both worlds): a valid scene can be
   // slow (the exact solvers on many body contacts with friction, docs/solvers.md), and the
   // fuzzer is after wrong answers, not long ones (libFuzzer's timeout is 10 s, under ASan).
