@@ -98,7 +98,7 @@ typedef struct mica_device_def {
   double offset[3];          /**< m, default 0 */
   double rotation[4];        /**< unit quaternion (w, x, y, z), default identity */
   int32_t force_mode;        /**< MICA_FORCE_*; default MICA_FORCE_LOCAL_MODEL */
-  int32_t filter_window;     /**< moving-average window in servo samples, >= 1; default 20 */
+  int32_t filter_window;     /**< moving-average window in servo samples, 1 to 10000; default 20 */
   double max_force;          /**< N, clamp on the rendered force; 0: the device's own max_force
                                   (a device reporting more than 100 N is then refused) */
   double max_force_rate;     /**< N/s, limit on the growth of the rendered force, per cycle at most

@@ -31,6 +31,8 @@ constexpr double kDeviceStiffnessLimit = 1e5;    // N/m
 // The longest servo cycle the force's rate limit counts (s): after a longer one (a stall) the
 // force grows as if 2 ms had passed.
 constexpr double kMaxRateInterval = 2e-3;
+// The longest moving-average window (servo samples) a device may ask for.
+constexpr int32_t kMaxFilterWindow = 10000;
 
 struct DeviceSettings {
   uint64_t tool = 0;  // the tool id the device drives, 0 for none

@@ -634,6 +634,11 @@ static void test_absurd_nominal_figures(void** state) {
   assert_int_equal(add_hostile(w, &h, tool, 1.0, &device), MICA_ERR_DEVICE);
   assert_true(contains(mica_world_last_error(w), "nominal_stiffness"));
   h.info.nominal_stiffness = 500;
+  /* Found by fuzz_api: a filter window of INT32_MAX samples allocated 51 GB (ASan: out of memory). */
+  mica_device_def dd = hostile_def(&h, tool);
+  dd.filter_window = INT32_MAX;
+  assert_int_equal(mica_device_create(w, &dd, &device), MICA_ERR_INVALID_ARGUMENT);
+  assert_true(contains(mica_world_last_error(w), "filter window must be 1..10000"));
   assert_int_equal(add_hostile(w, &h, tool, 1.0, &device), MICA_OK);
   mica_device_info info = {sizeof info};
   assert_int_equal(mica_device_get_info(w, device, &info), MICA_OK);
