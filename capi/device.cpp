@@ -119,7 +119,10 @@ MICA_API mica_status mica_device_get_info(const mica_world* world, mica_device_i
   return guarded(world, "mica_device_get_info", [&] {
     require(world, "world");
     require(out, "out");
-    const mica::DeviceInfo& in = world->world.device(device).info();
+    const mica::World::DeviceReadGuard guard = world->world.device_read_guard();  // other threads may create devices
+    const mica::DeviceLink* link = world->world.find_device(device);
+    if (!link) world->world.device(device);  // throws the stale-id error
+    const mica::DeviceInfo& in = link->info();
     mica_device_info r{};
     r.struct_size = sizeof r;
     std::memcpy(r.name, in.name.data(), sizeof r.name);
@@ -137,6 +140,7 @@ MICA_API mica_status mica_device_get_info(const mica_world* world, mica_device_i
 MICA_API mica_status mica_device_poll(mica_world* world, mica_device_id device, mica_device_state* out_state,
                                       double out_force[3]) {
   if (!world) return MICA_ERR_NULL_ARGUMENT;
+  const mica::World::DeviceReadGuard guard = world->world.device_read_guard();
   mica::DeviceLink* link = world->world.find_device(device);
   if (!link) return MICA_ERR_STALE_ID;
   mica::DeviceState state;
@@ -179,7 +183,8 @@ MICA_API mica_status mica_device_stop(mica_world* world, mica_device_id device) 
 MICA_API mica_status mica_device_get_stats(const mica_world* world, mica_device_id device, mica_device_stats* out) {
   if (!world || !out) return MICA_ERR_NULL_ARGUMENT;
   if (out->struct_size < sizeof(uint32_t) || out->struct_size > sizeof(mica_device_stats)) return MICA_ERR_STRUCT_SIZE;
-  const mica::DeviceLink* link = const_cast<mica_world*>(world)->world.find_device(device);
+  const mica::World::DeviceReadGuard guard = world->world.device_read_guard();
+  const mica::DeviceLink* link = world->world.find_device(device);
   if (!link) return MICA_ERR_STALE_ID;
   const mica::ServoStats& s = link->stats();
   mica_device_stats r{};

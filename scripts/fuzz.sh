@@ -1,10 +1,12 @@
 #!/usr/bin/env bash
-# Fuzzes the mesh loaders with libFuzzer (clang, ASan + UBSan) for a bounded time:
-#   bash scripts/fuzz.sh                      # each target FUZZ_SECONDS (default 60) seconds
+# Fuzzes the mesh loaders and the C API with libFuzzer (clang, ASan + UBSan) for a bounded time:
+#   bash scripts/fuzz.sh                      # each target FUZZ_SECONDS (default 60) seconds,
+#                                             # fuzz_api FUZZ_API_SECONDS (default the same)
 #   FUZZ_SECONDS=300 bash scripts/fuzz.sh     # longer
 #   FUZZ_TARGETS="fuzz_gmsh" bash scripts/fuzz.sh
 #   FUZZ_SECONDS=0 bash scripts/fuzz.sh       # no fuzzing: only run the seeds and learned corpus
-# Targets (fuzz/): fuzz_gmsh, fuzz_tetgen, fuzz_mesh_build. Seeds come from fuzz/corpus/<kind>/
+# Targets (fuzz/): fuzz_gmsh, fuzz_tetgen, fuzz_mesh_build, fuzz_api (sequences of C API calls
+# on twin worlds; fuzz/README.md). Seeds come from fuzz/corpus/<kind>/
 # (read only); what the fuzzer learns goes to <build>/corpus/<target>/ and is kept between runs.
 # A crashing input is saved as fuzz/crashes/<target>-crash-<sha1> (or -leak-, -timeout-, -oom-),
 # printed in base64, and makes the script exit 1 after the other targets have run.
@@ -13,14 +15,16 @@
 # Then turn it into a case of tests/mesh/test_fuzz_regressions.cpp and delete the file.
 #
 # Installs nothing. Needs the Debian 12 packages clang-14, libclang-rt-14-dev and
-# libeigen3-dev (llvm-14 too for symbolized stack traces).
-# Environment: FUZZ_SECONDS, FUZZ_TARGETS, FUZZ_BUILD_DIR (default build-fuzz/), FUZZ_CXX (the
+# libeigen3-dev (llvm-14 too for symbolized stack traces); fuzz_api also libsuitesparse-dev and
+# libccd-dev (the main build's).
+# Environment: FUZZ_SECONDS, FUZZ_API_SECONDS, FUZZ_TARGETS, FUZZ_BUILD_DIR (default build-fuzz/), FUZZ_CXX (the
 # clang++ to use), FUZZ_JOBS (build parallelism, default nproc), FUZZ_CRASH_DIR (default
 # fuzz/crashes/).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 seconds=${FUZZ_SECONDS:-60}
-targets=${FUZZ_TARGETS:-fuzz_gmsh fuzz_tetgen fuzz_mesh_build}
+targets=${FUZZ_TARGETS:-fuzz_gmsh fuzz_tetgen fuzz_mesh_build fuzz_api}
+api_seconds=${FUZZ_API_SECONDS:-$seconds}
 build=${FUZZ_BUILD_DIR:-$root/build-fuzz}
 crashes=${FUZZ_CRASH_DIR:-$root/fuzz/crashes}
 packages="clang-14 libclang-rt-14-dev libeigen3-dev (and llvm-14 for symbolized traces)"
@@ -56,12 +60,12 @@ cmake --build "$build" -j "${FUZZ_JOBS:-$(nproc 2>/dev/null || echo 2)}"
 export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:allocator_may_return_null=0}
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
 
-if [[ ! $seconds =~ ^[0-9]+$ ]]; then
-  echo "fuzz.sh: FUZZ_SECONDS must be a whole number of seconds, got '$seconds'" >&2
-  exit 2
-fi
-# libFuzzer takes -max_total_time=0 as "no limit": 0 means run the corpus once instead.
-if ((seconds == 0)); then budget=(-runs=0); else budget=(-max_total_time="$seconds"); fi
+for s in "$seconds" "$api_seconds"; do
+  if [[ ! $s =~ ^[0-9]+$ ]]; then
+    echo "fuzz.sh: FUZZ_SECONDS and FUZZ_API_SECONDS must be whole numbers of seconds, got '$s'" >&2
+    exit 2
+  fi
+done
 
 mkdir -p "$crashes"
 failed=()
@@ -70,15 +74,30 @@ for target in $targets; do
     fuzz_gmsh) seeds=("$root/fuzz/corpus/gmsh"); dict=gmsh ;;
     fuzz_tetgen) seeds=("$root/fuzz/corpus/tetgen"); dict=tetgen ;;
     fuzz_mesh_build) seeds=("$root/fuzz/corpus/gmsh" "$root/fuzz/corpus/tetgen"); dict=mesh_build ;;
+    fuzz_api) seeds=("$root/fuzz/corpus/api"); dict= ;;
     *) echo "fuzz.sh: unknown target '$target'" >&2; exit 2 ;;
   esac
+  if [[ ! -x "$build/$target" ]]; then
+    echo "fuzz.sh: $build/$target was not built (see $build/configure.log)" >&2
+    failed+=("$target")
+    continue
+  fi
+  s=$seconds
+  [[ $target == fuzz_api ]] && s=$api_seconds
+  # libFuzzer takes -max_total_time=0 as "no limit": 0 means run the corpus once instead.
+  if ((s == 0)); then budget=(-runs=0); else budget=(-max_total_time="$s"); fi
+  options=()
+  [[ -n $dict ]] && options+=(-dict="$root/fuzz/dict/$dict.dict")
+  # fuzz_api: a program's steps may take seconds under ASan on a loaded machine (it stops after 2 s
+  # of them): a longer timeout, so that a slow valid scene is not reported as a hang.
+  [[ $target == fuzz_api ]] && options+=(-max_len=4096 -timeout=30) || options+=(-max_len=65536 -timeout=10)
   work="$build/corpus/$target"
   mkdir -p "$work"
   before=$(find "$crashes" -maxdepth 1 -type f -name "$target-*" | sort)
-  echo "=== $target: ${seconds}s"
+  echo "=== $target: ${s}s"
   status=0
-  "$build/$target" "$work" "${seeds[@]}" -dict="$root/fuzz/dict/$dict.dict" \
-    "${budget[@]}" -max_len=65536 -rss_limit_mb=2048 -timeout=10 \
+  "$build/$target" "$work" "${seeds[@]}" "${options[@]}" \
+    "${budget[@]}" -rss_limit_mb=2048 \
     -artifact_prefix="$crashes/$target-" -print_final_stats=1 \
     >"$build/$target.log" 2>&1 || status=$?
   # The final lines: coverage, corpus size, executions (and the report of a crash).
@@ -105,4 +124,4 @@ if ((${#failed[@]})); then
   echo "fuzz.sh: FAILED: ${failed[*]}; crashers in $crashes" >&2
   exit 1
 fi
-echo "fuzz.sh: no crash in: $targets (${seconds}s each)"
+echo "fuzz.sh: no crash in: $targets (${seconds}s each, fuzz_api ${api_seconds}s)"

@@ -176,7 +176,10 @@ typedef struct mica_world_def {
    *  nidus benchmark (a tool crushing a few elements) it did not pay reliably (0.83-1.29x in
    *  five runs, docs/performance.md).
    *  Default 0: factor when the time step, damping or constraint set changes, and when a solve
-   *  drags on. Costs a second core while it runs, and a second factor's memory. */
+   *  drags on. Costs a second core while it runs, and a second factor's memory. (With or
+   *  without a refresh, so that a failed step can be undone, a factor replaced within a step
+   *  is kept until the step ends and then reused as the next one's storage: one factor's
+   *  memory more.) */
   int32_t refactor_interval;
 } mica_world_def;
 
@@ -251,7 +254,10 @@ MICA_API mica_status mica_body_create(mica_world* world, const mica_body_def* de
                                       mica_body_id* out_body);
 
 /** Creates a body from a mesh file: Gmsh .msh (2.2 or 4.1 ASCII) or a TetGen .node/.ele
- *  pair (either name). The world's thread. */
+ *  pair (either name). Only regular files of at most 256 MiB are read: a FIFO, a device (such
+ *  as /dev/zero), a directory or a larger file gives MICA_ERR_IO. A mesh with a repeated tet,
+ *  a face shared by three tets or no boundary surface gives MICA_ERR_BAD_MESH (as does
+ *  mica_body_create). The world's thread. */
 MICA_API mica_status mica_body_create_from_file(mica_world* world, const mica_body_def* def,
                                                 const char* path, mica_body_id* out_body);
 
@@ -442,10 +448,12 @@ MICA_API mica_status mica_tool_get_force(const mica_world* world, mica_tool_id t
 /** @name Stepping
  *  @{ */
 
-/** Advances the world by `dt` seconds (0 < dt <= 1) with one implicit step.
+/** Advances the world by `dt` seconds (1e-9 <= dt <= 1; a shorter step would take forces,
+ *  impulse / dt, out of double precision) with one implicit step.
  *  Returns MICA_WARN_NOT_CONVERGED when an iterative solver stopped at its cap (the step is
- *  kept; see mica_world_get_stats()), MICA_ERR_NUMERICAL when the result was not finite
- *  (the step is undone). The world's thread. */
+ *  kept; see mica_world_get_stats()), MICA_ERR_NUMERICAL when the result (positions,
+ *  velocities, tool forces, constraint reactions) was not finite. A step that fails is undone
+ *  whole: tool poses taken from devices and the solvers' schedules included. The world's thread. */
 MICA_API mica_status mica_step(mica_world* world, double dt);
 /** @} */
 

@@ -42,7 +42,8 @@ typedef struct mica_device_state {
   uint32_t struct_size;     /**< sizeof(mica_device_state) */
   int32_t buttons;          /**< bit k set: button k pressed */
   double position[3];       /**< m */
-  double orientation[4];    /**< unit quaternion (w, x, y, z) */
+  double orientation[4];    /**< unit quaternion (w, x, y, z); within 1% of unit length it is
+                                 normalised, further off the reading is refused (MICA_ERR_DEVICE) */
   double velocity[3];       /**< m/s */
   double timestamp;         /**< s, the device's clock */
 } mica_device_state;
@@ -97,9 +98,11 @@ typedef struct mica_device_def {
   double offset[3];          /**< m, default 0 */
   double rotation[4];        /**< unit quaternion (w, x, y, z), default identity */
   int32_t force_mode;        /**< MICA_FORCE_*; default MICA_FORCE_LOCAL_MODEL */
-  int32_t filter_window;     /**< moving-average window in servo samples, >= 1; default 20 */
-  double max_force;          /**< N, clamp on the rendered force; 0: the device's own max_force */
-  double max_force_rate;     /**< N/s, limit on the change of the rendered force; default 1000 */
+  int32_t filter_window;     /**< moving-average window in servo samples, 1 to 10000; default 20 */
+  double max_force;          /**< N, clamp on the rendered force; 0: the device's own max_force
+                                  (a device reporting more than 100 N is then refused) */
+  double max_force_rate;     /**< N/s, limit on the growth of the rendered force, per cycle at most
+                                  that of 2 ms however long the cycle; default 1000 */
   double stall_timeout;      /**< s: with no simulation step for this long the force ramps to zero; default 0.1 */
   double stall_ramp;         /**< s, duration of that ramp; default 0.05 */
   double coupling_stiffness; /**< N/m, MICA_FORCE_COUPLING; default 300 */
@@ -126,10 +129,13 @@ static inline mica_device_def mica_device_def_default(void) {
 }
 
 /** Creates and opens a device. A missing OpenHaptics library gives MICA_ERR_DEVICE with a
- *  message naming the path tried. The world's thread. */
+ *  message naming the path tried; so do device figures that are not finite and positive, or
+ *  absurd (docs/haptics.md). The world's thread; other threads may meanwhile read the world's
+ *  other devices with mica_device_get_stats, mica_device_get_info and mica_device_poll. */
 MICA_API mica_status mica_device_create(mica_world* world, const mica_device_def* def, mica_device_id* out_device);
 
-/** Stops, closes and destroys a device. The world's thread. */
+/** Stops, closes and destroys a device; waits for a mica_device_get_stats, _get_info or _poll
+ *  running on it on another thread to return. The world's thread. */
 MICA_API mica_status mica_device_destroy(mica_world* world, mica_device_id device);
 
 /** The device's description. Any thread but the servo thread. */
@@ -140,7 +146,8 @@ MICA_API mica_status mica_device_get_info(const mica_world* world, mica_device_i
  *  (device frame, N); either output may be NULL. The servo thread only, concurrently with
  *  mica_step() on the simulation thread: it never allocates, locks or blocks. A device
  *  failure, a non-finite reading or a jump back in time sends zero force and returns a
- *  status (MICA_ERR_DEVICE) without disturbing the simulation. */
+ *  status (MICA_ERR_DEVICE) without disturbing the simulation; so does a reading whose
+ *  orientation is not a unit quaternion, or whose pose is not finite (or beyond 1e6 m) once mapped into the scene. */
 MICA_API mica_status mica_device_poll(mica_world* world, mica_device_id device, mica_device_state* out_state,
                                       double out_force[3]);
 

@@ -275,9 +275,15 @@ DeviceResult TouchDevice::read(DeviceState& out) noexcept {
   }
   // HD's transform is column-major, like OpenGL's; its upper 3x3 is the stylus's rotation.
   const Eigen::Map<const Eigen::Matrix4d> m(transform);
-  out.orientation = Eigen::Quaterniond(Mat3(m.topLeftCorner<3, 3>())).normalized();
+  const Mat3 rotation = m.topLeftCorner<3, 3>();
+  out.orientation = Eigen::Quaterniond(rotation).normalized();
   out.buttons = buttons;
   out.timestamp = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  // A transform whose upper 3x3 is no rotation (scaled, singular, a reflection) has no
+  // orientation to give: the reading is refused rather than turned into some rotation.
+  if (result.ok() && rotation.allFinite() &&
+      !((rotation.transpose() * rotation - Mat3::Identity()).cwiseAbs().maxCoeff() <= 1e-3 && rotation.determinant() > 0))
+    return {-1, "the device's transform is not a rotation"};
   return result;
 }
 

@@ -11,6 +11,7 @@
 #include <string_view>
 
 #include "core/error.hpp"
+#include "mesh/text_scanner.hpp"
 
 namespace mica {
 
@@ -65,14 +66,8 @@ std::optional<double> finite_number(std::string_view field) {
   return value;
 }
 
-std::string read_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) fail(Errc::Io, path + ": cannot open: " + std::strerror(errno));
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) fail(Errc::Io, path + ": cannot read: " + std::strerror(errno));
-  return text.str();
-}
+// A regular file of at most 64 MiB (a FIFO or /dev/zero is refused, not waited on or read forever).
+std::string read_file(const std::string& path) { return detail::read_text_file(path, std::size_t(64) << 20); }
 
 }  // namespace
 

@@ -15,6 +15,25 @@
 
 namespace mica {
 
+// A device's orientation may be off unit length by this much (rounding in the device or its
+// driver): it is normalised. A reading further off is refused (poll fails, zero force).
+constexpr double kUnitQuaternionTolerance = 1e-2;
+// A device pose mapped into the scene further than this from the origin (m, any coordinate) is
+// refused like a non-finite one: 1e300 m is a broken reading, not a place to put a tool.
+constexpr double kMaxScenePosition = 1e6;
+
+// A device's own figures are trusted up to these (beyond, device creation is refused): its
+// max_force as the force clamp when the host sets none, its nominal stiffness as the cap on the
+// force model's stiffness.
+constexpr double kDeviceMaxForceLimit = 100;     // N
+constexpr double kDeviceStiffnessLimit = 1e5;    // N/m
+
+// The longest servo cycle the force's rate limit counts (s): after a longer one (a stall) the
+// force grows as if 2 ms had passed.
+constexpr double kMaxRateInterval = 2e-3;
+// The longest moving-average window (servo samples) a device may ask for.
+constexpr int32_t kMaxFilterWindow = 10000;
+
 struct DeviceSettings {
   uint64_t tool = 0;  // the tool id the device drives, 0 for none
   double scale = 1;   // scene = rotation * (scale * device) + offset

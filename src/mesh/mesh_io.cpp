@@ -2,7 +2,12 @@
 // and the other helpers the readers share (declared in text_scanner.hpp).
 #include "mesh/mesh_io.hpp"
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <cerrno>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <memory>
@@ -14,19 +19,39 @@
 namespace mica {
 namespace detail {
 
-std::string read_text_file(const std::string& path) {
-  struct Closer {
-    void operator()(std::FILE* f) const { std::fclose(f); }
-  };
+std::string read_text_file(const std::string& path, std::size_t max_bytes) {
+  // Opened without blocking (a FIFO would wait for a writer in open), then only a regular file
+  // is read: a FIFO, a device (/dev/zero never ends), a socket or a directory is refused, and so
+  // is a file above the cap (checked before reading, and again while reading: it may grow).
   errno = 0;
-  const std::unique_ptr<std::FILE, Closer> file(std::fopen(path.c_str(), "rb"));
-  if (!file) fail(Errc::Io, path + ": cannot open: " + std::strerror(errno));
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
+  if (fd < 0) fail(Errc::Io, path + ": cannot open: " + std::strerror(errno));
+  struct Closer {
+    int fd;
+    ~Closer() { ::close(fd); }
+  } closer{fd};
+  struct stat st {};
+  if (::fstat(fd, &st) != 0) fail(Errc::Io, path + ": cannot read: " + std::strerror(errno));
+  if (S_ISDIR(st.st_mode)) fail(Errc::Io, path + ": cannot read: it is a directory");
+  if (!S_ISREG(st.st_mode))
+    fail(Errc::Io, path + ": not a regular file (a FIFO, socket or device): libmica reads only regular files");
+  const auto too_large = [&] {
+    fail(Errc::Io, path + ": the file is larger than " + std::to_string(max_bytes) +
+                       " bytes, the most libmica reads (a mesh of some million tetrahedra)");
+  };
+  if (st.st_size < 0 || std::uint64_t(st.st_size) > max_bytes) too_large();
+  ::fcntl(fd, F_SETFL, ::fcntl(fd, F_GETFL) & ~O_NONBLOCK);
   std::string text;
+  text.reserve(std::size_t(st.st_size));
   char buffer[1 << 16];
-  std::size_t n = 0;
-  while ((n = std::fread(buffer, 1, sizeof buffer, file.get())) > 0) text.append(buffer, n);
-  // Opening a directory succeeds; reading it fails with EISDIR.
-  if (std::ferror(file.get())) fail(Errc::Io, path + ": cannot read: " + std::strerror(errno));
+  for (;;) {
+    const ssize_t n = ::read(fd, buffer, sizeof buffer);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) fail(Errc::Io, path + ": cannot read: " + std::strerror(errno));
+    if (n == 0) break;
+    if (text.size() + std::size_t(n) > max_bytes) too_large();
+    text.append(buffer, std::size_t(n));
+  }
   return text;
 }
 

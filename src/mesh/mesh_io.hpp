@@ -1,6 +1,7 @@
 // Reading tetrahedral meshes from files and writing VTK for ParaView.
 // Every parse error names the file, the line and what was expected.
 #pragma once
+#include <cstddef>
 #include <iosfwd>
 #include <string>
 #include <string_view>
@@ -8,6 +9,11 @@
 #include "mesh/tet_mesh.hpp"
 
 namespace mica {
+
+// The largest mesh file the loaders read (bytes): 256 MiB, some million tetrahedra in ASCII.
+// A larger file, and anything that is not a regular file (a FIFO, a device), is refused with
+// Errc::Io before it is read.
+constexpr std::size_t kMaxMeshFileBytes = std::size_t(256) << 20;
 
 // Dispatch on the extension: .msh (Gmsh 2.2 or 4.1 ASCII), .node or .ele (TetGen pair).
 TetMesh load_mesh(const std::string& path);

@@ -36,6 +36,49 @@ void validate_topology(const TetMesh& mesh, const std::string& source) {
   const auto unused = std::find(used.begin(), used.end(), 0);
   if (unused != used.end())
     fail(Errc::BadMesh, source + ": node " + std::to_string(unused - used.begin()) + " belongs to no tet");
+  // Faces: in a valid mesh each is shared by at most two tets, and some belong to one (the
+  // surface, which collision and contact need). A tet listed twice shares all four faces with
+  // its copy and leaves no surface at all.
+  struct Face {
+    Tri nodes;    // sorted
+    int32_t tet;  // the first tet that has it
+  };
+  std::vector<Face> faces;
+  faces.reserve(4 * mesh.tets.size());
+  for (size_t e = 0; e < mesh.tets.size(); ++e) {
+    const Tet& t = mesh.tets[e];
+    for (int skip = 0; skip < 4; ++skip) {
+      Face f{{}, int32_t(e)};
+      for (int a = 0, k = 0; a < 4; ++a)
+        if (a != skip) f.nodes[k++] = t[a];
+      std::sort(f.nodes.begin(), f.nodes.end());
+      faces.push_back(f);
+    }
+  }
+  std::sort(faces.begin(), faces.end(),
+            [](const Face& a, const Face& b) { return a.nodes != b.nodes ? a.nodes < b.nodes : a.tet < b.tet; });
+  bool boundary = false;
+  for (size_t i = 0; i < faces.size();) {
+    size_t j = i + 1;
+    while (j < faces.size() && faces[j].nodes == faces[i].nodes) ++j;
+    if (j - i == 1) boundary = true;
+    if (j - i > 1) {
+      Tet a = mesh.tets[size_t(faces[i].tet)], b = mesh.tets[size_t(faces[i + 1].tet)];
+      std::sort(a.begin(), a.end());
+      std::sort(b.begin(), b.end());
+      if (a == b)
+        fail(Errc::BadMesh, source + ": tet " + std::to_string(faces[i + 1].tet) + " has the same four nodes as tet " +
+                                std::to_string(faces[i].tet) + " (a duplicate element)");
+    }
+    if (j - i > 2)
+      fail(Errc::BadMesh, source + ": the face of nodes " + std::to_string(faces[i].nodes[0]) + ", " +
+                              std::to_string(faces[i].nodes[1]) + ", " + std::to_string(faces[i].nodes[2]) +
+                              " belongs to " + std::to_string(j - i) + " tets (at most two may share a face), tets " +
+                              std::to_string(faces[i].tet) + ", " + std::to_string(faces[i + 1].tet) + ", " +
+                              std::to_string(faces[i + 2].tet));
+    i = j;
+  }
+  if (!boundary) fail(Errc::BadMesh, source + ": the mesh has no boundary surface (every face is shared by two tets)");
 }
 
 QualityReport check_rest_quality(const TetMesh& mesh, const std::string& source, double sliver_aspect) {

@@ -17,8 +17,10 @@ struct TetMesh {
 // Signed volume of a tetrahedron, positive for the convention above.
 double signed_volume(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d);
 
-// Checks indices are in range and distinct and coordinates are finite; throws Error naming
-// the first offending element or node. `source` prefixes messages (file name or "body").
+// Checks indices are in range and distinct, coordinates are finite, every node is used, no tet
+// repeats another's four nodes, no face is shared by more than two tets, and the mesh has a
+// boundary surface; throws Error naming the first offending element or node. `source` prefixes
+// messages (file name or "body").
 void validate_topology(const TetMesh& mesh, const std::string& source);
 
 struct QualityReport {

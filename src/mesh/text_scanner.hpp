@@ -9,14 +9,17 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "mesh/mesh_io.hpp"
 #include "mesh/tet_mesh.hpp"
 
 namespace mica::detail {
 
 // ---- Shared by the readers, defined in mesh_io.cpp.
 
-// The whole file as text; Errc::Io naming the path and the system's reason on failure.
-std::string read_text_file(const std::string& path);
+// The whole file as text; Errc::Io naming the path and the system's reason on failure, for a
+// path that is not a regular file (a FIFO, a device such as /dev/zero, a directory), and for a
+// file above max_bytes.
+std::string read_text_file(const std::string& path, std::size_t max_bytes = kMaxMeshFileBytes);
 
 // True if `path` ends with `extension` (such as ".msh"), ignoring ASCII case.
 bool has_extension(std::string_view path, std::string_view extension);

@@ -106,6 +106,11 @@ SolveReport ExactContactSolver::solve(const SolveContext& ctx, std::vector<Solve
     friction = friction || normal_of[i] >= 0;
     warm[i] = warm_[size_t(kept[i])];
   }
+  // A contact problem out of double precision (a time step of 1e-300 s makes gap / h infinite)
+  // is the step's numerical failure, not a bad argument of the solvers below.
+  if (!Wk.allFinite() || !qk.allFinite())
+    fail(Errc::Numerical, "the contact problem of this step is not finite (the time step is too small, or the "
+                          "velocities too large, for double precision); the step was undone");
   // Without friction the LCP is solved exactly by Lemke's pivoting; with friction (not an LCP:
   // the cone's radius moves with the normal impulse) by block Gauss-Seidel over the contacts,
   // each contact's Coulomb problem solved exactly, to round-off. The sweeps also take over where

@@ -37,6 +37,16 @@ class FactoredMicaSolver : public CachingVelocitySolver<FactoredBodyCache> {
                     std::vector<double>& lambda) override;
   // W_rr of the last solve, per row (0 for a row nothing can move along).
   const std::vector<double>& row_diagonal() const override { return diag_; }
+  // The factors' refresh schedules and caches (LaggedFactor::begin, commit, rollback).
+  void begin_step() override {
+    for_each_cache([](FactoredBodyCache& c) { c.factor.begin(); });
+  }
+  void commit_step() override {
+    for_each_cache([](FactoredBodyCache& c) { c.factor.commit(); });
+  }
+  void rollback_step() override {
+    for_each_cache([](FactoredBodyCache& c) { c.factor.rollback(); });
+  }
 
  private:
   // What the loop needs beyond SolverBody, per body of a solve.

@@ -20,11 +20,28 @@ void LaggedFactor::factor(Slot& slot, const BlockPattern& pattern, const BlockVa
   ++factorizations_;
 }
 
+LaggedFactor::Slot& LaggedFactor::writable_active() {
+  const bool saved = active_.get() == saved_.active || (active_.get() == saved_.pending && saved_.job.valid());
+  if (!open_ || !saved) return *active_;
+  std::unique_ptr<Slot>& keep = kept_[0] ? kept_[1] : kept_[0];
+  keep = std::move(active_);
+  active_ = spare_ ? std::move(spare_) : std::make_unique<Slot>();
+  return *active_;
+}
+
+void LaggedFactor::clear_columns() {
+  if (open_ && !columns_cleared_) {
+    columns_kept_.swap(columns_);
+    columns_cleared_ = true;
+  }
+  columns_.clear();
+}
+
 void LaggedFactor::refactor_now(const BlockPattern& pattern, const BlockValues& A, const Projection& projection,
                                 const std::vector<Mat3>* node_rotation) {
-  columns_.clear();
+  clear_columns();
   try {
-    factor(*active_, pattern, A, projection, node_rotation);
+    factor(writable_active(), pattern, A, projection, node_rotation);
   } catch (...) {
     key_ = Key{};  // the factor in use is gone: the next update factors again
     throw;
@@ -35,11 +52,21 @@ void LaggedFactor::adopt() {
   try {
     job_.get();
   } catch (...) {
+    job_ = {};
     return;  // the copied system did not factor (not positive definite): keep the one in use
   }
+  job_ = {};
   if (pending_->born < active_->born) return;  // refactored since it was launched
   std::swap(active_, pending_);
-  columns_.clear();
+  clear_columns();
+}
+
+void LaggedFactor::launch(const BlockPattern& pattern) {
+  Slot& slot = *pending_;
+  const BlockPattern* p = &pattern;  // fixed for the body's life, which outlives the job
+  job_ = std::async(std::launch::async, [&slot, p] {
+           slot.direct.factorize(ProjectedSystem{*p, slot.A, slot.projection});
+         }).share();
 }
 
 void LaggedFactor::update(const FemModel& fem, const Key& key, const BlockValues& A, const Projection& projection,
@@ -52,29 +79,104 @@ void LaggedFactor::update(const FemModel& fem, const Key& key, const BlockValues
       job_.wait();
       job_ = {};
     }
-    factor(*active_, fem.pattern, A, projection, node_rotation);  // throws on failure: the key stays, the next step retries
+    launch_staged_ = false;
+    // throws on failure: the key stays, the next step retries
+    factor(writable_active(), fem.pattern, A, projection, node_rotation);
     key_ = key;
     launched_at_ = step_;  // the next refresh starts from a later step
-    columns_.clear();
+    clear_columns();
     return;
   }
   if (interval <= 0) return;
   if (job_.valid() && step_ - launched_at_ >= interval) adopt();
-  if (!job_.valid() && step_ > launched_at_) {
+  if (!job_.valid() && !launch_staged_ && step_ > launched_at_) {
+    // The copies the worker factors: *pending_ is free (or the factor adopted just now, whose
+    // copies are no longer needed; its factor and rotations are kept until the job starts).
     Slot& slot = *pending_;
     if (!slot.direct.analyzed()) slot.direct.analyze(fem.pattern);
     slot.A = A;
     slot.projection = projection;
-    if (node_rotation) slot.rotation = *node_rotation;
-    else slot.rotation.clear();
-    slot.born = step_;
-    const BlockPattern* pattern = &fem.pattern;  // fixed for the body's life, which outlives the job
-    job_ = std::async(std::launch::async, [&slot, pattern] {
-      slot.direct.factorize(ProjectedSystem{*pattern, slot.A, slot.projection});
-    });
+    if (open_) {
+      if (node_rotation) staged_rotation_ = *node_rotation;
+      else staged_rotation_.clear();
+      staged_born_ = step_;
+      staged_pattern_ = &fem.pattern;
+      launch_staged_ = true;
+    } else {
+      if (node_rotation) slot.rotation = *node_rotation;
+      else slot.rotation.clear();
+      slot.born = step_;
+      launch(fem.pattern);
+    }
     ++factorizations_;
     launched_at_ = step_;
   }
+}
+
+void LaggedFactor::begin() {
+  saved_.key = key_;
+  saved_.step = step_;
+  saved_.launched_at = launched_at_;
+  saved_.factorizations = factorizations_;
+  saved_.active = active_.get();
+  saved_.pending = pending_.get();
+  saved_.job = job_;
+  columns_cleared_ = false;
+  columns_added_.clear();
+  open_ = true;
+}
+
+void LaggedFactor::commit() {
+  if (!open_) return;
+  open_ = false;
+  for (std::unique_ptr<Slot>& k : kept_) {
+    if (k && !spare_) spare_ = std::move(k);
+    k.reset();
+  }
+  columns_kept_.clear();
+  columns_added_.clear();
+  saved_.job = {};
+  saved_.active = saved_.pending = nullptr;
+  if (launch_staged_) {
+    launch_staged_ = false;
+    pending_->rotation.swap(staged_rotation_);
+    pending_->born = staged_born_;
+    launch(*staged_pattern_);
+  }
+}
+
+void LaggedFactor::rollback() {
+  if (!open_) return;
+  open_ = false;
+  launch_staged_ = false;  // no job was launched since begin(): the only one is the saved one
+  std::unique_ptr<Slot>* all[] = {&active_, &pending_, &kept_[0], &kept_[1], &spare_};
+  std::unique_ptr<Slot> active, pending, spare;
+  for (std::unique_ptr<Slot>* s : all) {
+    if (!*s) continue;
+    if (s->get() == saved_.active) active = std::move(*s);
+    else if (s->get() == saved_.pending) pending = std::move(*s);
+    else if (!spare) spare = std::move(*s);
+    else s->reset();
+  }
+  for (std::unique_ptr<Slot>* s : all) s->reset();
+  active_ = std::move(active);
+  pending_ = std::move(pending);
+  spare_ = std::move(spare);
+  job_ = saved_.job;
+  saved_.job = {};
+  saved_.active = saved_.pending = nullptr;
+  key_ = saved_.key;
+  step_ = saved_.step;
+  launched_at_ = saved_.launched_at;
+  factorizations_ = saved_.factorizations;
+  if (columns_cleared_) {
+    columns_.swap(columns_kept_);
+  } else {
+    for (int32_t node : columns_added_) columns_.erase(node);
+  }
+  columns_kept_.clear();
+  columns_added_.clear();
+  columns_cleared_ = false;
 }
 
 void LaggedFactor::solve(const Vec3List& in, Vec3List& out) const {
@@ -89,6 +191,7 @@ void LaggedFactor::prepare_columns(const std::vector<int32_t>& nodes) {
     if (!columns_.count(node) && std::find(missing_.begin(), missing_.end(), node) == missing_.end())
       missing_.push_back(node);
   if (missing_.empty()) return;
+  if (open_) columns_added_.insert(columns_added_.end(), missing_.begin(), missing_.end());
   const Eigen::Index k = Eigen::Index(missing_.size());
   units_.setZero(3 * node_count_, 3 * k);
   for (Eigen::Index q = 0; q < k; ++q) units_.block<3, 3>(3 * missing_[q], 3 * q).setIdentity();

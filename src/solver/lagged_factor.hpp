@@ -62,6 +62,16 @@ class LaggedFactor {
   int64_t factorizations() const { return factorizations_; }
   int32_t node_count() const { return node_count_; }
 
+  // A step that may fail: begin() before its first update(), then commit() if the step is kept or
+  // rollback() if it is undone, which puts back the factor in use, the one in flight, the refresh
+  // schedule and the cached columns as they were at begin() (a failed step leaves no trace in
+  // later steps). Meanwhile a factor replaced at once (new key, refactor_now) is kept aside, and a
+  // background refresh is launched only at commit(); one slot so used stays as a spare (a third
+  // factor's memory at most). Without begin() every call takes effect at once.
+  void begin();
+  void commit();
+  void rollback();
+
  private:
   struct Slot {
     DirectSolver direct;
@@ -73,10 +83,30 @@ class LaggedFactor {
   void factor(Slot& slot, const BlockPattern& pattern, const BlockValues& A, const Projection& projection,
               const std::vector<Mat3>* node_rotation);
   void adopt();
+  void launch(const BlockPattern& pattern);  // the background factorization of *pending_
+  Slot& writable_active();  // active_, or in a step between begin() and its end a slot in its place
+  void clear_columns();
 
   Key key_;
   std::unique_ptr<Slot> active_, pending_;
-  std::future<void> job_;     // the background factorization of *pending_
+  std::shared_future<void> job_;  // the background factorization of *pending_
+  // begin() .. commit() / rollback().
+  struct Saved {
+    Key key;
+    int64_t step = 0, launched_at = -1, factorizations = 0;
+    const Slot* active = nullptr;
+    const Slot* pending = nullptr;
+    std::shared_future<void> job;
+  } saved_;
+  bool open_ = false;
+  std::unique_ptr<Slot> kept_[2], spare_;  // slots of begin() replaced in the step; a free one
+  bool launch_staged_ = false;             // a refresh to launch at commit()
+  const BlockPattern* staged_pattern_ = nullptr;
+  std::vector<Mat3> staged_rotation_;
+  int64_t staged_born_ = -1;
+  bool columns_cleared_ = false;
+  std::unordered_map<int32_t, Eigen::MatrixXd> columns_kept_;
+  std::vector<int32_t> columns_added_;
   int64_t step_ = 0, launched_at_ = -1;
   int64_t factorizations_ = 0;
   int32_t node_count_ = 0;

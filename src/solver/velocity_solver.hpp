@@ -92,6 +92,12 @@ class VelocitySolver {
   virtual void forget(uint64_t /*key*/) {}
   // Numeric factorizations made for a body so far (0 for a solver that does not factor).
   virtual int64_t factorizations(uint64_t /*key*/) const { return 0; }
+  // A step that may fail (World::step): begin_step() before it, then commit_step() when it is
+  // kept or rollback_step() when it is undone, which puts back what the solver keeps across steps
+  // as it was at begin_step() (a failed step leaves no trace in later ones).
+  virtual void begin_step() {}
+  virtual void commit_step() {}
+  virtual void rollback_step() {}
 };
 
 // A solver that keeps a Cache per body (factors, workspaces), by SolverBody::key, made on first
@@ -110,6 +116,10 @@ class CachingVelocitySolver : public VelocitySolver {
     std::unique_ptr<Cache>& cache = caches_[body.key];
     if (!cache) cache = std::make_unique<Cache>();
     return *cache;
+  }
+  template <class F>
+  void for_each_cache(F&& f) {
+    for (auto& [key, cache] : caches_) f(*cache);
   }
 
  private:

@@ -3,6 +3,7 @@
 // under the projection constraints (I - S) v+ = z. Each stage runs only when the plan holds it.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "collision/contact_curvature.hpp"
 #include "core/assert.hpp"
@@ -41,14 +42,19 @@ bool World::needs_loads(const Body& b) const {
 bool World::needs_damping(const Body& b) const { return settings_.plan_all_stages || b.has_damping(); }
 
 void World::step(double h) {
-  if (!(h > 0 && h <= 1)) fail(Errc::InvalidArgument, "the time step must be in (0, 1] s, got " + std::to_string(h));
-  const WorldStats saved = stats_;  // a failed step leaves even the statistics as they were
+  if (!(h >= kMinTimeStep && h <= 1)) {
+    char text[64];
+    std::snprintf(text, sizeof text, "%.17g", h);
+    fail(Errc::InvalidArgument, "the time step must be in [1e-9, 1] s, got " + std::string(text));
+  }
+  save_undo();  // a failed step leaves the world as it was (undo.cpp)
   try {
     advance(h);
   } catch (...) {
-    stats_ = saved;
+    undo();
     throw;
   }
+  solver_->commit_step();
 }
 
 StepContext World::begin_step(double h) {
@@ -106,6 +112,7 @@ void World::advance(double h) {
   });
   check_finite(ctx);  // throws before anything observable has changed
   stage.run(Stage::Forces, plan.forces, [&] { compute_forces(ctx); });
+  check_forces();
   commit(ctx);
   publish_force_models();
   stats_.step_count += 1;
@@ -117,7 +124,9 @@ void World::follow_devices() {
   // Each device's newest pose moves its tool before the step (the servo thread wrote it).
   devices_.for_each([&](Id, DeviceLink& link) {
     ScenePose pose;
-    if (link.settings().tool && link.latest_pose(pose)) {
+    // (The servo path publishes only finite unit poses; checked again: a tool never gets NaN.)
+    if (link.settings().tool && link.latest_pose(pose) && pose.position.allFinite() &&
+        pose.orientation.coeffs().allFinite() && std::fabs(pose.orientation.norm() - 1) < 1e-6) {
       Tool& t = tool(link.settings().tool);
       t.position = pose.position;
       t.orientation = pose.orientation;
@@ -259,6 +268,7 @@ void World::collide(StepContext& ctx) {
 }
 
 bool World::bounds_overlap(const SurfaceView& a, const SurfaceView& b) const {
+  if (a.bvh->empty() || b.bvh->empty()) return false;  // no surface (validate_topology refuses one): no contact
   const double reach = std::max(settings_.body_margin + a.travel + b.travel, b.depth);
   return a.bvh->bounds().inflated(reach).overlaps(b.bvh->bounds());
 }
@@ -289,6 +299,13 @@ void World::solve(const StepContext& ctx) {
   for (size_t r = 0; settings_.warm_start && r < rows_.size(); ++r) {
     const auto it = warm_start_.find(rows_.key[r]);
     if (it != warm_start_.end()) lambda_[r] = it->second;
+  }
+  if (rows_.size() > kExactRowsWarning && settings_.solver != SolverKind::Mica && !warned_exact_rows_ && settings_.log) {
+    warned_exact_rows_ = true;  // once per world
+    settings_.log(LogLevel::Warning,
+                  std::to_string(rows_.size()) + " contact rows in one step: the exact solvers (DIRECT, PCG) form a dense "
+                  "Delassus matrix with one linear solve per row, which takes seconds above some hundred rows "
+                  "(docs/solvers.md); MICA_SOLVER_MICA scales to such contact sets");
   }
   record(solver_->solve(ctx, solver_bodies_, rows_, lambda_));
 }
@@ -348,6 +365,19 @@ void World::check_finite(const StepContext& ctx) const {
       fail(Errc::Numerical, b->name + ": the step produced non-finite velocities or positions; the step was undone");
   for (double l : lambda_)
     if (!std::isfinite(l)) fail(Errc::Numerical, "a contact impulse is not finite; the step was undone");
+}
+
+void World::check_forces() const {
+  tools_.for_each([&](Id, const Tool& t) {
+    if (!(t.force.allFinite() && t.torque.allFinite() && t.stiffness.allFinite()))
+      fail(Errc::Numerical, "a tool force is not finite (the time step is too small, or the contact too stiff, "
+                            "for double precision); the step was undone");
+  });
+  lpcs_.for_each([&](Id, const Lpc& c) {
+    if (!c.reaction.allFinite())
+      fail(Errc::Numerical, "a constraint reaction is not finite (the time step is too small for double "
+                            "precision); the step was undone");
+  });
 }
 
 void World::commit(const StepContext& ctx) {

@@ -156,7 +156,10 @@ Id World::add_device(std::unique_ptr<Device> device, const DeviceSettings& setti
   require_finite(settings.offset, "the workspace offset");
   if (!settings.rotation.coeffs().allFinite() || !(settings.rotation.norm() > 1e-12))
     fail(Errc::InvalidArgument, "the workspace rotation must be a finite non-zero quaternion");
-  if (settings.filter_window < 1) fail(Errc::InvalidArgument, "the filter window must be >= 1 sample");
+  // (The window's samples are allocated: INT32_MAX of them asked for 51 GB.)
+  if (settings.filter_window < 1 || settings.filter_window > kMaxFilterWindow)
+    fail(Errc::InvalidArgument, "the filter window must be 1.." + std::to_string(kMaxFilterWindow) +
+                                    " samples (10 s at 1 kHz), got " + std::to_string(settings.filter_window));
   const SafetySettings& s = settings.safety;
   if (!(s.max_force >= 0) || !(s.max_rate > 0) || !(s.stall_timeout > 0) || !(s.stall_ramp > 0) ||
       !std::isfinite(s.max_force + s.max_rate + s.stall_timeout + s.stall_ramp))

@@ -23,6 +23,12 @@ namespace mica {
 enum class LogLevel { Error, Warning, Info };
 
 constexpr int32_t kMaxThreads = 1024;  // WorldSettings::threads above this is refused
+// The shortest time step World::step takes (s): below it forces (impulse / h) and stiffnesses
+// (1 / h^2) leave double precision.
+constexpr double kMinTimeStep = 1e-9;
+// Above this many contact rows in one step the exact solvers (dense Delassus matrix, one linear
+// solve per row) take seconds; the world logs a warning the first time.
+constexpr size_t kExactRowsWarning = 500;
 
 // The solver's settings (tolerance, max_iterations, warm_start, pgs_sweeps, paper_norm,
 // relaxation, refactor_interval, refactor_after: solver/velocity_solver.hpp) and the world's.
@@ -125,6 +131,11 @@ class World {
   DeviceLink& device(Id id) { return devices_.get(id, "device"); }
   const DeviceLink& device(Id id) const { return devices_.get(id, "device"); }
   DeviceLink* find_device(Id id) noexcept { return devices_.find(id); }  // the servo path: no throw
+  const DeviceLink* find_device(Id id) const noexcept { return devices_.find(id); }
+  // Any thread: while the guard lives, a device found above is not deleted by remove_device on the
+  // world's thread (which waits for it); creation never moves a device. Never blocks.
+  using DeviceReadGuard = SlotMap<DeviceLink, IdKind::Device>::ReadGuard;
+  DeviceReadGuard device_read_guard() const { return DeviceReadGuard(devices_); }
 
   // The last step's contacts, their rows of G and the impulses on them.
   const std::vector<Contact>& contacts() const { return contacts_; }
@@ -162,8 +173,12 @@ class World {
   void record(const SolveReport& report);
   void check_finite(const StepContext& ctx) const;
   void compute_forces(const StepContext& ctx);
+  void check_forces() const;
   void commit(const StepContext& ctx);
   void publish_force_models();
+  // Undoing a failed step (undo.cpp): what the step may write before it fails.
+  void save_undo();
+  void undo();
 
   bool needs_loads(const Body& b) const;
   bool needs_damping(const Body& b) const;
@@ -183,7 +198,20 @@ class World {
     int64_t pending_step = -1;  // the step whose completion commits `pending`
   } debt_;
   WorldStats stats_;
+  WorldStats saved_stats_;
+  decltype(debt_) saved_debt_;
+  struct SavedTool {  // save_undo(): what a failed step puts back
+    Tool* tool;
+    Vec3 position;
+    Eigen::Quaterniond orientation;
+    Vec3 velocity, angular_velocity, force, torque;
+    Mat3 stiffness;
+    int32_t contact_count;
+  };
+  std::vector<SavedTool> saved_tools_;
+  Vec3List saved_reactions_;
   int64_t bodies_created_ = 0;
+  bool warned_exact_rows_ = false;
   std::unique_ptr<ThreadPool> pool_;                // threads > 1 only; the step's parallel loops
   // Chosen once from the settings; keeps per-body factors (some factored in the background on
   // the bodies' patterns), so it goes before the bodies do.

@@ -837,12 +837,15 @@ static void test_nonfinite_node_forces(void** state) {
 
 static void test_bad_dt(void** state) {
   fixture* fx = *state;
-  const double bad[] = {0.0, -0.0, -0.01, -1.0, 1.0000001, 2.0, 1e300, NAN, INFINITY, -INFINITY, -NAN};
+  /* Below the floor of 1e-9 s too (0.4 took 1e-200 and reported infinite forces). */
+  const double bad[] = {0.0, -0.0, -0.01, -1.0, 1.0000001, 2.0, 1e300, NAN, INFINITY, -INFINITY, -NAN,
+                        5e-324, 1e-300, 1e-160, 1e-10, 9.999e-10};
   for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i)
-    EXPECT_FAIL(fx, MICA_ERR_INVALID_ARGUMENT, mica_step(fx->world, bad[i]), NULL);
-  /* The edges of (0, 1] are accepted. */
+    EXPECT_FAIL(fx, MICA_ERR_INVALID_ARGUMENT, mica_step(fx->world, bad[i]), "[1e-9, 1] s");
+  /* The edges of [1e-9, 1] are accepted. */
   EXPECT_STATUS(MICA_OK, mica_step(fx->world, 1.0));
   EXPECT_STATUS(MICA_OK, mica_step(fx->world, 1e-6));
+  EXPECT_STATUS(MICA_OK, mica_step(fx->world, 1e-9));
 }
 
 static void test_bad_selection_inputs(void** state) {

@@ -8,6 +8,7 @@
 #ifdef MICA_FAKE_HD_LIBRARY
 #include "devices/fake_hd/fake_hd.h"
 #include "haptics/alloc_counter.hpp"
+#include "haptics/device_link.hpp"
 #endif
 
 #include "test_util.hpp"
@@ -333,6 +334,61 @@ static void test_missing_library_names_the_path(void**) {
   assert_contains(message, "hdInitDevice");
 }
 
+// A hostile libHD (issue 16): NaN and huge poses, transforms that are no rotation, 50 ms stalls,
+// absurd nominal figures. Through the servo cycle (DeviceLink::poll) every cycle ends with a
+// status, a finite force within the clamp reaches HD, and the bad readings are refused; absurd
+// figures are refused when the device is attached.
+static void test_hostile_hd(void**) {
+  const std::string figures = expect_error(Errc::Device, [] {
+    fake_hd_set_hostile(FAKE_HD_HOSTILE_FIGURES);
+    DeviceLink link(std::make_unique<TouchDevice>(), DeviceSettings{});
+  });
+  assert_contains(figures, "max_force");
+  const int modes[] = {FAKE_HD_HOSTILE_NAN_POSE, FAKE_HD_HOSTILE_HUGE_POSE, FAKE_HD_HOSTILE_BAD_ROTATION,
+                       FAKE_HD_HOSTILE_STALL};
+  const char* names[] = {"NaN poses", "huge poses", "bad rotations", "50 ms stalls"};
+  for (int m = 0; m < 4; ++m) {
+    fake_hd_reset();
+    fake_hd_set_hostile(modes[m]);
+    DeviceSettings settings;
+    settings.mode = ForceMode::Hold;
+    settings.filter_window = 1;
+    DeviceLink link(std::make_unique<TouchDevice>(), settings);
+    const double clamp = link.info().max_force;
+    ForceModel model;
+    model.f0 = Vec3(0, 50, 0);  // far above the clamp
+    model.step = 1;
+    link.publish(model);
+    const long first_force = fake_hd_force_count();
+    int failures = 0;
+    for (int k = 0; k < 60; ++k) {
+      DeviceState state;
+      Vec3 force;
+      const DeviceResult r = link.poll(&state, &force);
+      assert_true(r.code >= -1 && r.code <= 1);
+      assert_true(r.message != nullptr);
+      failures += r.code < 0;
+      assert_true(force.allFinite());
+      assert_true(force.norm() <= clamp * (1 + 1e-12));
+      if (r.ok()) {
+        assert_true(state.position.allFinite());
+        assert_near(state.orientation.norm(), 1, 1e-12);
+      }
+      if (k % 10 == 9) link.publish(model);
+    }
+    for (long i = first_force; i < fake_hd_force_count(); ++i) {
+      double f[3];
+      assert_true(fake_hd_force(i, f));
+      assert_true(std::sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]) <= clamp * (1 + 1e-12));
+    }
+    print_message("%-14s 60 cycles, %d refused, clamp %.2f N\n", names[m], failures, clamp);
+    if (modes[m] == FAKE_HD_HOSTILE_STALL) assert_int_equal(failures, 0);
+    else assert_true(failures >= 15);
+    assert_int_equal(fake_hd_nonfinite_forces(), 0);
+  }
+  assert_protocol_kept();
+}
+
 int main(void) {
   // The backend finds the fake as it would find OpenHaptics.
   setenv("MICA_HD_LIBRARY", MICA_FAKE_HD_LIBRARY, 1);
@@ -348,6 +404,7 @@ int main(void) {
       cmocka_unit_test_setup(test_init_failure_gives_the_hd_code, reset),
       cmocka_unit_test_setup(test_calibration, reset),
       cmocka_unit_test_setup(test_missing_library_names_the_path, reset),
+      cmocka_unit_test_setup(test_hostile_hd, reset),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

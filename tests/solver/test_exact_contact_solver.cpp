@@ -2,6 +2,9 @@
 // meets the conditions of the problem to round-off, with and without friction; without contact
 // it is the plain projected solve; a body's factor is kept while its A and constraints stay, and
 // dropped with the body. With PCG for the linear solves it agrees with CHOLMOD to the tolerance.
+// A problem out of double precision is the step's numerical failure (issue 16: dt = 5e-324 with
+// DIRECT made gap / h infinite, and Lemke's own argument check surfaced as
+// MICA_ERR_INVALID_ARGUMENT "solve_lcp_lemke: M or q has a non-finite entry").
 #include "solver/exact_contact_solver.hpp"  // before cmocka (test_util.hpp)
 #include "solver/solver_problem.hpp"
 
@@ -88,6 +91,27 @@ static void test_pcg_agrees_with_cholmod(void**) {
   }
 }
 
+static void test_non_finite_problem_is_a_numerical_failure(void**) {
+  auto failure = [](SolverProblem& p) {
+    ExactContactSolver solver(LinearMethod::Direct);
+    try {
+      p.solve(solver);
+    } catch (const Error& e) {
+      assert_true(e.code() == Errc::Numerical);
+      assert_true(std::string(e.what()).find("not finite") != std::string::npos);
+      assert_true(std::string(e.what()).find("lemke") == std::string::npos);
+      return;
+    }
+    fail_msg("a non-finite contact problem was solved");
+  };
+  SolverProblem infinite_bias;  // gap / h with h = 5e-324
+  infinite_bias.rows.bias[0] = -HUGE_VAL;
+  failure(infinite_bias);
+  SolverProblem nan_rhs;  // a NaN in the free velocities' right-hand side
+  nan_rhs.b.back() = Vec3(0, 0, NAN);
+  failure(nan_rhs);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_frictionless_solution_is_exact),
@@ -95,6 +119,7 @@ int main(void) {
       cmocka_unit_test(test_without_contact_is_the_linear_solve),
       cmocka_unit_test(test_factor_follows_the_versions),
       cmocka_unit_test(test_pcg_agrees_with_cholmod),
+      cmocka_unit_test(test_non_finite_problem_is_a_numerical_failure),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -35,6 +35,7 @@ static struct {
 } fake;
 
 static double forces[FAKE_HD_MAX_FORCES][3];
+static int hostile; /* FAKE_HD_HOSTILE_* */
 
 static struct {
   HDSchedulerCallback callback;
@@ -133,6 +134,10 @@ void hdDisableDevice(HHD hHD) {
 }
 
 void hdBeginFrame(HHD hHD) {
+  if (hostile == FAKE_HD_HOSTILE_STALL && fake.frames % 20 == 19) {
+    const struct timespec pause = {0, 50 * 1000 * 1000};
+    nanosleep(&pause, NULL);
+  }
   pthread_mutex_lock(&state_lock);
   if (!good_handle(hHD)) {
   } else if (fake.in_frame) {
@@ -209,17 +214,36 @@ void hdGetDoublev(HDenum pname, HDdouble* params) {
   pthread_mutex_lock(&state_lock);
   switch (pname) {
     case HD_CURRENT_POSITION:
-      if (need_frame()) fake_hd_stylus(fake.frame, params, NULL, NULL, NULL);
+      if (need_frame()) {
+        fake_hd_stylus(fake.frame, params, NULL, NULL, NULL);
+        if (hostile == FAKE_HD_HOSTILE_NAN_POSE && fake.frame % 3 == 2) params[0] = NAN;
+        if (hostile == FAKE_HD_HOSTILE_HUGE_POSE && fake.frame % 3 == 2) params[1] = 1e300;
+      }
       break;
     case HD_CURRENT_VELOCITY:
-      if (need_frame()) fake_hd_stylus(fake.frame, NULL, params, NULL, NULL);
+      if (need_frame()) {
+        fake_hd_stylus(fake.frame, NULL, params, NULL, NULL);
+        if (hostile == FAKE_HD_HOSTILE_HUGE_POSE && fake.frame % 3 == 2) params[2] = -1e300;
+      }
       break;
     case HD_CURRENT_TRANSFORM:
-      if (need_frame()) fake_hd_stylus(fake.frame, NULL, NULL, params, NULL);
+      if (need_frame()) {
+        fake_hd_stylus(fake.frame, NULL, NULL, params, NULL);
+        if (hostile == FAKE_HD_HOSTILE_NAN_POSE && fake.frame % 3 == 2) params[13] = NAN;
+        if (hostile == FAKE_HD_HOSTILE_HUGE_POSE && fake.frame % 3 == 2) params[13] = 1e300;
+        if (hostile == FAKE_HD_HOSTILE_BAD_ROTATION && fake.frame % 3 == 2) {
+          const int kind = (int)(fake.frame / 3 % 3);
+          for (int c = 0; c < 3; ++c)
+            for (int r = 0; r < 3; ++r) {
+              double* m = &params[4 * c + r];
+              *m = kind == 0 ? 3 * *m : kind == 1 ? 0 : (c == 2 ? -*m : *m); /* scaled, zero, reflected */
+            }
+        }
+      }
       break;
-    case HD_NOMINAL_MAX_FORCE: params[0] = 3.3; break;
+    case HD_NOMINAL_MAX_FORCE: params[0] = hostile == FAKE_HD_HOSTILE_FIGURES ? 1e300 : 3.3; break;
     case HD_NOMINAL_MAX_CONTINUOUS_FORCE: params[0] = 0.88; break;
-    case HD_NOMINAL_MAX_STIFFNESS: params[0] = 1.25; break;  /* N/mm */
+    case HD_NOMINAL_MAX_STIFFNESS: params[0] = hostile == FAKE_HD_HOSTILE_FIGURES ? 1e300 : 1.25; break;  /* N/mm */
     case HD_NOMINAL_MAX_DAMPING: params[0] = 0.0025; break;  /* N s/mm */
     case HD_USABLE_WORKSPACE_DIMENSIONS: memcpy(params, workspace, sizeof workspace); break;
     default: misuse(HD_INVALID_ENUM);
@@ -349,6 +373,7 @@ void fake_hd_reset(void) {
   pthread_mutex_unlock(&schedule_lock);
   pthread_mutex_lock(&state_lock);
   memset(&fake, 0, sizeof fake);
+  hostile = FAKE_HD_HOSTILE_NONE;
   fake.calibration = HD_CALIBRATION_OK;
   fake.calibration_styles = HD_CALIBRATION_INKWELL;
   pthread_mutex_unlock(&state_lock);
@@ -428,3 +453,5 @@ HDushort fake_hd_last_priority(void) {
   pthread_mutex_unlock(&schedule_lock);
   return p;
 }
+
+void fake_hd_set_hostile(int mode) { hostile = mode; }

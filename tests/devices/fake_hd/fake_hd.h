@@ -21,6 +21,16 @@ void fake_hd_fail_init(HDerror code);                   /* hdInitDevice fails wi
 void fake_hd_set_calibration(HDenum status, HDint styles); /* hdCheckCalibration, HD_CALIBRATION_STYLE */
 void fake_hd_set_frame_error(HDerror code);             /* pushed by every hdEndFrame; 0: none */
 
+/* Hostile modes (issue 16): what the device reports goes wrong on every third frame (or always,
+ * for the figures). The stylus script below stays as documented; these change what HD returns. */
+#define FAKE_HD_HOSTILE_NONE 0
+#define FAKE_HD_HOSTILE_NAN_POSE 1      /* NaN position and transform translation */
+#define FAKE_HD_HOSTILE_HUGE_POSE 2     /* positions and velocities of 1e300 mm */
+#define FAKE_HD_HOSTILE_BAD_ROTATION 3  /* the transform's rotation scaled by 3, zero, or a reflection */
+#define FAKE_HD_HOSTILE_FIGURES 4       /* nominal max force and stiffness 1e300 */
+#define FAKE_HD_HOSTILE_STALL 5         /* hdBeginFrame sleeps 50 ms every 20th frame */
+void fake_hd_set_hostile(int mode);
+
 /* The scripted stylus during frame `frame` (0 = the first hdBeginFrame): position and
  * transform translation (mm), velocity (mm/s), rotation about z by 0.001 rad a frame,
  * buttons = frame & 3. Any output may be NULL. */
