@@ -83,3 +83,13 @@ install(CODE "
                  \"${PROJECT_BINARY_DIR}/pkgconfig/mica.pc\" @ONLY)")
 install(FILES ${PROJECT_BINARY_DIR}/pkgconfig/mica.pc
         DESTINATION ${CMAKE_INSTALL_LIBDIR}/pkgconfig)
+
+# After the library lands: make it loadable (cmake/MicaLoaderCache.cmake). A program linked
+# against libmica.so.0 finds it at run time only where the dynamic loader looks: the ld.so.conf
+# directories (through ldconfig's cache), the program's RPATH, or LD_LIBRARY_PATH.
+if(CMAKE_SYSTEM_NAME STREQUAL "Linux")
+  configure_file(${PROJECT_SOURCE_DIR}/cmake/MicaLoaderCache.cmake ${PROJECT_BINARY_DIR}/cmake/MicaLoaderCache.cmake
+                 COPYONLY)
+  install(CODE "set(MICA_INSTALL_LIBDIR \"${CMAKE_INSTALL_LIBDIR}\")
+include(\"${PROJECT_BINARY_DIR}/cmake/MicaLoaderCache.cmake\")")
+endif()

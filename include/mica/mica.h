@@ -16,6 +16,10 @@
  *   generation, so an id whose object was destroyed is detected, never dereferenced.
  * - Definition structs start with `struct_size`. Fill them with the matching `*_default()`
  *   function (or `*_init()` from a foreign-function interface), then change what you need.
+ *   Upgrades within a major version are drop-in: the library accepts a def of any size from
+ *   its size in 0.2.0 (the first release) to its own, so a program built against an older 0.x
+ *   header runs unchanged, the fields its header lacked taking their defaults. A def larger
+ *   than the library's (a newer header than the library) is refused with MICA_ERR_STRUCT_SIZE.
  * - Threads: a world is used by one thread at a time. Each function says who may call it.
  */
 #ifndef MICA_H
@@ -24,8 +28,16 @@
 #include <stddef.h>
 #include <stdint.h>
 
+/* Exported functions. libmica is built and tested on Linux (GCC) only; the Windows branch is
+ * the usual DLL export/import for a future port, not a supported build. */
 #if defined(MICA_STATIC)
 #define MICA_API
+#elif defined(_WIN32)
+#if defined(MICA_BUILDING_LIBRARY)
+#define MICA_API __declspec(dllexport)
+#else
+#define MICA_API __declspec(dllimport)
+#endif
 #elif defined(MICA_BUILDING_LIBRARY)
 #define MICA_API __attribute__((visibility("default")))
 #else
@@ -147,16 +159,17 @@ typedef struct mica_world_def {
   int32_t reserved1;       /**< zero */
   double body_margin;      /**< m: contacts between bodies are made for gaps below this; default 0.001 */
   double body_friction;    /**< Coulomb coefficient between bodies, >= 0; default 0 */
+  /* Since 0.3: */
   int32_t warm_start;      /**< MICA: 1 starts each step's iteration from the last step's velocities
                                 and impulses (matched by persistent contact keys); 0 from zero; default 1 */
   int32_t reserved2;       /**< zero */
-  /* Since 0.3: */
   double relaxation;       /**< MICA, Gauss-Seidel sweep: over-relaxation omega in (0, 2); default 1 (the paper) */
   /** Iterative solvers: > 0 stops the solve when the step has used this many milliseconds of
    *  wall-clock time; the step then completes with what the solver reached, mica_step returns
    *  MICA_WARN_NOT_CONVERGED and the statistics say out_of_time and the residual. Default 0: no budget. */
   double time_budget_ms;
   int32_t mica_sweep;      /**< MICA_SWEEP_*; default MICA_SWEEP_GAUSS_SEIDEL */
+  /* Since 0.4 (threads was reserved3 in 0.3: a 0.3 def gets the default, 1): */
   /** Threads for the step (rotations, element assembly, a colour-ordered Gauss-Seidel sweep):
    *  1 (default) runs the serial code and the paper's sweep order; 0 every CPU the process may
    *  run on; n > 1 starts n - 1 workers owned by the world (they sleep between steps). See
@@ -168,7 +181,7 @@ typedef struct mica_world_def {
    *  the new rotations, with a line search (docs/stability.md, K1). Default 1e-3. */
   double relinearise_tolerance;
   int32_t relinearise_max; /**< at most this many solves per step for that; < 2 turns the check off; default 8 */
-  /** Since 0.4. MICA_SWEEP_FACTORED on co-rotational bodies: every this many solves (one per
+  /** MICA_SWEEP_FACTORED on co-rotational bodies: every this many solves (one per
    *  step, more when a step is re-linearised) the factor is refreshed from the current system:
    *  copied, factored on a background thread (one per body) while the steps go on, and used from
    *  that many solves later (in lockstep: the step waits for a late factorization, so results do
@@ -182,19 +195,26 @@ typedef struct mica_world_def {
 
 /** Fills `def` with defaults, writing only its first `struct_size` bytes, and records
  *  `header_version`. This is the entry point for foreign-function interfaces; C and C++ use
- *  mica_world_def_default(). Returns MICA_ERR_STRUCT_SIZE if struct_size is too small. */
+ *  mica_world_def_default(). Returns MICA_ERR_STRUCT_SIZE, writing nothing, if struct_size
+ *  is smaller than the def's size in 0.2.0 or larger than this library's sizeof. Any thread. */
 MICA_API mica_status mica_world_def_init(mica_world_def* def, uint32_t struct_size,
                                          uint32_t header_version);
 
 /** The default world definition for the header you compiled with. */
 static inline mica_world_def mica_world_def_default(void) {
   mica_world_def def;
+  /* Set before the call: should init refuse (a library older than this header), the def still
+   * names its size and mica_world_create says what is wrong. */
+  def.struct_size = (uint32_t)sizeof def;
+  def.header_version = MICA_VERSION_NUMBER;
   mica_world_def_init(&def, (uint32_t)sizeof def, MICA_VERSION_NUMBER);
   return def;
 }
 
 /** Creates a world. Fails with MICA_ERR_VERSION_MISMATCH when def->header_version has another
- *  major version than the library. On failure *out_world is NULL and
+ *  major version than the library (any 0.x header works with a 0.x library), and with
+ *  MICA_ERR_STRUCT_SIZE when def->struct_size is not one it accepts (see the conventions at
+ *  the top). On failure *out_world is NULL and
  *  mica_world_last_error(NULL) says why. Any thread. */
 MICA_API mica_status mica_world_create(const mica_world_def* def, mica_world** out_world);
 
@@ -238,6 +258,7 @@ MICA_API mica_status mica_body_def_init(mica_body_def* def, uint32_t struct_size
 /** The default body definition. */
 static inline mica_body_def mica_body_def_default(void) {
   mica_body_def def;
+  def.struct_size = (uint32_t)sizeof def; /* kept if init refuses: the create call names it */
   mica_body_def_init(&def, (uint32_t)sizeof def);
   return def;
 }
@@ -339,6 +360,7 @@ MICA_API mica_status mica_lpc_def_init(mica_lpc_def* def, uint32_t struct_size);
 /** The default constraint definition (fixed, zero velocity). */
 static inline mica_lpc_def mica_lpc_def_default(void) {
   mica_lpc_def def;
+  def.struct_size = (uint32_t)sizeof def; /* kept if init refuses: the create call names it */
   mica_lpc_def_init(&def, (uint32_t)sizeof def);
   return def;
 }
@@ -417,6 +439,7 @@ MICA_API mica_status mica_tool_def_init(mica_tool_def* def, uint32_t struct_size
 /** The default tool definition (a 1 cm sphere at the origin). */
 static inline mica_tool_def mica_tool_def_default(void) {
   mica_tool_def def;
+  def.struct_size = (uint32_t)sizeof def; /* kept if init refuses: the create call names it */
   mica_tool_def_init(&def, (uint32_t)sizeof def);
   return def;
 }

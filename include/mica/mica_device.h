@@ -121,6 +121,7 @@ MICA_API mica_status mica_device_def_init(mica_device_def* def, uint32_t struct_
 /** The default device definition (a null device). */
 static inline mica_device_def mica_device_def_default(void) {
   mica_device_def def;
+  def.struct_size = (uint32_t)sizeof def; /* kept if init refuses: the create call names it */
   mica_device_def_init(&def, (uint32_t)sizeof def);
   return def;
 }
