@@ -96,8 +96,8 @@ static int case_refusals(scene* s) {
 
 static int case_world(scene* s) {
   mica_world_def def = mica_world_def_default();
-  EXPECT(def.struct_size == sizeof def, "struct_size %u, sizeof %u", (unsigned)def.struct_size,
-         (unsigned)sizeof def);
+  EXPECT(def.struct_size == sizeof def, "struct_size %u, sizeof %u (the library said: %s)", (unsigned)def.struct_size,
+         (unsigned)sizeof def, mica_world_last_error(NULL));
   EXPECT(def.header_version == MICA_VERSION_NUMBER, "header_version %u", (unsigned)def.header_version);
   EXPECT(def.gravity[1] == -9.81 && def.max_iterations == 200, "the defaults (gravity %g, cap %d)",
          def.gravity[1], (int)def.max_iterations);
