@@ -6,7 +6,7 @@
         tool = world.create_tool(radius=0.02, position=(0, 0.125, 0))
         world.step(0.01)
         force, torque, contacts = tool.force()
-        p = cube.positions          # numpy (n, 3) view: valid until the next step
+        p = cube.positions          # (n, 3) view, no copy: valid until the next step (then it raises)
 
 The library is found through $MICA_LIBRARY, else next to a build tree holding this package,
 else ctypes.util.find_library("mica") (see mica._native.find_library). The raw C API is in
@@ -35,7 +35,7 @@ _HERE = os.path.dirname(os.path.abspath(__file__))
 # Every MICA_* constant at the package level too (mica.MICA_SOLVER_MICA).
 globals().update({k: v for k, v in vars(native).items() if k.startswith("MICA_")})
 
-__all__ = ["MicaError", "MicaWarning", "World", "Body", "Tool", "Lpc", "Device", "DeviceBackend",
+__all__ = ["MicaError", "MicaWarning", "World", "Body", "Tool", "Lpc", "Device", "DeviceBackend", "PositionsView",
            "version", "world_def", "body_def", "lpc_def", "tool_def", "device_def", "native"]
 
 
@@ -154,13 +154,90 @@ def _id_of(obj):
     return getattr(obj, "id", obj) if obj is not None else native.MICA_NULL_ID
 
 
-class _PositionsView:
-    """Exposes the world's position buffer to numpy without a copy and keeps the world alive."""
+class _RawBuffer:
+    """The world's position buffer for numpy, without a copy (used only inside PositionsView)."""
 
-    def __init__(self, world, address, node_count):
-        self.world = world
+    def __init__(self, address, node_count):
         self.__array_interface__ = {"shape": (node_count, 3), "typestr": "<f8", "data": (address, True),
                                     "version": 3}
+
+
+class PositionsView:
+    """A body's current positions (m), (n, 3), read from the world's own buffer without copying
+    it (mica_body_positions_view).
+
+    The buffer belongs to the world: a step, destroying the body or closing the world
+    invalidates it. A view therefore checks, on every read, that none of these happened since it
+    was taken, and raises MicaError (MICA_ERR_WRONG_STATE) otherwise: it never reads freed
+    memory and never changes under you. Take body.positions again after each step.
+
+    Indexing (view[:, 1], view[k]) reads only the selected part, as a new array; numpy
+    functions and np.asarray(view) get a copy of the whole (a snapshot that stays valid);
+    min(), max(), mean(), sum() and copy() work on the view directly. It keeps its World alive.
+    """
+
+    __array_priority__ = 1  # numpy converts it through __array__ in mixed arithmetic
+
+    def __init__(self, world, body_id, address, node_count):
+        self.world = world
+        self.body_id = body_id
+        self._epoch = world._view_epoch
+        self._raw = np.asarray(_RawBuffer(address, node_count)) if node_count else np.empty((0, 3))
+        self._raw.flags.writeable = False
+
+    @property
+    def valid(self):
+        """False once a step, the body's destruction or the world's closing invalidated it."""
+        return not self.world.closed and self.world._view_epoch == self._epoch
+
+    def _array(self):
+        if self.world.closed:
+            raise MicaError(native.MICA_ERR_WRONG_STATE,
+                            "the world of this positions view was closed: the view's memory is gone")
+        if self.world._view_epoch != self._epoch:
+            raise MicaError(native.MICA_ERR_WRONG_STATE,
+                            "the world stepped (or destroyed a body) since this positions view was taken: "
+                            "take body.positions again")
+        return self._raw
+
+    shape = property(lambda self: self._raw.shape)
+    dtype = property(lambda self: self._raw.dtype)
+    ndim = property(lambda self: self._raw.ndim)
+    size = property(lambda self: self._raw.size)
+
+    def __len__(self):
+        return len(self._raw)
+
+    def __array__(self, dtype=None, copy=None):
+        return np.array(self._array(), dtype=dtype, copy=True)
+
+    def __getitem__(self, key):
+        part = self._array()[key]
+        return part.copy() if isinstance(part, np.ndarray) else part
+
+    def __iter__(self):
+        return iter(self.copy())
+
+    def copy(self):
+        """A copy of the positions (n, 3) that stays valid."""
+        return self._array().copy()
+
+    def min(self, *args, **kwargs):
+        return self._array().min(*args, **kwargs)
+
+    def max(self, *args, **kwargs):
+        return self._array().max(*args, **kwargs)
+
+    def mean(self, *args, **kwargs):
+        return self._array().mean(*args, **kwargs)
+
+    def sum(self, *args, **kwargs):
+        return self._array().sum(*args, **kwargs)
+
+    def __repr__(self):
+        if not self.valid:
+            return "PositionsView(invalid: take body.positions again)"
+        return "PositionsView(%r)" % (self._raw,)
 
 
 class World:
@@ -182,6 +259,7 @@ class World:
         handle = c_void_p()
         _check(native.mica_world_create(byref(d), byref(handle)), None, "mica_world_create")
         self._handle = handle
+        self._view_epoch = 0  # advanced by whatever invalidates positions views (PositionsView)
 
     # --- lifetime
     @property
@@ -198,6 +276,7 @@ class World:
     def close(self):
         """Destroys the world and everything in it. Views and ids from it become invalid."""
         if getattr(self, "_handle", None) is not None:
+            self._view_epoch += 1
             native.mica_world_destroy(self._handle)
             self._handle = None
             self._keepalive = []
@@ -224,8 +303,11 @@ class World:
     # --- world
     def step(self, dt):
         """Advances by dt seconds. Returns True, or False (and warns) when the solver stopped
-        at its iteration cap. Every positions view taken before is invalid afterwards."""
-        return self._check(native.mica_step(self.handle, dt), "mica_step") == native.MICA_OK
+        at its iteration cap. Every positions view taken before is invalid afterwards (reading
+        it raises)."""
+        handle = self.handle
+        self._view_epoch += 1  # even a failed step may have touched the buffers
+        return self._check(native.mica_step(handle, dt), "mica_step") == native.MICA_OK
 
     def set_gravity(self, gravity):
         self._check(native.mica_world_set_gravity(self.handle, _doubles(gravity, 3)), "mica_world_set_gravity")
@@ -341,15 +423,14 @@ class Body(_Object):
 
     @property
     def positions(self):
-        """Read-only numpy (n, 3) view of the current positions (m), no copy. It keeps the World
-        alive but is valid only until the next step (or the body's or world's destruction):
-        fetch it again after every step, or copy it (get_positions())."""
+        """A PositionsView of the current positions (m), (n, 3): read from the world's buffer
+        without copying it, valid until the next step, the body's destruction or the world's
+        closing, after which reading it raises MicaError. Take it again after every step, or
+        keep a copy (get_positions(), view.copy())."""
         ptr, n = POINTER(c_double)(), c_int32()
         self.world._check(native.mica_body_positions_view(self.world.handle, self.id, byref(ptr), byref(n)),
                           "mica_body_positions_view")
-        if n.value == 0:
-            return np.empty((0, 3))
-        return np.asarray(_PositionsView(self.world, ctypes.cast(ptr, c_void_p).value, n.value))
+        return PositionsView(self.world, self.id, ctypes.cast(ptr, c_void_p).value, n.value)
 
     def _get(self, fn, width, dtype, name):
         w = self.world
@@ -419,6 +500,7 @@ class Body(_Object):
                           "mica_body_write_vtk")
 
     def destroy(self):
+        self.world._view_epoch += 1  # positions views of this body lose their buffer
         self.world._check(native.mica_body_destroy(self.world.handle, self.id), "mica_body_destroy")
 
 
