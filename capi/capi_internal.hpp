@@ -71,47 +71,36 @@ inline void require(const void* p, const char* name) {
 // changes sizeof(T), not the first size. Written as "the end of the last field 0.2.0 had" so
 // that they hold on every ABI (the numbers are x86-64's).
 #define MICA_CAPI_END_OF(T, field) (offsetof(T, field) + sizeof(static_cast<T*>(nullptr)->field))
-template <class T>
-struct FirstSize;
-template <>
-struct FirstSize<mica_world_def> {
-  static constexpr uint32_t value = MICA_CAPI_END_OF(mica_world_def, body_friction);  // 0.3 added warm_start
-};
-template <>
-struct FirstSize<mica_body_def> {
-  static constexpr uint32_t value = MICA_CAPI_END_OF(mica_body_def, velocity);
-};
-template <>
-struct FirstSize<mica_lpc_def> {
-  static constexpr uint32_t value = MICA_CAPI_END_OF(mica_lpc_def, velocity);
-};
-template <>
-struct FirstSize<mica_tool_def> {
-  static constexpr uint32_t value = MICA_CAPI_END_OF(mica_tool_def, reserved0);
-};
-template <>
-struct FirstSize<mica_device_def> {
-  static constexpr uint32_t value = MICA_CAPI_END_OF(mica_device_def, hand_damping);
-};
+constexpr uint32_t first_size(const mica_world_def*) { return MICA_CAPI_END_OF(mica_world_def, body_friction); }
+constexpr uint32_t first_size(const mica_body_def*) { return MICA_CAPI_END_OF(mica_body_def, velocity); }
+constexpr uint32_t first_size(const mica_lpc_def*) { return MICA_CAPI_END_OF(mica_lpc_def, velocity); }
+constexpr uint32_t first_size(const mica_tool_def*) { return MICA_CAPI_END_OF(mica_tool_def, reserved0); }
+constexpr uint32_t first_size(const mica_device_def*) { return MICA_CAPI_END_OF(mica_device_def, hand_damping); }
 #undef MICA_CAPI_END_OF
-static_assert(sizeof(void*) != 8 || (FirstSize<mica_world_def>::value == 112 && FirstSize<mica_body_def>::value == 104 &&
-                                     FirstSize<mica_lpc_def>::value == 80 && FirstSize<mica_tool_def>::value == 160 &&
-                                     FirstSize<mica_device_def>::value == 200),
+template <class T>
+constexpr uint32_t first_size() {
+  return first_size(static_cast<const T*>(nullptr));
+}
+static_assert(sizeof(void*) != 8 || (first_size<mica_world_def>() == 112 && first_size<mica_body_def>() == 104 &&
+                                     first_size<mica_lpc_def>() == 80 && first_size<mica_tool_def>() == 160 &&
+                                     first_size<mica_device_def>() == 200),
               "the first released sizes (0.2.0, x86-64) must never change");
 
-// Why a struct_size is refused (empty when it is accepted), for "<name>->struct_size" or
-// "struct_size".
+// Refuses a struct_size this library does not accept ("<name>->struct_size" or "struct_size"
+// in the message): smaller than the def's first release, or larger than this library's def (a
+// newer header).
 template <class T>
-std::string struct_size_problem(uint32_t struct_size, const std::string& field) {
-  const uint32_t first = FirstSize<T>::value, last = sizeof(T);
+void check_struct_size(uint32_t struct_size, const std::string& field) {
+  const uint32_t first = first_size<T>(), last = sizeof(T);
   const std::string range = std::to_string(first) + ".." + std::to_string(last);
   if (struct_size > last)
-    return field + " is " + std::to_string(struct_size) + ", larger than any this libmica " + version_text() + " knows (" + range + "): the program was built against a newer libmica header than the library it "
-           "loaded; run it with that libmica or a newer one";
+    refuse(MICA_ERR_STRUCT_SIZE,
+           field + " is " + std::to_string(struct_size) + ", larger than any this libmica " + version_text() +
+               " knows (" + range + "): the program was built against a newer libmica header than the library it "
+               "loaded; run it with that libmica or a newer one");
   if (struct_size < first)
-    return field + " is " + std::to_string(struct_size) + ", this libmica knows sizes " + range +
-           " (the first from 0.2.0); initialise the def with its *_default() or *_init() function";
-  return {};
+    refuse(MICA_ERR_STRUCT_SIZE, field + " is " + std::to_string(struct_size) + ", this libmica knows sizes " + range +
+                                     " (the first from 0.2.0); initialise the def with its *_default() or *_init() function");
 }
 
 // Copies the first struct_size bytes of a caller's def over the defaults. A def from an
@@ -120,8 +109,7 @@ std::string struct_size_problem(uint32_t struct_size, const std::string& field) 
 template <class T>
 T read_def(const T* def, T defaults, const char* name) {
   require(def, name);
-  const std::string problem = struct_size_problem<T>(def->struct_size, std::string(name) + "->struct_size");
-  if (!problem.empty()) refuse(MICA_ERR_STRUCT_SIZE, problem);
+  check_struct_size<T>(def->struct_size, std::string(name) + "->struct_size");
   std::memcpy(static_cast<void*>(&defaults), def, def->struct_size);
   return defaults;
 }
@@ -132,8 +120,7 @@ template <class T>
 mica_status init_def(T* def, uint32_t struct_size, const T& defaults, const char* function) {
   return guarded(nullptr, function, [&] {
     require(def, "def");
-    const std::string problem = struct_size_problem<T>(struct_size, "struct_size");
-    if (!problem.empty()) refuse(MICA_ERR_STRUCT_SIZE, problem);
+    check_struct_size<T>(struct_size, "struct_size");
     std::memcpy(static_cast<void*>(def), &defaults, struct_size);
     def->struct_size = struct_size;
     return MICA_OK;

@@ -10,14 +10,7 @@ source=$2
 work=$3
 CC=${CC:-cc}
 
-# GNUInstallDirs may have put the library in lib/ or lib/<multiarch>/: find mica.pc.
-pc=$(find "$prefix" -path '*/pkgconfig/mica.pc' | head -n 1)
-if [ -z "$pc" ]; then
-  echo "FAIL: no pkgconfig/mica.pc under $prefix"
-  exit 1
-fi
-PKG_CONFIG_PATH=$(dirname "$pc")
-export PKG_CONFIG_PATH
+. "$(dirname "$0")/staged_pkgconfig.sh"
 
 libdir=$(pkg-config --variable=libdir mica)
 cflags=$(pkg-config --cflags mica)

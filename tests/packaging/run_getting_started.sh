@@ -9,10 +9,7 @@ page=$2
 work=$3
 CC=${CC:-cc}
 
-pc=$(find "$prefix" -path '*/pkgconfig/mica.pc' | head -n 1)
-[ -n "$pc" ] || { echo "FAIL: no pkgconfig/mica.pc under $prefix"; exit 1; }
-PKG_CONFIG_PATH=$(dirname "$pc")
-export PKG_CONFIG_PATH
+. "$(dirname "$0")/staged_pkgconfig.sh"
 
 # The command the page gives, with its variables; it must still be on the page word for word.
 documented='cc sag.c $(pkg-config --cflags --libs mica) -Wl,-rpath,$(pkg-config --variable=libdir mica) -o sag'
