@@ -9,8 +9,9 @@
 --
 -- The declarations come from mica_cdef.lua, generated from include/mica/*.h at build time
 -- (bindings/luajit/gen_cdef.py): require finds it in <build>/bindings/luajit. The library is
--- $MICA_LIBRARY, else libmica.so.<major> two folders above this file (a build tree), else
--- ffi.load("mica") (the system's search path).
+-- $MICA_LIBRARY, else libmica.so.<major> two folders above this file (a build tree), else the
+-- one installed with this module (mica_install.lua, written by cmake --install), else
+-- libmica.so.0 on the system's search path.
 --
 -- mica.C is the library namespace: every function of mica.h and mica_device.h, and the
 -- constants (mica.C.MICA_OK). Errors (status < 0) raise a mica.Error {status, message};
@@ -40,7 +41,13 @@ local function load_library()
     local path = module_dir() .. up .. "/libmica.so.0"
     if file_exists(path) then return ffi.load(path), path end
   end
-  return ffi.load("mica"), "mica"
+  -- An installed module: cmake --install wrote where it put libmica (mica_install.lua).
+  local ok, install = pcall(require, "mica_install")
+  if ok and type(install) == "table" and install.libdir then
+    local path = install.libdir .. "/libmica.so.0"
+    if file_exists(path) then return ffi.load(path), path end
+  end
+  return ffi.load("libmica.so.0"), "libmica.so.0"
 end
 
 local C, path = load_library()
