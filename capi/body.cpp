@@ -23,7 +23,7 @@ struct BodyInput {
 };
 
 BodyInput translate(const mica_body_def* def) {
-  const mica_body_def d = read_def(def, body_defaults(), sizeof(mica_body_def), "def");
+  const mica_body_def d = read_def(def, body_defaults(), "def");
   if (d.model != MICA_MODEL_COROTATIONAL && d.model != MICA_MODEL_LINEAR)
     refuse(MICA_ERR_INVALID_ARGUMENT, "def->model is " + std::to_string(d.model) + ", not a MICA_MODEL_* value");
   if (d.mass != MICA_MASS_CONSISTENT && d.mass != MICA_MASS_LUMPED)
@@ -70,7 +70,7 @@ mica_status select_nodes(const mica::Body& b, int32_t use_rest, int32_t* out, in
 extern "C" {
 
 MICA_API mica_status mica_body_def_init(mica_body_def* def, uint32_t struct_size) {
-  return init_def(def, struct_size, sizeof(mica_body_def), body_defaults(), "mica_body_def_init");
+  return init_def(def, struct_size, body_defaults(), "mica_body_def_init");
 }
 
 MICA_API mica_status mica_body_create(mica_world* world, const mica_body_def* def, const double* nodes,

@@ -3,11 +3,13 @@
 #pragma once
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstring>
 #include <new>
 #include <string>
 
 #include "mica/mica.h"
+#include "mica/mica_device.h"
 #include "world/world.hpp"
 
 struct mica_world {
@@ -19,6 +21,11 @@ struct mica_world {
 };
 
 namespace mica_capi {
+
+// This library's version as text ("0.4.0"), for messages.
+inline std::string version_text(uint32_t number = MICA_VERSION_NUMBER) {
+  return std::to_string(number / 10000) + "." + std::to_string(number / 100 % 100) + "." + std::to_string(number % 100);
+}
 
 // The message of the last failure of a call that had no world (creation), per thread.
 std::string& thread_last_error();
@@ -57,28 +64,63 @@ inline void require(const void* p, const char* name) {
   if (!p) refuse(MICA_ERR_NULL_ARGUMENT, std::string(name) + " is NULL");
 }
 
-// Copies the first struct_size bytes of a caller's def over the defaults. A def from an
-// older caller (smaller) keeps the defaults for the fields it lacks; a larger or a too
-// small one is refused.
+// The size each def had in the first release that had it: 0.2.0, the first release with an
+// ABI promise (its header is tests/abi_fixtures/0.2). A caller's struct_size may be anything
+// from this to sizeof(T): a program built against an older 0.x header keeps working, and the
+// fields its header lacked keep their defaults. Never move these: a field appended later
+// changes sizeof(T), not the first size. Written as "the end of the last field 0.2.0 had" so
+// that they hold on every ABI (the numbers are x86-64's).
+#define MICA_CAPI_END_OF(T, field) (offsetof(T, field) + sizeof(static_cast<T*>(nullptr)->field))
+constexpr uint32_t first_size(const mica_world_def*) { return MICA_CAPI_END_OF(mica_world_def, body_friction); }
+constexpr uint32_t first_size(const mica_body_def*) { return MICA_CAPI_END_OF(mica_body_def, velocity); }
+constexpr uint32_t first_size(const mica_lpc_def*) { return MICA_CAPI_END_OF(mica_lpc_def, velocity); }
+constexpr uint32_t first_size(const mica_tool_def*) { return MICA_CAPI_END_OF(mica_tool_def, reserved0); }
+constexpr uint32_t first_size(const mica_device_def*) { return MICA_CAPI_END_OF(mica_device_def, hand_damping); }
+#undef MICA_CAPI_END_OF
 template <class T>
-T read_def(const T* def, T defaults, uint32_t min_size, const char* name) {
+constexpr uint32_t first_size() {
+  return first_size(static_cast<const T*>(nullptr));
+}
+static_assert(sizeof(void*) != 8 || (first_size<mica_world_def>() == 112 && first_size<mica_body_def>() == 104 &&
+                                     first_size<mica_lpc_def>() == 80 && first_size<mica_tool_def>() == 160 &&
+                                     first_size<mica_device_def>() == 200),
+              "the first released sizes (0.2.0, x86-64) must never change");
+
+// Refuses a struct_size this library does not accept ("<name>->struct_size" or "struct_size"
+// in the message): smaller than the def's first release, or larger than this library's def (a
+// newer header).
+template <class T>
+void check_struct_size(uint32_t struct_size, const std::string& field) {
+  const uint32_t first = first_size<T>(), last = sizeof(T);
+  const std::string range = std::to_string(first) + ".." + std::to_string(last);
+  if (struct_size > last)
+    refuse(MICA_ERR_STRUCT_SIZE,
+           field + " is " + std::to_string(struct_size) + ", larger than any this libmica " + version_text() +
+               " knows (" + range + "): the program was built against a newer libmica header than the library it "
+               "loaded; run it with that libmica or a newer one");
+  if (struct_size < first)
+    refuse(MICA_ERR_STRUCT_SIZE, field + " is " + std::to_string(struct_size) + ", this libmica knows sizes " + range +
+                                     " (the first from 0.2.0); initialise the def with its *_default() or *_init() function");
+}
+
+// Copies the first struct_size bytes of a caller's def over the defaults. A def from an
+// older caller (smaller) keeps the defaults for the fields it lacks; a larger one (a newer
+// header) or one smaller than the first release's is refused.
+template <class T>
+T read_def(const T* def, T defaults, const char* name) {
   require(def, name);
-  if (def->struct_size < min_size || def->struct_size > sizeof(T))
-    refuse(MICA_ERR_STRUCT_SIZE, std::string(name) + "->struct_size is " + std::to_string(def->struct_size) +
-               ", this libmica knows sizes " + std::to_string(min_size) + ".." + std::to_string(sizeof(T)) +
-               " (initialise it with the *_default() function)");
+  check_struct_size<T>(def->struct_size, std::string(name) + "->struct_size");
   std::memcpy(static_cast<void*>(&defaults), def, def->struct_size);
   return defaults;
 }
 
-// Writes defaults into the first struct_size bytes of *def (the *_init functions).
+// Writes defaults into the first struct_size bytes of *def (the *_init functions), any size
+// read_def accepts; on a refusal *def is left untouched.
 template <class T>
-mica_status init_def(T* def, uint32_t struct_size, uint32_t min_size, const T& defaults, const char* function) {
+mica_status init_def(T* def, uint32_t struct_size, const T& defaults, const char* function) {
   return guarded(nullptr, function, [&] {
     require(def, "def");
-    if (struct_size < min_size || struct_size > sizeof(T))
-      refuse(MICA_ERR_STRUCT_SIZE, "struct_size is " + std::to_string(struct_size) + ", this libmica knows sizes " +
-                                       std::to_string(min_size) + ".." + std::to_string(sizeof(T)));
+    check_struct_size<T>(struct_size, "struct_size");
     std::memcpy(static_cast<void*>(def), &defaults, struct_size);
     def->struct_size = struct_size;
     return MICA_OK;

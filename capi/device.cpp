@@ -92,14 +92,14 @@ mica::DeviceSettings translate(const mica_device_def& d) {
 extern "C" {
 
 MICA_API mica_status mica_device_def_init(mica_device_def* def, uint32_t struct_size) {
-  return init_def(def, struct_size, sizeof(mica_device_def), device_defaults(), "mica_device_def_init");
+  return init_def(def, struct_size, device_defaults(), "mica_device_def_init");
 }
 
 MICA_API mica_status mica_device_create(mica_world* world, const mica_device_def* def, mica_device_id* out_device) {
   return guarded(world, "mica_device_create", [&] {
     require(world, "world");
     require(out_device, "out_device");
-    const mica_device_def d = read_def(def, device_defaults(), sizeof(mica_device_def), "def");
+    const mica_device_def d = read_def(def, device_defaults(), "def");
     const mica::DeviceSettings settings = translate(d);
     if (d.tool) world->world.tool(d.tool);  // a stale tool fails before the device is opened
     *out_device = world->world.add_device(make_device(d), settings);

@@ -17,7 +17,7 @@ mica_lpc_def lpc_defaults() {
 extern "C" {
 
 MICA_API mica_status mica_lpc_def_init(mica_lpc_def* def, uint32_t struct_size) {
-  return init_def(def, struct_size, sizeof(mica_lpc_def), lpc_defaults(), "mica_lpc_def_init");
+  return init_def(def, struct_size, lpc_defaults(), "mica_lpc_def_init");
 }
 
 MICA_API mica_status mica_add_lpc(mica_world* world, mica_body_id body, const int32_t* nodes, int32_t count,
@@ -27,7 +27,7 @@ MICA_API mica_status mica_add_lpc(mica_world* world, mica_body_id body, const in
     require(nodes, "nodes");
     require(out_lpc, "out_lpc");
     if (count < 1) refuse(MICA_ERR_INVALID_ARGUMENT, "count is " + std::to_string(count) + ", must be >= 1");
-    const mica_lpc_def d = read_def(def, lpc_defaults(), sizeof(mica_lpc_def), "def");
+    const mica_lpc_def d = read_def(def, lpc_defaults(), "def");
     mica::LpcSpec spec;
     switch (d.kind) {
       case MICA_LPC_FIXED: spec.kind = mica::LpcKind::Fixed; break;

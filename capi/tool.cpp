@@ -23,14 +23,14 @@ mica_tool_def tool_defaults() {
 extern "C" {
 
 MICA_API mica_status mica_tool_def_init(mica_tool_def* def, uint32_t struct_size) {
-  return init_def(def, struct_size, sizeof(mica_tool_def), tool_defaults(), "mica_tool_def_init");
+  return init_def(def, struct_size, tool_defaults(), "mica_tool_def_init");
 }
 
 MICA_API mica_status mica_tool_create(mica_world* world, const mica_tool_def* def, mica_tool_id* out_tool) {
   return guarded(world, "mica_tool_create", [&] {
     require(world, "world");
     require(out_tool, "out_tool");
-    const mica_tool_def d = read_def(def, tool_defaults(), sizeof(mica_tool_def), "def");
+    const mica_tool_def d = read_def(def, tool_defaults(), "def");
     mica::Tool t;
     switch (d.shape) {
       case MICA_TOOL_SPHERE: t.shape = mica::ToolShape::Sphere; break;

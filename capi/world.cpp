@@ -87,7 +87,7 @@ std::vector<mica::VtkPiece> vtk_pieces(const mica::Body& b, std::vector<mica::Ve
 extern "C" {
 
 MICA_API mica_status mica_world_def_init(mica_world_def* def, uint32_t struct_size, uint32_t header_version) {
-  const mica_status s = init_def(def, struct_size, sizeof(mica_world_def), world_defaults(), "mica_world_def_init");
+  const mica_status s = init_def(def, struct_size, world_defaults(), "mica_world_def_init");
   if (s == MICA_OK) def->header_version = header_version;
   return s;
 }
@@ -96,11 +96,17 @@ MICA_API mica_status mica_world_create(const mica_world_def* def, mica_world** o
   if (out_world) *out_world = nullptr;
   return guarded(nullptr, "mica_world_create", [&] {
     require(out_world, "out_world");
-    const mica_world_def d = read_def(def, world_defaults(), sizeof(mica_world_def), "def");
+    mica_world_def d = read_def(def, world_defaults(), "def");
+    // Any 0.x header works with this library (older minors are drop-in within SONAME 0); a
+    // header of another major version has another ABI.
     if (d.header_version / 10000 != MICA_VERSION_MAJOR)
       refuse(MICA_ERR_VERSION_MISMATCH, "the caller was compiled with libmica header " +
-                                            std::to_string(d.header_version) + ", this library is " +
-                                            std::to_string(MICA_VERSION_NUMBER));
+                                            version_text(d.header_version) + " (header_version " +
+                                            std::to_string(d.header_version) + "), this library is " + version_text() +
+                                            ": a different major version");
+    // In 0.3 the slot of `threads` was reserved3 ("zero"): a 0.3 def (it ends before
+    // relinearise_tolerance) gets the default thread count, not 0 = every CPU.
+    if (def->struct_size <= offsetof(mica_world_def, relinearise_tolerance)) d.threads = world_defaults().threads;
     mica::WorldSettings settings = translate(d);
     if (d.log) {
       const mica_log_fn log = d.log;

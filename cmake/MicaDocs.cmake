@@ -22,8 +22,11 @@ endif()
 
 configure_file(${PROJECT_SOURCE_DIR}/docs/Doxyfile.in ${MICA_DOCS_OUTPUT_DIR}/Doxyfile @ONLY)
 
+# The pages' pictures (![...](images/...)) are linked as they are, relative to the page: copied
+# beside the HTML.
 add_custom_target(docs
   COMMAND Doxygen::doxygen ${MICA_DOCS_OUTPUT_DIR}/Doxyfile
+  COMMAND ${CMAKE_COMMAND} -E copy_directory ${PROJECT_SOURCE_DIR}/docs/images ${MICA_DOCS_OUTPUT_DIR}/html/images
   WORKING_DIRECTORY ${PROJECT_SOURCE_DIR}
   DEPENDS ${MICA_DOCS_OUTPUT_DIR}/Doxyfile ${MICA_DOCS_HEADERS} ${MICA_DOCS_PAGES}
   COMMENT "Doxygen: API reference in ${MICA_DOCS_OUTPUT_DIR}/html"
@@ -31,7 +34,7 @@ add_custom_target(docs
 
 # `cmake --install <build> --component docs` after building docs; plain installs skip it.
 install(DIRECTORY ${MICA_DOCS_OUTPUT_DIR}/html/
-  DESTINATION ${CMAKE_INSTALL_DOCDIR}/html
+  DESTINATION ${MICA_INSTALL_DOCDIR}/html
   COMPONENT docs
   OPTIONAL
   EXCLUDE_FROM_ALL)

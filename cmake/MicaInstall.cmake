@@ -1,5 +1,6 @@
 # Install rules: libmica (shared, and static when built), the public headers, a CMake
-# package (find_package(mica) -> mica::mica, mica::mica_static) and mica.pc.
+# package (find_package(mica) -> mica::mica, mica::mica_static), mica.pc, and the licence
+# (LICENSE, NOTICE), README and CHANGELOG under share/doc/libmica.
 # Included by the top-level CMakeLists once the targets mica and (optionally) mica_static exist.
 # The docs HTML (component docs) is installed from cmake/MicaDocs.cmake, next to its target.
 include(CMakePackageConfigHelpers)
@@ -35,6 +36,16 @@ install(DIRECTORY ${PROJECT_SOURCE_DIR}/include/mica/
   DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/mica
   FILES_MATCHING PATTERN "*.h")
 
+# The licence and the release notes. The directory is named after the library (libmica), not
+# the CMake project (GNUInstallDirs' DOCDIR would be share/doc/mica).
+set(MICA_INSTALL_DOCDIR ${CMAKE_INSTALL_DATAROOTDIR}/doc/libmica)
+install(FILES
+  ${PROJECT_SOURCE_DIR}/LICENSE
+  ${PROJECT_SOURCE_DIR}/NOTICE
+  ${PROJECT_SOURCE_DIR}/README.md
+  ${PROJECT_SOURCE_DIR}/CHANGELOG.md
+  DESTINATION ${MICA_INSTALL_DOCDIR})
+
 install(EXPORT micaTargets
   NAMESPACE mica::
   DESTINATION ${MICA_INSTALL_CMAKEDIR})
@@ -42,7 +53,8 @@ install(EXPORT micaTargets
 configure_package_config_file(
   ${PROJECT_SOURCE_DIR}/cmake/micaConfig.cmake.in
   ${PROJECT_BINARY_DIR}/cmake/micaConfig.cmake
-  INSTALL_DESTINATION ${MICA_INSTALL_CMAKEDIR})
+  INSTALL_DESTINATION ${MICA_INSTALL_CMAKEDIR}
+  PATH_VARS MICA_INSTALL_DOCDIR)
 # SOVERSION is the major version, so any release with the same major is a drop-in.
 write_basic_package_version_file(
   ${PROJECT_BINARY_DIR}/cmake/micaConfigVersion.cmake
@@ -71,3 +83,13 @@ install(CODE "
                  \"${PROJECT_BINARY_DIR}/pkgconfig/mica.pc\" @ONLY)")
 install(FILES ${PROJECT_BINARY_DIR}/pkgconfig/mica.pc
         DESTINATION ${CMAKE_INSTALL_LIBDIR}/pkgconfig)
+
+# After the library lands: make it loadable (cmake/MicaLoaderCache.cmake). A program linked
+# against libmica.so.0 finds it at run time only where the dynamic loader looks: the ld.so.conf
+# directories (through ldconfig's cache), the program's RPATH, or LD_LIBRARY_PATH.
+if(CMAKE_SYSTEM_NAME STREQUAL "Linux")
+  configure_file(${PROJECT_SOURCE_DIR}/cmake/MicaLoaderCache.cmake ${PROJECT_BINARY_DIR}/cmake/MicaLoaderCache.cmake
+                 COPYONLY)
+  install(CODE "set(MICA_INSTALL_LIBDIR \"${CMAKE_INSTALL_LIBDIR}\")
+include(\"${PROJECT_BINARY_DIR}/cmake/MicaLoaderCache.cmake\")")
+endif()

@@ -9,8 +9,9 @@
 --
 -- The declarations come from mica_cdef.lua, generated from include/mica/*.h at build time
 -- (bindings/luajit/gen_cdef.py): require finds it in <build>/bindings/luajit. The library is
--- $MICA_LIBRARY, else libmica.so.<major> two folders above this file (a build tree), else
--- ffi.load("mica") (the system's search path).
+-- $MICA_LIBRARY, else libmica.so.<major> two folders above this file (a build tree), else the
+-- one installed with this module (mica_install.lua, written by cmake --install), else
+-- libmica.so.0 on the system's search path.
 --
 -- mica.C is the library namespace: every function of mica.h and mica_device.h, and the
 -- constants (mica.C.MICA_OK). Errors (status < 0) raise a mica.Error {status, message};
@@ -40,7 +41,13 @@ local function load_library()
     local path = module_dir() .. up .. "/libmica.so.0"
     if file_exists(path) then return ffi.load(path), path end
   end
-  return ffi.load("mica"), "mica"
+  -- An installed module: cmake --install wrote where it put libmica (mica_install.lua).
+  local ok, install = pcall(require, "mica_install")
+  if ok and type(install) == "table" and install.libdir then
+    local path = install.libdir .. "/libmica.so.0"
+    if file_exists(path) then return ffi.load(path), path end
+  end
+  return ffi.load("libmica.so.0"), "libmica.so.0"
 end
 
 local C, path = load_library()
@@ -148,6 +155,24 @@ function World:create_box(lo, hi, cells, tets_per_cell, fields)
   return id[0]
 end
 
+-- A body from a mesh file: Gmsh .msh (2.2 or 4.1 ASCII) or a TetGen .node/.ele pair.
+function World:create_body_from_file(path, fields)
+  local id = ffi.new("mica_body_id[1]")
+  self:check(C.mica_body_create_from_file(self.ptr, M.body_def(fields), path, id))
+  return id[0]
+end
+
+-- A body from Lua tables: nodes {x1, y1, z1, x2, ...} (m), tets {a1, b1, c1, d1, ...} (0-based).
+function World:create_body(nodes, tets, fields)
+  assert(#nodes % 3 == 0 and #tets % 4 == 0, "nodes: 3 values a node, tets: 4 indices a tet")
+  local id = ffi.new("mica_body_id[1]")
+  self:check(C.mica_body_create(self.ptr, M.body_def(fields), ffi.new("double[?]", #nodes, nodes), #nodes / 3,
+                                ffi.new("int32_t[?]", #tets, tets), #tets / 4, id))
+  return id[0]
+end
+
+function World:destroy_body(body) self:check(C.mica_body_destroy(self.ptr, body)) end
+
 function World:create_tool(fields)
   local id = ffi.new("mica_tool_id[1]")
   self:check(C.mica_tool_create(self.ptr, M.tool_def(fields), id))
@@ -175,6 +200,36 @@ function World:add_lpc(body, nodes, count, fields)
   local id = ffi.new("mica_lpc_id[1]")
   self:check(C.mica_add_lpc(self.ptr, body, nodes, count, M.lpc_def(fields), id))
   return id[0]
+end
+
+function World:remove_lpc(lpc) self:check(C.mica_lpc_remove(self.ptr, lpc)) end
+
+-- Picking: holds the nodes of `body` within `radius` (m) of `center` on a handle; with a tool
+-- id the handle follows that tool (forceps). Returns the constraint's id.
+function World:grab(body, center, radius, tool)
+  local id = ffi.new("mica_lpc_id[1]")
+  self:check(C.mica_lpc_grab(self.ptr, body, vec(center), radius, tool or C.MICA_NULL_ID, id))
+  return id[0]
+end
+
+-- Moves a grab's handle: position (m) and unit quaternion {w, x, y, z} (default identity).
+function World:set_handle_pose(lpc, position, orientation)
+  self:check(C.mica_lpc_set_handle_pose(self.ptr, lpc, vec(position), vec(orientation or { 1, 0, 0, 0 }, 4)))
+end
+
+function World:set_lpc_velocity(lpc, velocity) self:check(C.mica_lpc_set_velocity(self.ptr, lpc, vec(velocity))) end
+
+-- Target positions {x1, y1, z1, ...} (m), one per node of the constraint.
+function World:set_lpc_targets(lpc, targets)
+  assert(#targets % 3 == 0, "targets: 3 values a node")
+  self:check(C.mica_lpc_set_targets(self.ptr, lpc, ffi.new("double[?]", #targets, targets), #targets / 3))
+end
+
+-- The reaction force (double[3], N) of a constraint in the last step: the force on the holder.
+function World:lpc_reaction(lpc)
+  local force = ffi.new("double[3]")
+  self:check(C.mica_lpc_get_reaction(self.ptr, lpc, force))
+  return force
 end
 
 function World:set_tool_pose(tool, position, orientation)

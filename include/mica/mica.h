@@ -16,7 +16,14 @@
  *   generation, so an id whose object was destroyed is detected, never dereferenced.
  * - Definition structs start with `struct_size`. Fill them with the matching `*_default()`
  *   function (or `*_init()` from a foreign-function interface), then change what you need.
+ *   Upgrades within a major version are drop-in: the library accepts a def of any size from
+ *   its size in 0.2.0 (the first release) to its own, so a program built against an older 0.x
+ *   header runs unchanged, the fields its header lacked taking their defaults. A def larger
+ *   than the library's (a newer header than the library) is refused with MICA_ERR_STRUCT_SIZE.
  * - Threads: a world is used by one thread at a time. Each function says who may call it.
+ * - Each function lists the statuses it returns; any that allocates may also return
+ *   MICA_ERR_OUT_OF_MEMORY, and any may return MICA_ERR_INTERNAL (a bug in libmica: please report
+ *   it with the message).
  */
 #ifndef MICA_H
 #define MICA_H
@@ -24,8 +31,16 @@
 #include <stddef.h>
 #include <stdint.h>
 
+/* Exported functions. libmica is built and tested on Linux (GCC) only; the Windows branch is
+ * the usual DLL export/import for a future port, not a supported build. */
 #if defined(MICA_STATIC)
 #define MICA_API
+#elif defined(_WIN32)
+#if defined(MICA_BUILDING_LIBRARY)
+#define MICA_API __declspec(dllexport)
+#else
+#define MICA_API __declspec(dllimport)
+#endif
 #elif defined(MICA_BUILDING_LIBRARY)
 #define MICA_API __attribute__((visibility("default")))
 #else
@@ -47,7 +62,8 @@ extern "C" {
 /** major * 10000 + minor * 100 + patch */
 #define MICA_VERSION_NUMBER (MICA_VERSION_MAJOR * 10000 + MICA_VERSION_MINOR * 100 + MICA_VERSION_PATCH)
 
-/** The version of the library actually loaded, as MICA_VERSION_NUMBER. Any thread. */
+/** The version of the library actually loaded. Thread: any.
+ *  @return MICA_VERSION_NUMBER of the loaded libmica (major * 10000 + minor * 100 + patch). */
 MICA_API int32_t mica_version(void);
 /** @} */
 
@@ -78,7 +94,9 @@ typedef int32_t mica_status;
 #define MICA_ERR_OUT_OF_MEMORY (-15)   /**< an allocation failed */
 #define MICA_ERR_INTERNAL (-16)        /**< a bug in libmica: please report it with the message */
 
-/** Static text naming a status ("MICA_ERR_STALE_ID: ..."). Never NULL. Any thread. */
+/** Static text naming a status ("MICA_ERR_STALE_ID: ..."). Thread: any.
+ *  @param status any ::mica_status (unknown values get a generic text).
+ *  @return a static NUL-terminated string, never NULL. */
 MICA_API const char* mica_status_string(mica_status status);
 /** @} */
 
@@ -147,16 +165,17 @@ typedef struct mica_world_def {
   int32_t reserved1;       /**< zero */
   double body_margin;      /**< m: contacts between bodies are made for gaps below this; default 0.001 */
   double body_friction;    /**< Coulomb coefficient between bodies, >= 0; default 0 */
+  /* Since 0.3: */
   int32_t warm_start;      /**< MICA: 1 starts each step's iteration from the last step's velocities
                                 and impulses (matched by persistent contact keys); 0 from zero; default 1 */
   int32_t reserved2;       /**< zero */
-  /* Since 0.3: */
   double relaxation;       /**< MICA, Gauss-Seidel sweep: over-relaxation omega in (0, 2); default 1 (the paper) */
   /** Iterative solvers: > 0 stops the solve when the step has used this many milliseconds of
    *  wall-clock time; the step then completes with what the solver reached, mica_step returns
    *  MICA_WARN_NOT_CONVERGED and the statistics say out_of_time and the residual. Default 0: no budget. */
   double time_budget_ms;
   int32_t mica_sweep;      /**< MICA_SWEEP_*; default MICA_SWEEP_GAUSS_SEIDEL */
+  /* Since 0.4 (threads was reserved3 in 0.3: a 0.3 def gets the default, 1): */
   /** Threads for the step (rotations, element assembly, a colour-ordered Gauss-Seidel sweep):
    *  1 (default) runs the serial code and the paper's sweep order; 0 every CPU the process may
    *  run on; n > 1 starts n - 1 workers owned by the world (they sleep between steps). See
@@ -168,7 +187,7 @@ typedef struct mica_world_def {
    *  the new rotations, with a line search (docs/stability.md, K1). Default 1e-3. */
   double relinearise_tolerance;
   int32_t relinearise_max; /**< at most this many solves per step for that; < 2 turns the check off; default 8 */
-  /** Since 0.4. MICA_SWEEP_FACTORED on co-rotational bodies: every this many solves (one per
+  /** MICA_SWEEP_FACTORED on co-rotational bodies: every this many solves (one per
    *  step, more when a step is re-linearised) the factor is refreshed from the current system:
    *  copied, factored on a background thread (one per body) while the steps go on, and used from
    *  that many solves later (in lockstep: the step waits for a late factorization, so results do
@@ -184,32 +203,62 @@ typedef struct mica_world_def {
 } mica_world_def;
 
 /** Fills `def` with defaults, writing only its first `struct_size` bytes, and records
- *  `header_version`. This is the entry point for foreign-function interfaces; C and C++ use
- *  mica_world_def_default(). Returns MICA_ERR_STRUCT_SIZE if struct_size is too small. */
+ *  `header_version`. The entry point for foreign-function interfaces; C and C++ use
+ *  mica_world_def_default(). Thread: any.
+ *  @param def the def to fill.
+ *  @param struct_size sizeof(mica_world_def) as the caller compiled it: from its size in 0.2.0 up
+ *         to this library's.
+ *  @param header_version MICA_VERSION_NUMBER the caller compiled with.
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`def` is NULL); MICA_ERR_STRUCT_SIZE (`struct_size`
+ *          outside the accepted sizes: nothing is written). */
 MICA_API mica_status mica_world_def_init(mica_world_def* def, uint32_t struct_size,
                                          uint32_t header_version);
 
-/** The default world definition for the header you compiled with. */
+/** The default world definition for the header you compiled with. Thread: any.
+ *  @return a def with `struct_size` = sizeof(mica_world_def), `header_version` =
+ *          MICA_VERSION_NUMBER and every field at its default. Should the loaded library be older
+ *          than this header, the def keeps only those two fields and mica_world_create() refuses
+ *          it, naming its size. */
 static inline mica_world_def mica_world_def_default(void) {
   mica_world_def def;
+  /* Set before the call: should init refuse (a library older than this header), the def still
+   * names its size and mica_world_create says what is wrong. */
+  def.struct_size = (uint32_t)sizeof def;
+  def.header_version = MICA_VERSION_NUMBER;
   mica_world_def_init(&def, (uint32_t)sizeof def, MICA_VERSION_NUMBER);
   return def;
 }
 
-/** Creates a world. Fails with MICA_ERR_VERSION_MISMATCH when def->header_version has another
- *  major version than the library. On failure *out_world is NULL and
- *  mica_world_last_error(NULL) says why. Any thread. */
+/** Creates a world. On failure mica_world_last_error(NULL) says why. Thread: any; the world is then
+ *  used by one thread at a time.
+ *  @param def the definition (mica_world_def_default(), then changed); only its first
+ *         `def->struct_size` bytes are read (see the conventions at the top).
+ *  @param out_world receives the world; NULL on failure.
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`def` or `out_world` is NULL); MICA_ERR_STRUCT_SIZE
+ *          (`def->struct_size` is not one this library accepts); MICA_ERR_VERSION_MISMATCH
+ *          (`def->header_version` has another major version; any 0.x header works);
+ *          MICA_ERR_INVALID_ARGUMENT (a field outside its domain: the message names it);
+ *          MICA_ERR_OUT_OF_MEMORY. */
 MICA_API mica_status mica_world_create(const mica_world_def* def, mica_world** out_world);
 
-/** Destroys a world and everything in it. NULL is allowed. The world's thread. */
+/** Destroys a world and everything in it (its devices are stopped and closed first). Thread: the
+ *  world's; no other thread may be in a call on it (mica_device_poll() included).
+ *  @param world the world, or NULL (nothing happens). */
 MICA_API void mica_world_destroy(mica_world* world);
 
-/** The message of the last failed call on `world` ("body 0x...: tet 41 has zero volume"), or,
- *  for world == NULL, of the last failed call on this thread that had no world (creation).
- *  Empty when there was none. Valid until the next call on that world (or thread). */
+/** The message of the last failed call on `world` ("mica_body_create: tet 41 has zero volume"), or,
+ *  for world == NULL, of the last failed call on this thread that had no world (creation, the
+ *  *_init functions). Thread: the world's (NULL: any; each thread has its own).
+ *  @param world a world, or NULL.
+ *  @return the message, never NULL; empty when no call failed. Valid until the next call on that
+ *          world (or, for NULL, on this thread). */
 MICA_API const char* mica_world_last_error(const mica_world* world);
 
-/** Sets gravity (m/s^2). The world's thread. */
+/** Sets gravity. The world's thread (the one thread using the world at a time).
+ *  @param world the world.
+ *  @param gravity m/s^2, 3 values.
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` or a required pointer is NULL);
+ *          MICA_ERR_INVALID_ARGUMENT (a value is not finite). */
 MICA_API mica_status mica_world_set_gravity(mica_world* world, const double gravity[3]);
 /** @} */
 
@@ -235,89 +284,229 @@ typedef struct mica_body_def {
   double velocity[3];    /**< m/s, initial velocity of every node; default 0 */
 } mica_body_def;
 
-/** Fills `def` with defaults, writing only its first `struct_size` bytes. Any thread. */
+/** Fills `def` with defaults, writing only its first `struct_size` bytes. Thread: any.
+ *  @param def the def to fill.
+ *  @param struct_size sizeof(mica_body_def) as the caller compiled it.
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`def` is NULL); MICA_ERR_STRUCT_SIZE (`struct_size`
+ *          outside the accepted sizes: nothing is written). */
 MICA_API mica_status mica_body_def_init(mica_body_def* def, uint32_t struct_size);
 
-/** The default body definition. */
+/** The default body definition. Thread: any.
+ *  @return a def with `struct_size` = sizeof(mica_body_def) and every field at its default. */
 static inline mica_body_def mica_body_def_default(void) {
   mica_body_def def;
+  def.struct_size = (uint32_t)sizeof def; /* kept if init refuses: the create call names it */
   mica_body_def_init(&def, (uint32_t)sizeof def);
   return def;
 }
 
-/** Creates a body from caller arrays: `nodes` holds 3 * node_count coordinates (m),
- *  `tets` holds 4 * tet_count 0-based node indices, each tet with positive volume
- *  (det[X1-X0, X2-X0, X3-X0] > 0). The arrays are copied. The world's thread. */
+/** Creates a body from caller arrays. The arrays are copied. The world's thread (the one thread
+ *  using the world at a time).
+ *  @param world the world.
+ *  @param def the body's definition (mica_body_def_default(), then changed).
+ *  @param nodes 3 * `node_count` coordinates (m).
+ *  @param node_count number of nodes, >= 4.
+ *  @param tets 4 * `tet_count` 0-based node indices, each tet with positive volume (det[X1-X0,
+ *         X2-X0, X3-X0] > 0).
+ *  @param tet_count number of tets, >= 1.
+ *  @param out_body receives the body's id.
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` or a required pointer is NULL);
+ *          MICA_ERR_STRUCT_SIZE (`def->struct_size`); MICA_ERR_INVALID_ARGUMENT (a count, a def
+ *          field or a coordinate out of its domain); MICA_ERR_OUT_OF_RANGE (a node index outside
+ *          0..node_count-1); MICA_ERR_BAD_MESH (a degenerate or inverted tet);
+ *          MICA_ERR_OUT_OF_MEMORY. */
 MICA_API mica_status mica_body_create(mica_world* world, const mica_body_def* def,
                                       const double* nodes, int32_t node_count,
                                       const int32_t* tets, int32_t tet_count,
                                       mica_body_id* out_body);
 
-/** Creates a body from a mesh file: Gmsh .msh (2.2 or 4.1 ASCII) or a TetGen .node/.ele
- *  pair (either name). Only regular files of at most 256 MiB are read: a FIFO, a device (such
- *  as /dev/zero), a directory or a larger file gives MICA_ERR_IO. A mesh with a repeated tet,
- *  a face shared by three tets or no boundary surface gives MICA_ERR_BAD_MESH (as does
- *  mica_body_create). The world's thread. */
+/** Creates a body from a mesh file: Gmsh .msh (2.2 or 4.1 ASCII) or a TetGen .node/.ele pair
+ *  (either name). Only regular files of at most 256 MiB are read. The world's thread (the one
+ *  thread using the world at a time).
+ *  @param world the world.
+ *  @param def the body's definition.
+ *  @param path the file (UTF-8, as fopen takes it).
+ *  @param out_body receives the body's id.
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` or a required pointer is NULL);
+ *          MICA_ERR_STRUCT_SIZE (`def->struct_size`); MICA_ERR_INVALID_ARGUMENT (a def field);
+ *          MICA_ERR_UNSUPPORTED (an extension other than .msh, .node, .ele); MICA_ERR_IO (the file
+ *          cannot be read, or is a FIFO, a device such as /dev/zero, a directory or larger than
+ *          256 MiB); MICA_ERR_PARSE (the file is malformed: the message gives the line);
+ *          MICA_ERR_BAD_MESH (a degenerate or inverted tet, a repeated tet, a face shared by three
+ *          tets, or no boundary surface, as for mica_body_create); MICA_ERR_OUT_OF_MEMORY. */
 MICA_API mica_status mica_body_create_from_file(mica_world* world, const mica_body_def* def,
                                                 const char* path, mica_body_id* out_body);
 
-/** Creates a box [lo, hi] (m) meshed as cells[0] x cells[1] x cells[2] cubes cut into
- *  `tets_per_cell` (5 or 6) tetrahedra. The world's thread. */
+/** Creates a box [lo, hi] meshed as cells[0] x cells[1] x cells[2] cubes, each cut into
+ *  `tets_per_cell` tetrahedra. The world's thread (the one thread using the world at a time).
+ *  @param world the world.
+ *  @param def the body's definition.
+ *  @param lo the low corner (m).
+ *  @param hi the high corner (m), > lo on every axis.
+ *  @param cells cubes along x, y and z, each >= 1.
+ *  @param tets_per_cell 5 or 6.
+ *  @param out_body receives the body's id.
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` or a required pointer is NULL);
+ *          MICA_ERR_STRUCT_SIZE (`def->struct_size`); MICA_ERR_INVALID_ARGUMENT (corners, cell
+ *          counts, tets_per_cell or a def field); MICA_ERR_OUT_OF_MEMORY. */
 MICA_API mica_status mica_body_create_box(mica_world* world, const mica_body_def* def,
                                           const double lo[3], const double hi[3],
                                           const int32_t cells[3], int32_t tets_per_cell,
                                           mica_body_id* out_body);
 
-/** Destroys a body and the constraints on it. The world's thread. */
+/** Destroys a body and the constraints on it. The world's thread (the one thread using the world at
+ *  a time).
+ *  @param world the world.
+ *  @param body the body.
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` or a required pointer is NULL);
+ *          MICA_ERR_STALE_ID (`body` is null, of another kind or destroyed). */
 MICA_API mica_status mica_body_destroy(mica_world* world, mica_body_id body);
 
-/** Counts of a body's nodes, tets and surface triangles (any may be NULL). */
+/** Counts of a body's nodes, tets and surface triangles. The world's thread (the one thread using
+ *  the world at a time).
+ *  @param world the world (not changed).
+ *  @param body the body.
+ *  @param node_count receives the node count, or NULL.
+ *  @param tet_count receives the tet count, or NULL.
+ *  @param triangle_count receives the surface triangle count, or NULL.
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` or a required pointer is NULL);
+ *          MICA_ERR_STALE_ID (`body` is null, of another kind or destroyed). */
 MICA_API mica_status mica_body_get_counts(const mica_world* world, mica_body_id body,
                                           int32_t* node_count, int32_t* tet_count,
                                           int32_t* triangle_count);
 
-/** Read-back into caller buffers. `capacity` counts items (nodes or triangles), not doubles.
- *  With out == NULL only *out_count is written (the size query). With a buffer smaller
- *  than the result: MICA_ERR_BUFFER_TOO_SMALL, nothing copied, *out_count = needed. */
+/** Current positions (m), 3 doubles per node, copied into the caller's buffer. With out == NULL
+ *  only *out_count is written (the size query). The world's thread (the one thread using the world
+ *  at a time).
+ *  @param world the world (not changed).
+ *  @param body the body.
+ *  @param out the caller's buffer, or NULL to ask for the count only. @param capacity the buffer's
+ *         size in nodes (not in values). @param out_count receives the count (may be NULL when
+ *         `out` is not).
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` or a required pointer is NULL);
+ *          MICA_ERR_STALE_ID (`body` is null, of another kind or destroyed);
+ *          MICA_ERR_INVALID_ARGUMENT (`capacity` < 0); MICA_ERR_BUFFER_TOO_SMALL (`capacity` below
+ *          the count: nothing copied, `*out_count` = the count needed). */
 MICA_API mica_status mica_body_get_positions(const mica_world* world, mica_body_id body,
                                              double* out, int32_t capacity, int32_t* out_count);
-/** Current velocities (m/s), 3 doubles per node; as mica_body_get_positions(). */
+/** Current velocities (m/s), 3 doubles per node; as mica_body_get_positions(). The world's thread
+ *  (the one thread using the world at a time).
+ *  @param world the world (not changed).
+ *  @param body the body.
+ *  @param out the caller's buffer, or NULL to ask for the count only. @param capacity the buffer's
+ *         size in nodes (not in values). @param out_count receives the count (may be NULL when
+ *         `out` is not).
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` or a required pointer is NULL);
+ *          MICA_ERR_STALE_ID (`body` is null, of another kind or destroyed);
+ *          MICA_ERR_INVALID_ARGUMENT (`capacity` < 0); MICA_ERR_BUFFER_TOO_SMALL (`capacity` below
+ *          the count: nothing copied, `*out_count` = the count needed). */
 MICA_API mica_status mica_body_get_velocities(const mica_world* world, mica_body_id body,
                                               double* out, int32_t capacity, int32_t* out_count);
-/** Rest positions (m), 3 doubles per node; as mica_body_get_positions(). */
+/** Rest positions (m), 3 doubles per node; as mica_body_get_positions(). The world's thread (the
+ *  one thread using the world at a time).
+ *  @param world the world (not changed).
+ *  @param body the body.
+ *  @param out the caller's buffer, or NULL to ask for the count only. @param capacity the buffer's
+ *         size in nodes (not in values). @param out_count receives the count (may be NULL when
+ *         `out` is not).
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` or a required pointer is NULL);
+ *          MICA_ERR_STALE_ID (`body` is null, of another kind or destroyed);
+ *          MICA_ERR_INVALID_ARGUMENT (`capacity` < 0); MICA_ERR_BUFFER_TOO_SMALL (`capacity` below
+ *          the count: nothing copied, `*out_count` = the count needed). */
 MICA_API mica_status mica_body_get_rest_positions(const mica_world* world, mica_body_id body,
                                                   double* out, int32_t capacity,
                                                   int32_t* out_count);
-/** Surface triangles, 3 node indices each, counter-clockwise seen from outside. */
+/** Surface triangles, 3 node indices each, counter-clockwise seen from outside; as
+ *  mica_body_get_positions(). The world's thread (the one thread using the world at a time).
+ *  @param world the world (not changed).
+ *  @param body the body.
+ *  @param out the caller's buffer, or NULL to ask for the count only. @param capacity the buffer's
+ *         size in triangles (not in values). @param out_count receives the count (may be NULL when
+ *         `out` is not).
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` or a required pointer is NULL);
+ *          MICA_ERR_STALE_ID (`body` is null, of another kind or destroyed);
+ *          MICA_ERR_INVALID_ARGUMENT (`capacity` < 0); MICA_ERR_BUFFER_TOO_SMALL (`capacity` below
+ *          the count: nothing copied, `*out_count` = the count needed). */
 MICA_API mica_status mica_body_get_surface(const mica_world* world, mica_body_id body,
                                            int32_t* out, int32_t capacity, int32_t* out_count);
 
-/** Zero-copy view of the current positions: 3 * node_count doubles owned by the world,
- *  valid until the next mica_step or destruction of the body or world. */
+/** Zero-copy view of the current positions: 3 * node_count doubles owned by the world, valid until
+ *  the next mica_step() or the destruction of the body or the world. The world's thread (the one
+ *  thread using the world at a time).
+ *  @param world the world (not changed).
+ *  @param body the body.
+ *  @param out receives the pointer.
+ *  @param out_node_count receives the node count, or NULL.
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` or a required pointer is NULL);
+ *          MICA_ERR_STALE_ID (`body` is null, of another kind or destroyed). */
 MICA_API mica_status mica_body_positions_view(const mica_world* world, mica_body_id body,
                                               const double** out, int32_t* out_node_count);
 
-/** Sets persistent external forces (N) on nodes: `forces` holds 3 * count values for the
- *  nodes listed. They add to gravity until changed; zero forces remove them. */
+/** Sets persistent external forces (N) on nodes. They add to gravity until changed; zero forces
+ *  remove them. The world's thread (the one thread using the world at a time).
+ *  @param world the world.
+ *  @param body the body.
+ *  @param nodes `count` node indices (may be NULL when count is 0).
+ *  @param forces 3 * `count` values, N (may be NULL when count is 0).
+ *  @param count number of nodes, >= 0.
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` or a required pointer is NULL);
+ *          MICA_ERR_STALE_ID (`body` is null, of another kind or destroyed);
+ *          MICA_ERR_INVALID_ARGUMENT (`count` < 0 or a force not finite); MICA_ERR_OUT_OF_RANGE (a
+ *          node index outside the body). */
 MICA_API mica_status mica_body_set_node_forces(mica_world* world, mica_body_id body,
                                                const int32_t* nodes, const double* forces,
                                                int32_t count);
 
-/** Nodes inside the axis-aligned box [lo, hi] (m), in rest positions when `use_rest` is 1,
- *  else current. Buffer protocol as mica_body_get_positions(). */
+/** Nodes inside the axis-aligned box [lo, hi], in rest or current positions. Buffer protocol as
+ *  mica_body_get_positions(). The world's thread (the one thread using the world at a time).
+ *  @param world the world (not changed).
+ *  @param body the body.
+ *  @param lo the low corner (m).
+ *  @param hi the high corner (m).
+ *  @param use_rest 1: rest positions, 0: current positions.
+ *  @param out the caller's buffer, or NULL to ask for the count only. @param capacity the buffer's
+ *         size in nodes (not in values). @param out_count receives the count (may be NULL when
+ *         `out` is not).
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` or a required pointer is NULL);
+ *          MICA_ERR_STALE_ID (`body` is null, of another kind or destroyed);
+ *          MICA_ERR_INVALID_ARGUMENT (corners not finite, `use_rest` not 0 or 1, `capacity` < 0);
+ *          MICA_ERR_BUFFER_TOO_SMALL (nothing copied, `*out_count` = the count needed). */
 MICA_API mica_status mica_body_select_nodes_in_box(const mica_world* world, mica_body_id body,
                                                    const double lo[3], const double hi[3],
                                                    int32_t use_rest, int32_t* out,
                                                    int32_t capacity, int32_t* out_count);
-/** Nodes with (p - point) . normal <= tolerance (m), i.e. on the side the normal points away
- *  from, in rest positions when `use_rest` is 1. Buffer protocol as above. */
+/** Nodes with (p - point) . normal <= tolerance, i.e. on the side the normal points away from.
+ *  Buffer protocol as mica_body_get_positions(). The world's thread (the one thread using the world
+ *  at a time).
+ *  @param world the world (not changed).
+ *  @param body the body.
+ *  @param point a point of the plane (m).
+ *  @param normal the plane's normal (any non-zero length).
+ *  @param tolerance m, how far past the plane a node still counts.
+ *  @param use_rest 1: rest positions, 0: current positions.
+ *  @param out the caller's buffer, or NULL to ask for the count only. @param capacity the buffer's
+ *         size in nodes (not in values). @param out_count receives the count (may be NULL when
+ *         `out` is not).
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` or a required pointer is NULL);
+ *          MICA_ERR_STALE_ID (`body` is null, of another kind or destroyed);
+ *          MICA_ERR_INVALID_ARGUMENT (a value not finite, a zero normal, `use_rest` not 0 or 1,
+ *          `capacity` < 0); MICA_ERR_BUFFER_TOO_SMALL (nothing copied, `*out_count` = the count
+ *          needed). */
 MICA_API mica_status mica_body_select_nodes_by_plane(const mica_world* world, mica_body_id body,
                                                      const double point[3], const double normal[3],
                                                      double tolerance, int32_t use_rest,
                                                      int32_t* out, int32_t capacity,
                                                      int32_t* out_count);
 
-/** Total kinetic, elastic and gravitational potential energy of a body (J). */
+/** Total kinetic, elastic and gravitational potential energy of a body (J). The world's thread (the
+ *  one thread using the world at a time).
+ *  @param world the world (not changed).
+ *  @param body the body.
+ *  @param kinetic receives the kinetic energy, or NULL.
+ *  @param elastic receives the elastic energy, or NULL.
+ *  @param potential receives the gravitational potential energy, or NULL.
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` or a required pointer is NULL);
+ *          MICA_ERR_STALE_ID (`body` is null, of another kind or destroyed). */
 MICA_API mica_status mica_body_get_energy(const mica_world* world, mica_body_id body,
                                           double* kinetic, double* elastic, double* potential);
 /** @} */
@@ -339,54 +528,121 @@ typedef struct mica_lpc_def {
   double velocity[3];    /**< m/s, prescribed velocity of the constrained components; default 0 */
 } mica_lpc_def;
 
-/** Fills `def` with defaults, writing only its first `struct_size` bytes. Any thread. */
+/** Fills `def` with defaults, writing only its first `struct_size` bytes. Thread: any.
+ *  @param def the def to fill.
+ *  @param struct_size sizeof(mica_lpc_def) as the caller compiled it.
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`def` is NULL); MICA_ERR_STRUCT_SIZE (`struct_size`
+ *          outside the accepted sizes: nothing is written). */
 MICA_API mica_status mica_lpc_def_init(mica_lpc_def* def, uint32_t struct_size);
 
-/** The default constraint definition (fixed, zero velocity). */
+/** The default constraint definition (fixed, zero velocity). Thread: any.
+ *  @return a def with `struct_size` = sizeof(mica_lpc_def) and every field at its default. */
 static inline mica_lpc_def mica_lpc_def_default(void) {
   mica_lpc_def def;
+  def.struct_size = (uint32_t)sizeof def; /* kept if init refuses: the create call names it */
   mica_lpc_def_init(&def, (uint32_t)sizeof def);
   return def;
 }
 
-/** Adds a projection constraint on `count` nodes of `body`. Where constraints overlap on a
- *  node, the constrained directions add up and the later constraint's velocity wins on its
- *  directions. The world's thread. */
+/** Adds a projection constraint on nodes of a body. Where constraints overlap on a node, the
+ *  constrained directions add up and the later constraint's velocity wins on its directions. The
+ *  world's thread (the one thread using the world at a time).
+ *  @param world the world.
+ *  @param body the body.
+ *  @param nodes `count` node indices.
+ *  @param count number of nodes, >= 1.
+ *  @param def the constraint (mica_lpc_def_default(), then changed).
+ *  @param out_lpc receives the constraint's id.
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` or a required pointer is NULL);
+ *          MICA_ERR_STALE_ID (`body` is null, of another kind or destroyed); MICA_ERR_STRUCT_SIZE
+ *          (`def->struct_size`); MICA_ERR_INVALID_ARGUMENT (`count` < 1, an unknown kind, a zero or
+ *          parallel direction, a velocity not finite); MICA_ERR_OUT_OF_RANGE (a node index outside
+ *          the body). */
 MICA_API mica_status mica_add_lpc(mica_world* world, mica_body_id body, const int32_t* nodes,
                                   int32_t count, const mica_lpc_def* def, mica_lpc_id* out_lpc);
 
-/** Removes a constraint. The world's thread. */
+/** Removes a constraint. The world's thread (the one thread using the world at a time).
+ *  @param world the world.
+ *  @param lpc the constraint.
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` or a required pointer is NULL);
+ *          MICA_ERR_STALE_ID (`lpc` is null, of another kind or destroyed). */
 MICA_API mica_status mica_lpc_remove(mica_world* world, mica_lpc_id lpc);
 
-/** Changes the prescribed velocity (m/s) of a constraint's constrained components (and drops
- *  any targets or handle it had). The world's thread. */
+/** Changes the prescribed velocity of a constraint's constrained components (and drops any targets
+ *  or handle it had). The world's thread (the one thread using the world at a time).
+ *  @param world the world.
+ *  @param lpc the constraint.
+ *  @param velocity m/s, 3 values.
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` or a required pointer is NULL);
+ *          MICA_ERR_STALE_ID (`lpc` is null, of another kind or destroyed);
+ *          MICA_ERR_INVALID_ARGUMENT (a value not finite). */
 MICA_API mica_status mica_lpc_set_velocity(mica_world* world, mica_lpc_id lpc, const double velocity[3]);
 
-/** Gives each node of the constraint a target position (m): every step the constrained
- *  components move so that the node reaches its target in that step. `targets` holds
- *  3 * count values, count = the constraint's node count. The world's thread. */
+/** Gives each node of the constraint a target position: every step the constrained components move
+ *  so that the node reaches its target in that step. The world's thread (the one thread using the
+ *  world at a time).
+ *  @param world the world.
+ *  @param lpc the constraint.
+ *  @param targets 3 * `count` values, m.
+ *  @param count the constraint's node count.
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` or a required pointer is NULL);
+ *          MICA_ERR_STALE_ID (`lpc` is null, of another kind or destroyed);
+ *          MICA_ERR_INVALID_ARGUMENT (`count` is not the constraint's node count, a value not
+ *          finite). */
 MICA_API mica_status mica_lpc_set_targets(mica_world* world, mica_lpc_id lpc, const double* targets,
                                           int32_t count);
 
-/** Picking: holds every node of `body` within `radius` (m) of `center` (m, current positions)
- *  on a handle, fully constrained (S = 0). The handle starts at `center` and moves with
- *  mica_lpc_set_handle_pose(); given a tool (not MICA_NULL_ID), it follows that tool's pose
- *  instead, like forceps. Release with mica_lpc_remove(). The world's thread. */
+/** Picking: holds every node of `body` within `radius` of `center` (current positions) on a handle,
+ *  fully constrained (S = 0). The handle starts at `center` and moves with
+ *  mica_lpc_set_handle_pose(); given a tool, it follows that tool's pose instead, like forceps.
+ *  Release with mica_lpc_remove(). The world's thread (the one thread using the world at a time).
+ *  @param world the world.
+ *  @param body the body.
+ *  @param center m.
+ *  @param radius m, > 0.
+ *  @param tool a tool whose pose the handle follows, or MICA_NULL_ID for a hand-held handle.
+ *  @param out_lpc receives the constraint's id.
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` or a required pointer is NULL);
+ *          MICA_ERR_STALE_ID (`body`, or a non-null `tool`, is stale); MICA_ERR_INVALID_ARGUMENT
+ *          (centre or radius not finite, radius <= 0, no node within the radius). */
 MICA_API mica_status mica_lpc_grab(mica_world* world, mica_body_id body, const double center[3], double radius,
                                    mica_tool_id tool, mica_lpc_id* out_lpc);
 
-/** Moves a grab's handle: position (m) and unit quaternion (w, x, y, z). The held nodes keep
- *  their offsets in the handle frame. The world's thread. */
+/** Moves a grab's handle. The held nodes keep their offsets in the handle frame. The world's thread
+ *  (the one thread using the world at a time).
+ *  @param world the world.
+ *  @param lpc the constraint (from mica_lpc_grab() without a tool).
+ *  @param position m.
+ *  @param orientation unit quaternion (w, x, y, z).
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` or a required pointer is NULL);
+ *          MICA_ERR_STALE_ID (`lpc` is null, of another kind or destroyed); MICA_ERR_WRONG_STATE
+ *          (the constraint has no handle, or its handle follows a tool); MICA_ERR_INVALID_ARGUMENT
+ *          (a value not finite, a zero quaternion). */
 MICA_API mica_status mica_lpc_set_handle_pose(mica_world* world, mica_lpc_id lpc, const double position[3],
                                               const double orientation[4]);
 
-/** The nodes a constraint holds; buffer protocol as mica_body_get_positions(). */
+/** The nodes a constraint holds; buffer protocol as mica_body_get_positions(). The world's thread
+ *  (the one thread using the world at a time).
+ *  @param world the world (not changed).
+ *  @param lpc the constraint.
+ *  @param out the caller's buffer, or NULL to ask for the count only. @param capacity the buffer's
+ *         size in nodes (not in values). @param out_count receives the count (may be NULL when
+ *         `out` is not).
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` or a required pointer is NULL);
+ *          MICA_ERR_STALE_ID (`lpc` is null, of another kind or destroyed);
+ *          MICA_ERR_INVALID_ARGUMENT (`capacity` < 0); MICA_ERR_BUFFER_TOO_SMALL (`capacity` below
+ *          the count: nothing copied, `*out_count` = the count needed). */
 MICA_API mica_status mica_lpc_get_nodes(const mica_world* world, mica_lpc_id lpc, int32_t* out, int32_t capacity,
                                         int32_t* out_count);
 
-/** Reaction force (N) of a constraint group of the last step: the force on whoever holds the
- *  constraint (the user's hand in a grasp). Lifting a grasped region up against gravity gives
- *  a downward force. The world's thread. */
+/** Reaction force of a constraint group in the last step: the force on whoever holds the constraint
+ *  (the user's hand in a grasp). Lifting a grasped region up against gravity gives a downward
+ *  force. The world's thread (the one thread using the world at a time).
+ *  @param world the world (not changed).
+ *  @param lpc the constraint.
+ *  @param out_force receives the force, N.
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` or a required pointer is NULL);
+ *          MICA_ERR_STALE_ID (`lpc` is null, of another kind or destroyed). */
 MICA_API mica_status mica_lpc_get_reaction(const mica_world* world, mica_lpc_id lpc, double out_force[3]);
 /** @} */
 
@@ -417,30 +673,68 @@ typedef struct mica_tool_def {
   int32_t reserved0;     /**< zero */
 } mica_tool_def;
 
-/** Fills `def` with defaults, writing only its first `struct_size` bytes. Any thread. */
+/** Fills `def` with defaults, writing only its first `struct_size` bytes. Thread: any.
+ *  @param def the def to fill.
+ *  @param struct_size sizeof(mica_tool_def) as the caller compiled it.
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`def` is NULL); MICA_ERR_STRUCT_SIZE (`struct_size`
+ *          outside the accepted sizes: nothing is written). */
 MICA_API mica_status mica_tool_def_init(mica_tool_def* def, uint32_t struct_size);
 
-/** The default tool definition (a 1 cm sphere at the origin). */
+/** The default tool definition (a 1 cm sphere at the origin). Thread: any.
+ *  @return a def with `struct_size` = sizeof(mica_tool_def) and every field at its default. */
 static inline mica_tool_def mica_tool_def_default(void) {
   mica_tool_def def;
+  def.struct_size = (uint32_t)sizeof def; /* kept if init refuses: the create call names it */
   mica_tool_def_init(&def, (uint32_t)sizeof def);
   return def;
 }
 
 /** Creates a tool. Every solver handles its contacts (MICA; DIRECT and PCG through the Delassus
- *  matrix). The world's thread. */
+ *  matrix). The world's thread (the one thread using the world at a time).
+ *  @param world the world.
+ *  @param def the tool (mica_tool_def_default(), then changed).
+ *  @param out_tool receives the tool's id.
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` or a required pointer is NULL) (also
+ *          `def->hull_points` for a hull); MICA_ERR_STRUCT_SIZE (`def->struct_size`);
+ *          MICA_ERR_INVALID_ARGUMENT (an unknown shape, a size, pose, margin or friction out of its
+ *          domain, 4..64 hull points). */
 MICA_API mica_status mica_tool_create(mica_world* world, const mica_tool_def* def, mica_tool_id* out_tool);
-/** Destroys a tool. The world's thread. */
+/** Destroys a tool. The world's thread (the one thread using the world at a time).
+ *  @param world the world.
+ *  @param tool the tool.
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` or a required pointer is NULL);
+ *          MICA_ERR_STALE_ID (`tool` is null, of another kind or destroyed); MICA_ERR_WRONG_STATE
+ *          (a device drives the tool: destroy it first). */
 MICA_API mica_status mica_tool_destroy(mica_world* world, mica_tool_id tool);
-/** Moves a tool: position (m) and unit quaternion (w, x, y, z) for the next step. The world's thread. */
+/** Moves a tool for the next step. The world's thread (the one thread using the world at a time).
+ *  @param world the world.
+ *  @param tool the tool.
+ *  @param position m.
+ *  @param orientation unit quaternion (w, x, y, z).
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` or a required pointer is NULL);
+ *          MICA_ERR_STALE_ID (`tool` is null, of another kind or destroyed);
+ *          MICA_ERR_INVALID_ARGUMENT (a value not finite, a zero quaternion). */
 MICA_API mica_status mica_tool_set_pose(mica_world* world, mica_tool_id tool, const double position[3],
                                         const double orientation[4]);
-/** The tool's current pose: position (m) and unit quaternion (w, x, y, z); either may be NULL.
- *  A tool driven by a device takes the device's pose at each step. The world's thread. */
+/** The tool's current pose. A tool driven by a device takes the device's pose at each step. The
+ *  world's thread (the one thread using the world at a time).
+ *  @param world the world (not changed).
+ *  @param tool the tool.
+ *  @param out_position receives the position (m), or NULL.
+ *  @param out_orientation receives the unit quaternion (w, x, y, z), or NULL.
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` or a required pointer is NULL);
+ *          MICA_ERR_STALE_ID (`tool` is null, of another kind or destroyed). */
 MICA_API mica_status mica_tool_get_pose(const mica_world* world, mica_tool_id tool, double out_position[3],
                                         double out_orientation[4]);
-/** Force (N) and torque about the tool origin (N m) the bodies put on the tool in the last step,
- *  and the number of active contacts; any output may be NULL. The world's thread. */
+/** Force and torque the bodies put on the tool in the last step, and its active contacts. The
+ *  world's thread (the one thread using the world at a time).
+ *  @param world the world (not changed).
+ *  @param tool the tool.
+ *  @param out_force receives the force (N), or NULL.
+ *  @param out_torque receives the torque about the tool origin (N m), or NULL.
+ *  @param out_contacts receives the number of active contacts, or NULL.
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` or a required pointer is NULL);
+ *          MICA_ERR_STALE_ID (`tool` is null, of another kind or destroyed). */
 MICA_API mica_status mica_tool_get_force(const mica_world* world, mica_tool_id tool, double out_force[3],
                                          double out_torque[3], int32_t* out_contacts);
 /** @} */
@@ -448,12 +742,17 @@ MICA_API mica_status mica_tool_get_force(const mica_world* world, mica_tool_id t
 /** @name Stepping
  *  @{ */
 
-/** Advances the world by `dt` seconds (1e-9 <= dt <= 1; a shorter step would take forces,
- *  impulse / dt, out of double precision) with one implicit step.
- *  Returns MICA_WARN_NOT_CONVERGED when an iterative solver stopped at its cap (the step is
- *  kept; see mica_world_get_stats()), MICA_ERR_NUMERICAL when the result (positions,
- *  velocities, tool forces, constraint reactions) was not finite. A step that fails is undone
- *  whole: tool poses taken from devices and the solvers' schedules included. The world's thread. */
+/** Advances the world by one implicit step. The world's thread (the one thread using the world at a
+ *  time).
+ *  @param world the world.
+ *  @param dt the step, s: 1e-9 <= dt <= 1 (a shorter step would take forces, impulse / dt, out of
+ *         double precision).
+ *  @return MICA_OK; MICA_WARN_NOT_CONVERGED (an iterative solver stopped at its cap or its time
+ *          budget: the step is kept, mica_world_get_stats() says how far it got); or
+ *          MICA_ERR_NULL_ARGUMENT (`world` is NULL); MICA_ERR_INVALID_ARGUMENT (`dt` out of range);
+ *          MICA_ERR_NUMERICAL (the result - positions, velocities, tool forces, constraint
+ *          reactions - was not finite); MICA_ERR_OUT_OF_MEMORY. A step that fails is undone whole:
+ *          tool poses taken from devices and the solvers' schedules included. */
 MICA_API mica_status mica_step(mica_world* world, double dt);
 /** @} */
 
@@ -493,21 +792,40 @@ typedef struct mica_world_stats {
   mica_stage_stats stages[MICA_STAGE_COUNT]; /**< indexed by MICA_STAGE_* */
 } mica_world_stats;
 
-/** Copies the statistics into `out`, writing at most out->struct_size bytes (set it first).
- *  The world's thread. */
+/** Copies the statistics of the last step and since creation into `out`, writing at most
+ *  `out->struct_size` bytes (set it first). The world's thread (the one thread using the world at a
+ *  time).
+ *  @param world the world (not changed).
+ *  @param out the caller's struct, its `struct_size` set.
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` or a required pointer is NULL);
+ *          MICA_ERR_STRUCT_SIZE (`out->struct_size` smaller than the fields before `stages` or
+ *          larger than this library's). */
 MICA_API mica_status mica_world_get_stats(const mica_world* world, mica_world_stats* out);
 
-/** Static name of a stage ("gravity", "rotations", ...), or "unknown". Any thread. */
+/** Static name of a stage ("gravity", "rotations", ...). Thread: any.
+ *  @param stage a MICA_STAGE_* value.
+ *  @return a static string, "unknown" for any other value. */
 MICA_API const char* mica_stage_name(int32_t stage);
 /** @} */
 
 /** @name Output
  *  @{ */
-/** Writes one body (current positions, velocities and displacements) as a VTK legacy
- *  unstructured grid that ParaView opens. The world's thread. */
+/** Writes one body (current positions, velocities and displacements) as a VTK legacy unstructured
+ *  grid that ParaView opens. The world's thread (the one thread using the world at a time).
+ *  @param world the world (not changed).
+ *  @param body the body.
+ *  @param path the file to write (replaced if it exists).
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` or a required pointer is NULL);
+ *          MICA_ERR_STALE_ID (`body` is null, of another kind or destroyed); MICA_ERR_IO (the file
+ *          cannot be written). */
 MICA_API mica_status mica_body_write_vtk(const mica_world* world, mica_body_id body,
                                          const char* path);
-/** Writes every body of the world into one VTK file (cell scalar "piece" = body order). */
+/** Writes every body of the world into one VTK file (cell scalar "piece" = body order). The world's
+ *  thread (the one thread using the world at a time).
+ *  @param world the world (not changed).
+ *  @param path the file to write (replaced if it exists).
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` or a required pointer is NULL); MICA_ERR_IO
+ *          (the file cannot be written). */
 MICA_API mica_status mica_world_write_vtk(const mica_world* world, const char* path);
 /** @} */
 

@@ -118,43 +118,84 @@ typedef struct mica_device_def {
   double hand_damping;       /**< N s/m; default 5 */
 } mica_device_def;
 
-/** Fills `def` with defaults, writing only its first `struct_size` bytes. Any thread. */
+/** Fills `def` with defaults, writing only its first `struct_size` bytes. Thread: any.
+ *  @param def the def to fill.
+ *  @param struct_size sizeof(mica_device_def) as the caller compiled it.
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`def` is NULL); MICA_ERR_STRUCT_SIZE (`struct_size`
+ *          outside the accepted sizes: nothing is written). */
 MICA_API mica_status mica_device_def_init(mica_device_def* def, uint32_t struct_size);
 
-/** The default device definition (a null device). */
+/** The default device definition (a null device). Thread: any.
+ *  @return a def with `struct_size` = sizeof(mica_device_def) and every field at its default. */
 static inline mica_device_def mica_device_def_default(void) {
   mica_device_def def;
+  def.struct_size = (uint32_t)sizeof def; /* kept if init refuses: the create call names it */
   mica_device_def_init(&def, (uint32_t)sizeof def);
   return def;
 }
 
-/** Creates and opens a device. A missing OpenHaptics library gives MICA_ERR_DEVICE with a
- *  message naming the path tried; so do device figures that are not finite and positive, or
- *  absurd (docs/haptics.md). The world's thread; other threads may meanwhile read the world's
- *  other devices with mica_device_get_stats, mica_device_get_info and mica_device_poll. */
+/** Creates and opens a device. Thread: the world's; other threads may meanwhile read the world's
+ *  other devices with mica_device_get_stats, mica_device_get_info and mica_device_poll.
+ *  @param world the world.
+ *  @param def the device (mica_device_def_default(), then changed).
+ *  @param out_device receives the device's id.
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world`, `def`, `out_device`, or the callback table
+ *          a backend needs, is NULL); MICA_ERR_STALE_ID (`def->tool` is not MICA_NULL_ID and
+ *          stale); MICA_ERR_STRUCT_SIZE (`def->struct_size` or the callback table's);
+ *          MICA_ERR_INVALID_ARGUMENT (an unknown backend or force mode, a mapping, filter or safety
+ *          value out of its domain); MICA_ERR_IO or MICA_ERR_PARSE (the simulated device's
+ *          trajectory CSV); MICA_ERR_DEVICE (the device failed to open - a missing OpenHaptics
+ *          library names the path tried - or its figures are not finite and positive, or absurd:
+ *          docs/haptics.md). */
 MICA_API mica_status mica_device_create(mica_world* world, const mica_device_def* def, mica_device_id* out_device);
 
 /** Stops, closes and destroys a device; waits for a mica_device_get_stats, _get_info or _poll
- *  running on it on another thread to return. The world's thread. */
+ *  running on it on another thread to return. Thread: the world's (not the servo thread).
+ *  @param world the world.
+ *  @param device the device.
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` is NULL); MICA_ERR_STALE_ID (`device` is
+ *          null, of another kind or destroyed). */
 MICA_API mica_status mica_device_destroy(mica_world* world, mica_device_id device);
 
-/** The device's description. Any thread but the servo thread. */
+/** The device's description. Thread: any but the servo thread.
+ *  @param world the world.
+ *  @param device the device.
+ *  @param out receives the description (the whole struct).
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` or `out` is NULL); MICA_ERR_STALE_ID
+ *          (`device` is null, of another kind or destroyed). */
 MICA_API mica_status mica_device_get_info(const mica_world* world, mica_device_id device, mica_device_info* out);
 
-/** One servo cycle: read the device, map it onto its tool, evaluate the force model, filter,
- *  apply the safety limits, write the force, and return the state read and the force sent
- *  (device frame, N); either output may be NULL. The servo thread only, concurrently with
- *  mica_step() on the simulation thread: it never allocates, locks or blocks. A device
- *  failure, a non-finite reading or a jump back in time sends zero force and returns a
- *  status (MICA_ERR_DEVICE) without disturbing the simulation; so does a reading whose
- *  orientation is not a unit quaternion, or whose pose is not finite (or beyond 1e6 m) once mapped into the scene. */
+/** One servo cycle: read the device, map it onto its tool, evaluate the force model, filter, apply
+ *  the safety limits, write the force. It never allocates, locks or blocks. A device failure, a
+ *  non-finite reading, a jump back in time, an orientation that is not a unit quaternion or a pose
+ *  not finite (or beyond 1e6 m) once mapped into the scene sends zero force and returns
+ *  MICA_ERR_DEVICE without disturbing the simulation. No message is recorded (the world's message
+ *  belongs to the simulation thread). Thread: the servo thread only (one), concurrently with
+ *  mica_step() on the simulation thread.
+ *  @param world the world.
+ *  @param device the device.
+ *  @param out_state receives the state read (device frame), or NULL.
+ *  @param out_force receives the force sent (device frame, N), or NULL.
+ *  @return MICA_OK; MICA_WARN_DEVICE (the device reported a warning); or MICA_ERR_NULL_ARGUMENT
+ *          (`world` is NULL); MICA_ERR_STALE_ID (`device`); MICA_ERR_DEVICE (the cycle failed: zero
+ *          force sent). */
 MICA_API mica_status mica_device_poll(mica_world* world, mica_device_id device, mica_device_state* out_state,
                                       double out_force[3]);
 
-/** Runs mica_device_poll() at 1 kHz on an internal thread (or the backend's own scheduler,
- *  for the Touch). The world's thread. */
+/** Runs mica_device_poll() at 1 kHz on an internal thread (or the backend's own scheduler, for the
+ *  Touch); nothing happens when it already runs. Thread: the world's.
+ *  @param world the world.
+ *  @param device the device.
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` is NULL); MICA_ERR_STALE_ID (`device` is
+ *          null, of another kind or destroyed); MICA_ERR_OUT_OF_MEMORY or MICA_ERR_INTERNAL (the
+ *          thread could not be started). */
 MICA_API mica_status mica_device_start(mica_world* world, mica_device_id device);
-/** Stops the servo loop started by mica_device_start() and waits for it. The world's thread. */
+/** Stops the servo loop started by mica_device_start() and waits for it (nothing happens when it is
+ *  not running). Thread: the world's.
+ *  @param world the world.
+ *  @param device the device.
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` is NULL); MICA_ERR_STALE_ID (`device` is
+ *          null, of another kind or destroyed). */
 MICA_API mica_status mica_device_stop(mica_world* world, mica_device_id device);
 
 /** Servo statistics of a device. */
@@ -169,7 +210,14 @@ typedef struct mica_device_stats {
   double last_raw_force[3]; /**< N, the last force of the model before filtering and limits (device frame) */
 } mica_device_stats;
 
-/** Copies the servo statistics, writing at most out->struct_size bytes. Any thread. */
+/** Copies the servo statistics, writing at most `out->struct_size` bytes (set it first). No message
+ *  is recorded. Thread: any.
+ *  @param world the world.
+ *  @param device the device.
+ *  @param out the caller's struct, its `struct_size` set.
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` or `out` is NULL); MICA_ERR_STALE_ID
+ *          (`device` is null, of another kind or destroyed); MICA_ERR_STRUCT_SIZE
+ *          (`out->struct_size` smaller than 4 or larger than this library's). */
 MICA_API mica_status mica_device_get_stats(const mica_world* world, mica_device_id device, mica_device_stats* out);
 
 #ifdef __cplusplus

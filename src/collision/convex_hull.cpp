@@ -117,7 +117,7 @@ std::shared_ptr<const HullData> build_convex_hull(const Vec3List& points, const 
           }
         const std::vector<int> ring = convex_polygon(flat);
         if (ring.size() < 3) continue;
-        HullFace face{normal, offset, {}};
+        HullFace face{normal, offset, {}, {}};
         for (int r : ring) {
           face.polygon.push_back(points[index[r]]);
           corners |= uint64_t(1) << index[r];

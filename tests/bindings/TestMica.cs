@@ -320,6 +320,33 @@ static class TestMica
         }
     }
 
+    // User code in its own assembly: a mesh from a file, and an id from the raw layer wrapped.
+    static void LoaderAndRawIds()
+    {
+        string mesh = Path.Combine(Environment.GetEnvironmentVariable("MICA_SOURCE_DIR"), "tests", "data", "cube_v22.msh");
+        using (var world = new World(Mica.WorldDef()))
+        {
+            var body = world.CreateBodyFromFile(mesh, Mica.BodyDef());
+            int nodes, tets, triangles;
+            body.GetCounts(out nodes, out tets, out triangles);
+            Expect(nodes > 0 && tets > 0 && triangles > 0, "the mesh's counts");
+            try { world.CreateBodyFromFile(Path.Combine(Path.GetDirectoryName(mesh), "no_such_mesh.msh"), Mica.BodyDef()); throw new Exception("no exception"); }
+            catch (MicaException e) { Expect(e.Status == MicaNative.MICA_ERR_IO, "a missing file: " + e.Status); }
+
+            var tdef = Mica.ToolDef();
+            ulong raw;
+            Mica.Check(MicaNative.mica_tool_create(world.Handle, ref tdef, out raw), world.Handle);
+            var tool = new Tool(world, raw);
+            tool.SetPose(new double[] { 0, 2, 0 });
+            double[] p = new double[3], q = new double[4];
+            tool.GetPose(p, q);
+            Expect(p[1] == 2, "a wrapped raw tool id");
+            var same = new Body(world, body.Id);
+            same.GetCounts(out nodes, out tets, out triangles);
+            Expect(tets > 0, "a wrapped body id");
+        }
+    }
+
     sealed class Stylus : DeviceBackend
     {
         public int Reads, Writes, Opened, Closed;
@@ -378,6 +405,7 @@ static class TestMica
         Test("errors, the log callback and the SafeHandle", Errors);
         Test("sphere indent matches C to 1e-9", SphereIndent);
         Test("a device backend in C#", DeviceBackendInCSharp);
+        Test("a mesh file and raw ids, from another assembly", LoaderAndRawIds);
         Console.WriteLine("{0} passed, {1} failed, {2} skipped", passed, failed, skipped);
         return failed == 0 ? 0 : 1;
     }

@@ -11,7 +11,11 @@ if [ ! -f "$MICA_MANIFEST_TSV" ]; then
   exit 77
 fi
 runtime=$MICA_SOURCE_DIR/bindings/csharp/com.libmica.mica/Runtime
+# Two assemblies, as Unity builds them: the package's Runtime/ (its asmdef, LibMica) and the
+# user's code referencing it, which sees only what the binding makes public.
+dll=$MICA_TEST_WORK_DIR/LibMica.dll
 exe=$MICA_TEST_WORK_DIR/TestMica.exe
-mcs -nologo -warnaserror+ -unsafe -langversion:7.2 -out:"$exe" "$runtime"/*.cs "$1"
-# [DllImport("mica")] resolves to libmica.so on the library path.
+mcs -nologo -warnaserror+ -unsafe -langversion:7.2 -target:library -out:"$dll" "$runtime"/*.cs
+mcs -nologo -warnaserror+ -unsafe -langversion:7.2 -r:"$dll" -out:"$exe" "$1"
+# [DllImport("mica")] resolves to libmica.so on the library path; mono finds LibMica.dll beside the exe.
 LD_LIBRARY_PATH=$MICA_LIBRARY_DIR${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH} exec mono --debug "$exe"

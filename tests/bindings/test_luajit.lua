@@ -228,5 +228,37 @@ test("a device with Lua callbacks", function()
   world:close()
 end)
 
+test("loaders, grasp and constraint helpers", function()
+  local world = mica.world{ gravity = { 0, -9.81, 0 } }
+  local mesh = os.getenv("MICA_SOURCE_DIR") .. "/tests/data/cube_v22.msh"
+  local cube = world:create_body_from_file(mesh)
+  local counts = ffi.new("int32_t[3]")
+  world:check(C.mica_body_get_counts(world.ptr, cube, counts, counts + 1, counts + 2))
+  expect(counts[0] > 0 and counts[1] > 0, "the mesh's counts")
+  local ok, err = pcall(world.create_body_from_file, world, os.getenv("MICA_SOURCE_DIR") .. "/tests/data/no_such.msh")
+  expect(not ok and err.status == C.MICA_ERR_IO, "a missing file raises MICA_ERR_IO")
+  local tet = world:create_body({ 2, 0, 0, 3, 0, 0, 2, 1, 0, 2, 0, 1 }, { 0, 1, 2, 3 })
+  world:destroy_body(tet)
+
+  -- A grab lifted against gravity: the holder feels the body's weight, downward.
+  local box = world:create_box({ 0, 0, 0 }, { 0.1, 0.1, 0.1 }, { 2, 2, 2 }, 5)
+  local grab = world:grab(box, { 0.05, 0.1, 0.05 }, 0.06)
+  for k = 1, 5 do
+    world:set_handle_pose(grab, { 0.05, 0.1 + 0.001 * k, 0.05 })
+    world:step(0.01)
+  end
+  expect(world:lpc_reaction(grab)[1] < 0, "the grab's reaction points down")
+  world:remove_lpc(grab)
+  local bottom, n = world:select_nodes_by_plane(box, { 0, 0, 0 }, { 0, 1, 0 })
+  local clamp = world:add_lpc(box, bottom, n)
+  world:set_lpc_velocity(clamp, { 0, 0, 0 })
+  local targets = {}
+  for i = 0, n - 1 do targets[#targets + 1] = 0; targets[#targets + 1] = 0; targets[#targets + 1] = 0 end
+  world:set_lpc_targets(clamp, targets)
+  world:step(0.01)
+  world:remove_lpc(clamp)
+  world:close()
+end)
+
 print(string.format("%d passed, %d failed, %d skipped", passed, failed, skipped))
 os.exit(failed == 0 and 0 or 1)

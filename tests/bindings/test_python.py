@@ -199,16 +199,67 @@ class Behaviour(unittest.TestCase):
 
         view, body = make()
         gc.collect()
-        self.assertFalse(view.flags.writeable)
-        self.assertFalse(view.flags.owndata)
+        self.assertIsInstance(view, mica.PositionsView)
+        self.assertTrue(view.valid)
+        self.assertEqual(view.shape, (27, 3))
+        self.assertEqual(len(view), 27)
+        self.assertIs(view.world, body.world)
         np.testing.assert_array_equal(view, body.get_positions())
-        self.assertIs(view.base.world, body.world)
+        # No copy: the view reads the world's own buffer, the same one each time.
         view2 = body.positions
-        self.assertEqual(view.__array_interface__["data"][0], view2.__array_interface__["data"][0])
-        body.world.step(0.01)  # the documented rule: fetch the view again after a step
+        self.assertEqual(view._raw.__array_interface__["data"][0], view2._raw.__array_interface__["data"][0])
+        self.assertFalse(view._raw.flags.writeable)
+        # What leaves the view is a copy: writing to it does not touch the world.
+        column = view[:, 1]
+        column[:] = 42.0
+        self.assertNotEqual(body.get_positions()[0, 1], 42.0)
+        snapshot = np.asarray(view)
+        body.world.step(0.01)  # the documented rule: take the view again after a step
         np.testing.assert_array_equal(body.positions, body.get_positions())
         self.assertLess(body.positions[:, 1].min(), 0)
+        self.assertLess(body.positions.min(axis=0)[1], 0)
+        self.assertEqual(snapshot[0, 1], 0.0)  # the snapshot taken before the step did not change
         body.world.close()
+
+    def test_type_hints(self):
+        # Every public method of the object layer is annotated, and the annotations resolve.
+        import inspect
+        import typing
+        for cls in (mica.World, mica.Body, mica.Tool, mica.Lpc, mica.Device, mica.PositionsView, mica.DeviceBackend):
+            for name, fn in inspect.getmembers(cls, inspect.isfunction):
+                if name.startswith("_") and name not in ("__init__", "__getitem__", "__len__", "__array__"):
+                    continue
+                if name in ("min", "max", "mean", "sum"):  # numpy's signatures, forwarded
+                    continue
+                hints = typing.get_type_hints(fn, vars(mica))
+                self.assertIn("return", hints, "%s.%s has no return annotation" % (cls.__name__, name))
+        self.assertIs(typing.get_type_hints(mica.World.create_box, vars(mica))["return"], mica.Body)
+
+    def test_positions_view_raises_once_invalid(self):
+        world = mica.World()
+        body = world.create_box((0, 0, 0), (1, 1, 1), (2, 2, 2))
+        other = world.create_box((2, 0, 0), (3, 1, 1), (2, 2, 2))
+        view = body.positions
+        world.step(0.01)
+        self.assertFalse(view.valid)
+        for read in (lambda: view[0], lambda: np.asarray(view), lambda: view.max(), lambda: view.copy()):
+            with self.assertRaises(mica.MicaError) as caught:
+                read()
+            self.assertEqual(caught.exception.status, mica.MICA_ERR_WRONG_STATE)
+            self.assertIn("take body.positions again", str(caught.exception))
+        view = other.positions
+        body.destroy()
+        with self.assertRaises(mica.MicaError):
+            view[0]
+        view = other.positions
+        self.assertTrue(view.valid)
+        world.close()  # the world's memory is freed: the view must not read it
+        self.assertFalse(view.valid)
+        with self.assertRaises(mica.MicaError) as caught:
+            view[:, 1].max()
+        self.assertEqual(caught.exception.status, mica.MICA_ERR_WRONG_STATE)
+        self.assertIn("closed", str(caught.exception))
+        self.assertIn("invalid", repr(view))
 
     def test_constraints_and_grab(self):
         with mica.World(gravity=(0, 0, 0)) as world:

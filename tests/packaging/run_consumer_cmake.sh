@@ -26,7 +26,11 @@ case "$mica_dir" in
 esac
 
 # The imported target carries the library's location: the build RPATH finds libmica.so.
+unset LD_LIBRARY_PATH
 "$work/app"
+# Installed with INSTALL_RPATH_USE_LINK_PATH, the program still finds it.
+"$cmake" --install "$work" --prefix "$work/installed"
+"$work/installed/bin/app"
 # The static library is exercised too when it was installed (MICA_BUILD_STATIC=ON).
 if [ -x "$work/app_static" ]; then
   "$work/app_static"

@@ -6,7 +6,7 @@
         tool = world.create_tool(radius=0.02, position=(0, 0.125, 0))
         world.step(0.01)
         force, torque, contacts = tool.force()
-        p = cube.positions          # numpy (n, 3) view: valid until the next step
+        p = cube.positions          # (n, 3) view, no copy: valid until the next step (then it raises)
 
 The library is found through $MICA_LIBRARY, else next to a build tree holding this package,
 else ctypes.util.find_library("mica") (see mica._native.find_library). The raw C API is in
@@ -19,11 +19,14 @@ returns False instead of True.
 
 Threads: a World is used by one thread at a time; Device.poll() runs on the servo thread.
 """
+from __future__ import annotations
+
 import ctypes
 import os
 import sys
 import warnings
 from ctypes import POINTER, byref, c_double, c_int32, c_void_p, sizeof
+from typing import Any, Callable, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -32,10 +35,17 @@ from ._native import MICA_VERSION_NUMBER
 
 _HERE = os.path.dirname(os.path.abspath(__file__))
 
+# Type hints: a 3-vector (any sequence of floats or a numpy array), a quaternion (w, x, y, z),
+# an (n, k) array or nested sequences, a file path.
+Vec3 = Sequence[float]
+Quat = Sequence[float]
+ArrayLike = Union[np.ndarray, Sequence[Any]]
+PathLike = Union[str, "os.PathLike[str]"]
+
 # Every MICA_* constant at the package level too (mica.MICA_SOLVER_MICA).
 globals().update({k: v for k, v in vars(native).items() if k.startswith("MICA_")})
 
-__all__ = ["MicaError", "MicaWarning", "World", "Body", "Tool", "Lpc", "Device", "DeviceBackend",
+__all__ = ["MicaError", "MicaWarning", "World", "Body", "Tool", "Lpc", "Device", "DeviceBackend", "PositionsView",
            "version", "world_def", "body_def", "lpc_def", "tool_def", "device_def", "native"]
 
 
@@ -77,7 +87,7 @@ def _caller_level():
     return level
 
 
-def version():
+def version() -> int:
     """The version of the loaded library, as MICA_VERSION_NUMBER (major*10000 + minor*100 + patch)."""
     return native.mica_version()
 
@@ -108,35 +118,35 @@ def _fill(struct, fields):
 
 # The defs are filled by the *_init functions with this side's sizeof, so a newer library
 # sees exactly the fields this binding knows.
-def world_def(**fields):
+def world_def(**fields: Any) -> native.mica_world_def:
     """A mica_world_def with the library's defaults, then `fields` (gravity=(0, 0, 0), ...)."""
     d = native.mica_world_def()
     _check(native.mica_world_def_init(byref(d), sizeof(d), MICA_VERSION_NUMBER), None, "mica_world_def_init")
     return _fill(d, fields)
 
 
-def body_def(**fields):
+def body_def(**fields: Any) -> native.mica_body_def:
     """A mica_body_def with the library's defaults, then `fields`."""
     d = native.mica_body_def()
     _check(native.mica_body_def_init(byref(d), sizeof(d)), None, "mica_body_def_init")
     return _fill(d, fields)
 
 
-def lpc_def(**fields):
+def lpc_def(**fields: Any) -> native.mica_lpc_def:
     """A mica_lpc_def with the library's defaults, then `fields`."""
     d = native.mica_lpc_def()
     _check(native.mica_lpc_def_init(byref(d), sizeof(d)), None, "mica_lpc_def_init")
     return _fill(d, fields)
 
 
-def tool_def(**fields):
+def tool_def(**fields: Any) -> native.mica_tool_def:
     """A mica_tool_def with the library's defaults, then `fields`."""
     d = native.mica_tool_def()
     _check(native.mica_tool_def_init(byref(d), sizeof(d)), None, "mica_tool_def_init")
     return _fill(d, fields)
 
 
-def device_def(**fields):
+def device_def(**fields: Any) -> native.mica_device_def:
     """A mica_device_def with the library's defaults, then `fields`."""
     d = native.mica_device_def()
     _check(native.mica_device_def_init(byref(d), sizeof(d)), None, "mica_device_def_init")
@@ -154,13 +164,90 @@ def _id_of(obj):
     return getattr(obj, "id", obj) if obj is not None else native.MICA_NULL_ID
 
 
-class _PositionsView:
-    """Exposes the world's position buffer to numpy without a copy and keeps the world alive."""
+class _RawBuffer:
+    """The world's position buffer for numpy, without a copy (used only inside PositionsView)."""
 
-    def __init__(self, world, address, node_count):
-        self.world = world
+    def __init__(self, address, node_count):
         self.__array_interface__ = {"shape": (node_count, 3), "typestr": "<f8", "data": (address, True),
                                     "version": 3}
+
+
+class PositionsView:
+    """A body's current positions (m), (n, 3), read from the world's own buffer without copying
+    it (mica_body_positions_view).
+
+    The buffer belongs to the world: a step, destroying the body or closing the world
+    invalidates it. A view therefore checks, on every read, that none of these happened since it
+    was taken, and raises MicaError (MICA_ERR_WRONG_STATE) otherwise: it never reads freed
+    memory and never changes under you. Take body.positions again after each step.
+
+    Indexing (view[:, 1], view[k]) reads only the selected part, as a new array; numpy
+    functions and np.asarray(view) get a copy of the whole (a snapshot that stays valid);
+    min(), max(), mean(), sum() and copy() work on the view directly. It keeps its World alive.
+    """
+
+    __array_priority__ = 1  # numpy converts it through __array__ in mixed arithmetic
+
+    def __init__(self, world: World, body_id: int, address: int, node_count: int) -> None:
+        self.world = world
+        self.body_id = body_id
+        self._epoch = world._view_epoch
+        self._raw = np.asarray(_RawBuffer(address, node_count)) if node_count else np.empty((0, 3))
+        self._raw.flags.writeable = False
+
+    @property
+    def valid(self) -> bool:
+        """False once a step, the body's destruction or the world's closing invalidated it."""
+        return not self.world.closed and self.world._view_epoch == self._epoch
+
+    def _array(self):
+        if self.world.closed:
+            raise MicaError(native.MICA_ERR_WRONG_STATE,
+                            "the world of this positions view was closed: the view's memory is gone")
+        if self.world._view_epoch != self._epoch:
+            raise MicaError(native.MICA_ERR_WRONG_STATE,
+                            "the world stepped (or destroyed a body) since this positions view was taken: "
+                            "take body.positions again")
+        return self._raw
+
+    shape = property(lambda self: self._raw.shape)
+    dtype = property(lambda self: self._raw.dtype)
+    ndim = property(lambda self: self._raw.ndim)
+    size = property(lambda self: self._raw.size)
+
+    def __len__(self) -> int:
+        return len(self._raw)
+
+    def __array__(self, dtype: Any = None, copy: Optional[bool] = None) -> np.ndarray:
+        return np.array(self._array(), dtype=dtype, copy=True)
+
+    def __getitem__(self, key: Any) -> Any:
+        part = self._array()[key]
+        return part.copy() if isinstance(part, np.ndarray) else part
+
+    def __iter__(self):
+        return iter(self.copy())
+
+    def copy(self) -> np.ndarray:
+        """A copy of the positions (n, 3) that stays valid."""
+        return self._array().copy()
+
+    def min(self, *args, **kwargs):
+        return self._array().min(*args, **kwargs)
+
+    def max(self, *args, **kwargs):
+        return self._array().max(*args, **kwargs)
+
+    def mean(self, *args, **kwargs):
+        return self._array().mean(*args, **kwargs)
+
+    def sum(self, *args, **kwargs):
+        return self._array().sum(*args, **kwargs)
+
+    def __repr__(self):
+        if not self.valid:
+            return "PositionsView(invalid: take body.positions again)"
+        return "PositionsView(%r)" % (self._raw,)
 
 
 class World:
@@ -170,7 +257,8 @@ class World:
     ...); `log` is an optional callable(level, message) for the library's messages.
     """
 
-    def __init__(self, definition=None, log=None, **fields):
+    def __init__(self, definition: Optional[native.mica_world_def] = None,
+                 log: Optional[Callable[[int, str], None]] = None, **fields: Any) -> None:
         d = definition if definition is not None else world_def()
         _fill(d, fields)
         self._keepalive = []  # callbacks the library may call while the world exists
@@ -182,27 +270,29 @@ class World:
         handle = c_void_p()
         _check(native.mica_world_create(byref(d), byref(handle)), None, "mica_world_create")
         self._handle = handle
+        self._view_epoch = 0  # advanced by whatever invalidates positions views (PositionsView)
 
     # --- lifetime
     @property
-    def handle(self):
+    def handle(self) -> c_void_p:
         """The mica_world* as a c_void_p; raises if the world was closed."""
         if self._handle is None:
             raise MicaError(native.MICA_ERR_WRONG_STATE, "the world is closed")
         return self._handle
 
     @property
-    def closed(self):
+    def closed(self) -> bool:
         return self._handle is None
 
-    def close(self):
+    def close(self) -> None:
         """Destroys the world and everything in it. Views and ids from it become invalid."""
         if getattr(self, "_handle", None) is not None:
+            self._view_epoch += 1
             native.mica_world_destroy(self._handle)
             self._handle = None
             self._keepalive = []
 
-    def __enter__(self):
+    def __enter__(self) -> World:
         return self
 
     def __exit__(self, *exc):
@@ -218,30 +308,34 @@ class World:
         return _check(status, self.handle, function)
 
     @property
-    def last_error(self):
+    def last_error(self) -> str:
         return (native.mica_world_last_error(self.handle) or b"").decode(errors="replace")
 
     # --- world
-    def step(self, dt):
+    def step(self, dt: float) -> bool:
         """Advances by dt seconds. Returns True, or False (and warns) when the solver stopped
-        at its iteration cap. Every positions view taken before is invalid afterwards."""
-        return self._check(native.mica_step(self.handle, dt), "mica_step") == native.MICA_OK
+        at its iteration cap. Every positions view taken before is invalid afterwards (reading
+        it raises)."""
+        handle = self.handle
+        self._view_epoch += 1  # even a failed step may have touched the buffers
+        return self._check(native.mica_step(handle, dt), "mica_step") == native.MICA_OK
 
-    def set_gravity(self, gravity):
+    def set_gravity(self, gravity: Vec3) -> None:
         self._check(native.mica_world_set_gravity(self.handle, _doubles(gravity, 3)), "mica_world_set_gravity")
 
-    def stats(self):
+    def stats(self) -> native.mica_world_stats:
         """A mica_world_stats of the last step (stages indexed by MICA_STAGE_*)."""
         s = native.mica_world_stats()
         s.struct_size = sizeof(s)
         self._check(native.mica_world_get_stats(self.handle, byref(s)), "mica_world_get_stats")
         return s
 
-    def write_vtk(self, path):
+    def write_vtk(self, path: PathLike) -> None:
         self._check(native.mica_world_write_vtk(self.handle, str(path).encode()), "mica_world_write_vtk")
 
     # --- creation
-    def create_body(self, nodes, tets, definition=None, **fields):
+    def create_body(self, nodes: ArrayLike, tets: ArrayLike, definition: Optional[native.mica_body_def] = None,
+                    **fields: Any) -> Body:
         """A body from nodes (n, 3) in m and tets (m, 4) of 0-based indices."""
         d = _fill(definition if definition is not None else body_def(), fields)
         nodes = np.ascontiguousarray(nodes, dtype=np.float64).reshape(-1, 3)
@@ -252,14 +346,17 @@ class World:
                                             byref(out)), "mica_body_create")
         return Body(self, out.value)
 
-    def create_body_from_file(self, path, definition=None, **fields):
+    def create_body_from_file(self, path: PathLike, definition: Optional[native.mica_body_def] = None,
+                              **fields: Any) -> Body:
+        """A body from a mesh file: Gmsh .msh (2.2 or 4.1 ASCII) or a TetGen .node/.ele pair."""
         d = _fill(definition if definition is not None else body_def(), fields)
         out = native.mica_body_id()
         self._check(native.mica_body_create_from_file(self.handle, byref(d), str(path).encode(), byref(out)),
                     "mica_body_create_from_file")
         return Body(self, out.value)
 
-    def create_box(self, lo, hi, cells, tets_per_cell=5, definition=None, **fields):
+    def create_box(self, lo: Vec3, hi: Vec3, cells: Sequence[int], tets_per_cell: int = 5,
+                   definition: Optional[native.mica_body_def] = None, **fields: Any) -> Body:
         """A box [lo, hi] (m) of cells[0] x cells[1] x cells[2] cubes, 5 or 6 tets each."""
         d = _fill(definition if definition is not None else body_def(), fields)
         c = (c_int32 * 3)(*cells)
@@ -268,7 +365,8 @@ class World:
                                                 tets_per_cell, byref(out)), "mica_body_create_box")
         return Body(self, out.value)
 
-    def create_tool(self, definition=None, hull_points=None, **fields):
+    def create_tool(self, definition: Optional[native.mica_tool_def] = None, hull_points: Optional[ArrayLike] = None,
+                    **fields: Any) -> Tool:
         """A kinematic tool; fields of mica_tool_def (shape, radius, position, ...)."""
         d = _fill(definition if definition is not None else tool_def(), fields)
         if hull_points is not None:
@@ -279,7 +377,9 @@ class World:
         self._check(native.mica_tool_create(self.handle, byref(d), byref(out)), "mica_tool_create")
         return Tool(self, out.value)
 
-    def create_device(self, backend=None, tool=None, trajectory=None, definition=None, **fields):
+    def create_device(self, backend: Optional[DeviceBackend] = None, tool: Optional[Tool] = None,
+                      trajectory: Optional[Callable[[float], Vec3]] = None,
+                      definition: Optional[native.mica_device_def] = None, **fields: Any) -> Device:
         """A haptic device driving `tool`. `backend` is a DeviceBackend (its methods become the
         callback table) or None for the def's backend (MICA_DEVICE_NULL by default);
         `trajectory` is a callable t -> (x, y, z) for a simulated device."""
@@ -305,7 +405,7 @@ class World:
 class _Object:
     """An object of a world, named by its 64-bit id; it holds a reference to the World."""
 
-    def __init__(self, world, id_):
+    def __init__(self, world: World, id_: int) -> None:
         self.world = world
         self.id = id_
 
@@ -332,7 +432,7 @@ def _read_items(call, width, dtype):
 class Body(_Object):
     """A deformable (or static) body."""
 
-    def counts(self):
+    def counts(self) -> Tuple[int, int, int]:
         """(node_count, tet_count, triangle_count)."""
         n, t, tri = c_int32(), c_int32(), c_int32()
         self.world._check(native.mica_body_get_counts(self.world.handle, self.id, byref(n), byref(t), byref(tri)),
@@ -340,49 +440,49 @@ class Body(_Object):
         return n.value, t.value, tri.value
 
     @property
-    def positions(self):
-        """Read-only numpy (n, 3) view of the current positions (m), no copy. It keeps the World
-        alive but is valid only until the next step (or the body's or world's destruction):
-        fetch it again after every step, or copy it (get_positions())."""
+    def positions(self) -> PositionsView:
+        """A PositionsView of the current positions (m), (n, 3): read from the world's buffer
+        without copying it, valid until the next step, the body's destruction or the world's
+        closing, after which reading it raises MicaError. Take it again after every step, or
+        keep a copy (get_positions(), view.copy())."""
         ptr, n = POINTER(c_double)(), c_int32()
         self.world._check(native.mica_body_positions_view(self.world.handle, self.id, byref(ptr), byref(n)),
                           "mica_body_positions_view")
-        if n.value == 0:
-            return np.empty((0, 3))
-        return np.asarray(_PositionsView(self.world, ctypes.cast(ptr, c_void_p).value, n.value))
+        return PositionsView(self.world, self.id, ctypes.cast(ptr, c_void_p).value, n.value)
 
     def _get(self, fn, width, dtype, name):
         w = self.world
         return _read_items(lambda out, cap, cnt: w._check(fn(w.handle, self.id, out, cap, cnt), name), width, dtype)
 
-    def get_positions(self):
+    def get_positions(self) -> np.ndarray:
         """A copy of the current positions (m), (n, 3)."""
         return self._get(native.mica_body_get_positions, 3, np.float64, "mica_body_get_positions")
 
-    def velocities(self):
+    def velocities(self) -> np.ndarray:
         return self._get(native.mica_body_get_velocities, 3, np.float64, "mica_body_get_velocities")
 
-    def rest_positions(self):
+    def rest_positions(self) -> np.ndarray:
         return self._get(native.mica_body_get_rest_positions, 3, np.float64, "mica_body_get_rest_positions")
 
-    def surface(self):
+    def surface(self) -> np.ndarray:
         """Surface triangles (k, 3), counter-clockwise seen from outside."""
         return self._get(native.mica_body_get_surface, 3, np.int32, "mica_body_get_surface")
 
-    def select_nodes_in_box(self, lo, hi, use_rest=True):
+    def select_nodes_in_box(self, lo: Vec3, hi: Vec3, use_rest: bool = True) -> np.ndarray:
         w, lo, hi = self.world, _doubles(lo, 3), _doubles(hi, 3)
         return _read_items(lambda out, cap, cnt: w._check(native.mica_body_select_nodes_in_box(
             w.handle, self.id, lo, hi, int(use_rest), out, cap, cnt), "mica_body_select_nodes_in_box"),
             1, np.int32).ravel()
 
-    def select_nodes_by_plane(self, point, normal, tolerance=1e-9, use_rest=True):
+    def select_nodes_by_plane(self, point: Vec3, normal: Vec3, tolerance: float = 1e-9,
+                              use_rest: bool = True) -> np.ndarray:
         """Nodes with (p - point) . normal <= tolerance."""
         w, p, nrm = self.world, _doubles(point, 3), _doubles(normal, 3)
         return _read_items(lambda out, cap, cnt: w._check(native.mica_body_select_nodes_by_plane(
             w.handle, self.id, p, nrm, tolerance, int(use_rest), out, cap, cnt), "mica_body_select_nodes_by_plane"),
             1, np.int32).ravel()
 
-    def set_node_forces(self, nodes, forces):
+    def set_node_forces(self, nodes: ArrayLike, forces: ArrayLike) -> None:
         nodes = np.ascontiguousarray(nodes, dtype=np.int32).ravel()
         forces = np.ascontiguousarray(forces, dtype=np.float64).reshape(-1, 3)
         if len(forces) != len(nodes):
@@ -391,14 +491,14 @@ class Body(_Object):
             self.world.handle, self.id, nodes.ctypes.data_as(POINTER(c_int32)),
             forces.ctypes.data_as(POINTER(c_double)), len(nodes)), "mica_body_set_node_forces")
 
-    def energy(self):
+    def energy(self) -> Tuple[float, float, float]:
         """(kinetic, elastic, potential) in J."""
         k, e, p = c_double(), c_double(), c_double()
         self.world._check(native.mica_body_get_energy(self.world.handle, self.id, byref(k), byref(e), byref(p)),
                           "mica_body_get_energy")
         return k.value, e.value, p.value
 
-    def add_lpc(self, nodes, definition=None, **fields):
+    def add_lpc(self, nodes: ArrayLike, definition: Optional[native.mica_lpc_def] = None, **fields: Any) -> Lpc:
         """A projection constraint on `nodes` (kind=MICA_LPC_FIXED by default)."""
         d = _fill(definition if definition is not None else lpc_def(), fields)
         nodes = np.ascontiguousarray(nodes, dtype=np.int32).ravel()
@@ -407,75 +507,76 @@ class Body(_Object):
                                               len(nodes), byref(d), byref(out)), "mica_add_lpc")
         return Lpc(self.world, out.value)
 
-    def grab(self, center, radius, tool=None):
+    def grab(self, center: Vec3, radius: float, tool: Optional[Tool] = None) -> Lpc:
         """Holds the nodes within `radius` of `center` on a handle (following `tool` if given)."""
         out = native.mica_lpc_id()
         self.world._check(native.mica_lpc_grab(self.world.handle, self.id, _doubles(center, 3), radius,
                                                _id_of(tool), byref(out)), "mica_lpc_grab")
         return Lpc(self.world, out.value)
 
-    def write_vtk(self, path):
+    def write_vtk(self, path: PathLike) -> None:
         self.world._check(native.mica_body_write_vtk(self.world.handle, self.id, str(path).encode()),
                           "mica_body_write_vtk")
 
-    def destroy(self):
+    def destroy(self) -> None:
+        self.world._view_epoch += 1  # positions views of this body lose their buffer
         self.world._check(native.mica_body_destroy(self.world.handle, self.id), "mica_body_destroy")
 
 
 class Lpc(_Object):
     """A linear projection constraint group (fixed nodes, a plane, a grab)."""
 
-    def set_velocity(self, velocity):
+    def set_velocity(self, velocity: Vec3) -> None:
         self.world._check(native.mica_lpc_set_velocity(self.world.handle, self.id, _doubles(velocity, 3)),
                           "mica_lpc_set_velocity")
 
-    def set_targets(self, targets):
+    def set_targets(self, targets: ArrayLike) -> None:
         t = np.ascontiguousarray(targets, dtype=np.float64).reshape(-1, 3)
         self.world._check(native.mica_lpc_set_targets(self.world.handle, self.id,
                                                       t.ctypes.data_as(POINTER(c_double)), len(t)),
                           "mica_lpc_set_targets")
 
-    def set_handle_pose(self, position, orientation=(1, 0, 0, 0)):
+    def set_handle_pose(self, position: Vec3, orientation: Quat = (1, 0, 0, 0)) -> None:
         self.world._check(native.mica_lpc_set_handle_pose(self.world.handle, self.id, _doubles(position, 3),
                                                           _doubles(orientation, 4)), "mica_lpc_set_handle_pose")
 
-    def nodes(self):
+    def nodes(self) -> np.ndarray:
         w = self.world
         return _read_items(lambda out, cap, cnt: w._check(native.mica_lpc_get_nodes(w.handle, self.id, out, cap, cnt),
                                                           "mica_lpc_get_nodes"), 1, np.int32).ravel()
 
-    def reaction(self):
+    def reaction(self) -> np.ndarray:
         """Reaction force (N) of the last step, as a numpy 3-vector."""
         f = (c_double * 3)()
         self.world._check(native.mica_lpc_get_reaction(self.world.handle, self.id, f), "mica_lpc_get_reaction")
         return np.array(f[:])
 
-    def remove(self):
+    def remove(self) -> None:
         self.world._check(native.mica_lpc_remove(self.world.handle, self.id), "mica_lpc_remove")
 
 
 class Tool(_Object):
     """A kinematic rigid tool: the host sets its pose, the bodies push back on it."""
 
-    def set_pose(self, position, orientation=(1, 0, 0, 0)):
+    def set_pose(self, position: Vec3, orientation: Quat = (1, 0, 0, 0)) -> None:
         self.world._check(native.mica_tool_set_pose(self.world.handle, self.id, _doubles(position, 3),
                                                     _doubles(orientation, 4)), "mica_tool_set_pose")
 
-    def pose(self):
+    def pose(self) -> Tuple[np.ndarray, np.ndarray]:
         """(position m, orientation quaternion w, x, y, z) as numpy vectors; a tool driven by a
         device takes the device's pose at each step."""
         p, q = (c_double * 3)(), (c_double * 4)()
         self.world._check(native.mica_tool_get_pose(self.world.handle, self.id, p, q), "mica_tool_get_pose")
         return np.array(p[:]), np.array(q[:])
 
-    def force(self):
+    def force(self) -> Tuple[np.ndarray, np.ndarray, int]:
         """(force N, torque N m, contacts) of the last step; force and torque as numpy 3-vectors."""
         f, t, n = (c_double * 3)(), (c_double * 3)(), c_int32()
         self.world._check(native.mica_tool_get_force(self.world.handle, self.id, f, t, byref(n)),
                           "mica_tool_get_force")
         return np.array(f[:]), np.array(t[:]), n.value
 
-    def destroy(self):
+    def destroy(self) -> None:
         self.world._check(native.mica_tool_destroy(self.world.handle, self.id), "mica_tool_destroy")
 
 
@@ -491,20 +592,20 @@ class DeviceBackend:
 
     error = None
 
-    def open(self):
+    def open(self) -> None:
         pass
 
-    def close(self):
+    def close(self) -> None:
         pass
 
-    def info(self, out):
+    def info(self, out: native.mica_device_info) -> None:
         """Fill `out` (a mica_device_info); leave this method alone to use libmica's defaults."""
 
-    def read_state(self, state):
+    def read_state(self, state: native.mica_device_state) -> None:
         """Fill `state` (a mica_device_state: position, orientation, velocity, buttons, timestamp)."""
         raise NotImplementedError
 
-    def write_force(self, force, torque):
+    def write_force(self, force: Tuple[float, float, float], torque: Tuple[float, float, float]) -> None:
         """Render `force` (N) and `torque` (N m), both 3-tuples in the device frame."""
         raise NotImplementedError
 
@@ -537,11 +638,11 @@ class Device(_Object):
     """A haptic device driving a tool. poll() is the servo cycle: call it on the servo thread
     (or start() libmica's own 1 kHz loop)."""
 
-    def __init__(self, world, id_, backend=None):
+    def __init__(self, world: World, id_: int, backend: Optional[DeviceBackend] = None) -> None:
         super().__init__(world, id_)
         self.backend = backend
 
-    def poll(self):
+    def poll(self) -> Tuple[native.mica_device_state, np.ndarray]:
         """One servo cycle: returns (mica_device_state read, force sent as a numpy 3-vector).
         A failing device (zero force sent) raises MicaError without a message: the world's
         last error belongs to the simulation thread. Warnings (MICA_WARN_DEVICE) are not
@@ -554,23 +655,23 @@ class Device(_Object):
             raise MicaError(status, "", "mica_device_poll")
         return s, np.array(f[:])
 
-    def start(self):
+    def start(self) -> None:
         self.world._check(native.mica_device_start(self.world.handle, self.id), "mica_device_start")
 
-    def stop(self):
+    def stop(self) -> None:
         self.world._check(native.mica_device_stop(self.world.handle, self.id), "mica_device_stop")
 
-    def info(self):
+    def info(self) -> native.mica_device_info:
         i = native.mica_device_info()
         i.struct_size = sizeof(i)
         self.world._check(native.mica_device_get_info(self.world.handle, self.id, byref(i)), "mica_device_get_info")
         return i
 
-    def stats(self):
+    def stats(self) -> native.mica_device_stats:
         s = native.mica_device_stats()
         s.struct_size = sizeof(s)
         self.world._check(native.mica_device_get_stats(self.world.handle, self.id, byref(s)), "mica_device_get_stats")
         return s
 
-    def destroy(self):
+    def destroy(self) -> None:
         self.world._check(native.mica_device_destroy(self.world.handle, self.id), "mica_device_destroy")

@@ -369,6 +369,13 @@ def _candidates():
     for _ in range(4):
         d = os.path.dirname(d)
         found += [os.path.join(d, n) for n in names if os.path.exists(os.path.join(d, n))]
+    # An installed package: cmake --install wrote where it put libmica (mica/_install.py).
+    try:
+        from ._install import LIBDIR
+    except ImportError:
+        LIBDIR = None
+    if LIBDIR:
+        found += [os.path.join(LIBDIR, n) for n in names[:2] if os.path.exists(os.path.join(LIBDIR, n))]
     system = ctypes.util.find_library("mica")
     if system:
         found.append(system)
@@ -377,7 +384,8 @@ def _candidates():
 
 def find_library():
     """The path libmica is loaded from: $MICA_LIBRARY, else a libmica up to four folders above
-    this package (a build tree), else ctypes.util.find_library("mica")."""
+    this package (a build tree), else the library installed with this package (mica/_install.py,
+    written by cmake --install), else ctypes.util.find_library("mica")."""
     c = _candidates()
     if not c:
         raise OSError("libmica not found: set MICA_LIBRARY to the path of libmica.so")

@@ -246,6 +246,16 @@ namespace LibMica
             return new Body(this, id);
         }
 
+        /// <summary>A body from a mesh file: Gmsh .msh (2.2 or 4.1 ASCII) or a TetGen .node/.ele
+        /// pair (either name), as mica_body_create_from_file.</summary>
+        public Body CreateBodyFromFile(string path, MicaNative.mica_body_def def)
+        {
+            if (path == null) throw new ArgumentNullException("path");
+            ulong id;
+            Check(MicaNative.mica_body_create_from_file(Handle, ref def, Mica.Utf8z(path), out id));
+            return new Body(this, id);
+        }
+
         public Tool CreateTool(MicaNative.mica_tool_def def)
         {
             ulong id;
@@ -279,7 +289,8 @@ namespace LibMica
         public readonly World World;
         public readonly ulong Id;
 
-        internal Body(World world, ulong id) { World = world; Id = id; }
+        /// <summary>Wraps a body id of `world` (one the raw MicaNative calls returned).</summary>
+        public Body(World world, ulong id) { World = world; Id = id; }
 
         public void GetCounts(out int nodes, out int tets, out int triangles)
         {
@@ -372,7 +383,8 @@ namespace LibMica
         public readonly World World;
         public readonly ulong Id;
 
-        internal Lpc(World world, ulong id) { World = world; Id = id; }
+        /// <summary>Wraps a constraint id of `world` (one the raw MicaNative calls returned).</summary>
+        public Lpc(World world, ulong id) { World = world; Id = id; }
 
         public void SetVelocity(double[] v) { World.Check(MicaNative.mica_lpc_set_velocity(World.Handle, Id, Mica.Vec(v, 3, "velocity"))); }
 
@@ -400,7 +412,8 @@ namespace LibMica
         public readonly ulong Id;
         static readonly double[] Identity = { 1, 0, 0, 0 };
 
-        internal Tool(World world, ulong id) { World = world; Id = id; }
+        /// <summary>Wraps a tool id of `world` (one the raw MicaNative calls returned).</summary>
+        public Tool(World world, ulong id) { World = world; Id = id; }
 
         public void SetPose(double[] position, double[] orientation = null)
         {

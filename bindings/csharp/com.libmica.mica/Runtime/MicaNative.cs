@@ -9,7 +9,8 @@ namespace LibMica
 {
     public static unsafe class MicaNative
     {
-        // "mica" resolves to libmica.so / mica.dll / libmica.dylib beside the player or on the path.
+        // "mica" resolves to libmica.so beside the player or on the library path. libmica is built
+        // and tested on Linux x86-64 only; there is no mica.dll or libmica.dylib yet.
         public const string Library = "mica";
 
         // --- Constants (mica.h)

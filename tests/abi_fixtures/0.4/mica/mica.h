@@ -1,0 +1,510 @@
+/**
+ * @file mica.h
+ * @brief libmica: the C API.
+ *
+ * libmica simulates deformable bodies (co-rotational linear tetrahedral FEM, implicit
+ * steps) and the two kinds of haptic interaction with them in one solver (MICA:
+ * Modified Iterative Constraint Anticipation): direct manipulation through linear
+ * projection constraints, and contact with tools.
+ *
+ * Conventions (see docs/architecture.md):
+ * - Units are SI throughout: m, kg, s, N, Pa.
+ * - Every call that can fail returns a ::mica_status; 0 is ::MICA_OK, negative values
+ *   are errors, positive values are warnings (the call did its work). On an error the
+ *   world is left exactly as it was and mica_world_last_error() says what was wrong.
+ * - Objects inside a world are named by 64-bit ids (zero is the null id). An id carries a
+ *   generation, so an id whose object was destroyed is detected, never dereferenced.
+ * - Definition structs start with `struct_size`. Fill them with the matching `*_default()`
+ *   function (or `*_init()` from a foreign-function interface), then change what you need.
+ * - Threads: a world is used by one thread at a time. Each function says who may call it.
+ */
+#ifndef MICA_H
+#define MICA_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#if defined(MICA_STATIC)
+#define MICA_API
+#elif defined(MICA_BUILDING_LIBRARY)
+#define MICA_API __attribute__((visibility("default")))
+#else
+#define MICA_API
+#endif
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** @name Version
+ *  @{ */
+/** Major version: incompatible ABI changes. */
+#define MICA_VERSION_MAJOR 0
+/** Minor version: compatible additions. */
+#define MICA_VERSION_MINOR 4
+/** Patch version: fixes. */
+#define MICA_VERSION_PATCH 0
+/** major * 10000 + minor * 100 + patch */
+#define MICA_VERSION_NUMBER (MICA_VERSION_MAJOR * 10000 + MICA_VERSION_MINOR * 100 + MICA_VERSION_PATCH)
+
+/** The version of the library actually loaded, as MICA_VERSION_NUMBER. Any thread. */
+MICA_API int32_t mica_version(void);
+/** @} */
+
+/** @name Status codes
+ *  @{ */
+/** A status: 0 success, > 0 warning (the call did its work), < 0 error (nothing changed). */
+typedef int32_t mica_status;
+/** Success. */
+#define MICA_OK 0
+/** Warning: the step finished but the solver stopped at its cap before its tolerance. */
+#define MICA_WARN_NOT_CONVERGED 1
+/** Warning: the haptic device reported a warning (warm motors, force clamped by the device). */
+#define MICA_WARN_DEVICE 2
+#define MICA_ERR_NULL_ARGUMENT (-1)    /**< a required pointer is NULL */
+#define MICA_ERR_INVALID_ARGUMENT (-2) /**< a value is outside its domain (NaN, negative, bad enum) */
+#define MICA_ERR_OUT_OF_RANGE (-3)     /**< an index is outside its array */
+#define MICA_ERR_STALE_ID (-4)         /**< the id is null, of the wrong kind, or its object was destroyed */
+#define MICA_ERR_VERSION_MISMATCH (-5) /**< the header the caller compiled with does not match the library */
+#define MICA_ERR_STRUCT_SIZE (-6)      /**< a def's struct_size is not one this library knows */
+#define MICA_ERR_BAD_MESH (-7)         /**< the mesh has a degenerate or inverted rest element */
+#define MICA_ERR_IO (-8)               /**< a file cannot be opened, read or written */
+#define MICA_ERR_PARSE (-9)            /**< a file is malformed */
+#define MICA_ERR_NUMERICAL (-10)       /**< the step produced non-finite values (the step was undone) */
+#define MICA_ERR_WRONG_STATE (-11)     /**< the call is not allowed now */
+#define MICA_ERR_UNSUPPORTED (-12)     /**< not available in this build or for this object */
+#define MICA_ERR_BUFFER_TOO_SMALL (-13)/**< the caller's buffer is smaller than the result (the needed count is returned) */
+#define MICA_ERR_DEVICE (-14)          /**< a haptic device failed */
+#define MICA_ERR_OUT_OF_MEMORY (-15)   /**< an allocation failed */
+#define MICA_ERR_INTERNAL (-16)        /**< a bug in libmica: please report it with the message */
+
+/** Static text naming a status ("MICA_ERR_STALE_ID: ..."). Never NULL. Any thread. */
+MICA_API const char* mica_status_string(mica_status status);
+/** @} */
+
+/** @name Ids
+ *  A 64-bit id: bits 0-31 slot + 1, bits 32-55 generation, bits 56-63 kind. 0 is null.
+ *  @{ */
+/** Id of a body. */
+typedef uint64_t mica_body_id;
+/** Id of a linear projection constraint group. */
+typedef uint64_t mica_lpc_id;
+/** Id of a tool. */
+typedef uint64_t mica_tool_id;
+/** The null id: never names an object. */
+#define MICA_NULL_ID 0u
+/** @} */
+
+/** @name World
+ *  @{ */
+
+/** An opaque simulation world. */
+typedef struct mica_world mica_world;
+
+/** Log levels for ::mica_log_fn. */
+#define MICA_LOG_ERROR 0   /**< a call failed */
+#define MICA_LOG_WARNING 1 /**< something worth knowing went wrong, the call succeeded */
+#define MICA_LOG_INFO 2    /**< information */
+
+/** Receives library messages on the thread that made the call. `message` is valid only during
+ *  the call. Must not call back into the same world. */
+typedef void (*mica_log_fn)(int32_t level, const char* message, void* user);
+
+/** Velocity solvers. */
+#define MICA_SOLVER_DIRECT 0 /**< sparse Cholesky (CHOLMOD) of the projected system: exact */
+#define MICA_SOLVER_PCG 1    /**< projected conjugate gradient, block-Jacobi preconditioner */
+#define MICA_SOLVER_MICA 2   /**< MICA: constraint anticipation, PGS on contacts, modified block Gauss-Seidel */
+
+#define MICA_SWEEP_GAUSS_SEIDEL 0 /**< MICA's velocity sweep as in the paper: modified block Gauss-Seidel */
+/** MICA with a factored anticipation: a sparse Cholesky factor of a recent system (the first
+ *  step's after any change of time step, damping or constraint set), warped by node rotations,
+ *  preconditions the velocity solve (conjugate gradients) and gives the contact rows their
+ *  compliance; far fewer iterations on stiff or fine meshes. A solve that has used 100
+ *  conjugate-gradient iterations (crushed elements turning fast under a tool) refactors the
+ *  current system and ends in a few more; `refactor_interval` also refreshes the factor in the
+ *  background (docs/solvers.md). */
+#define MICA_SWEEP_FACTORED 1
+
+/** How to create a world: fill with mica_world_def_default(), then change fields. */
+typedef struct mica_world_def {
+  uint32_t struct_size;    /**< sizeof(mica_world_def) as the caller compiled it */
+  uint32_t header_version; /**< MICA_VERSION_NUMBER the caller compiled with */
+  double gravity[3];       /**< m/s^2; default (0, -9.81, 0) */
+  int32_t solver;          /**< MICA_SOLVER_*; default MICA_SOLVER_DIRECT */
+  int32_t max_iterations;  /**< cap for iterative solvers; default 200 */
+  double tolerance;        /**< relative residual for iterative solvers; default 1e-8 */
+  /** 1: run every stage of the step even when the scene does not call for it (for
+   *  measuring what the plan saves). Default 0: the plan holds only the effects present. */
+  int32_t plan_all_stages;
+  int32_t reserved0;       /**< zero */
+  mica_log_fn log;         /**< optional log callback, NULL for none */
+  void* log_user;          /**< passed to `log` */
+  int32_t pgs_sweeps;      /**< MICA: PGS sweeps over the contacts per iteration; default 1 */
+  int32_t paper_norm;      /**< MICA: 1 stops on the paper's 2-norm of the change of (v, lambda);
+                                default 0: relative changes of v and of lambda, each below tolerance */
+  double max_recovery_speed; /**< m/s: penetration is recovered at most this fast (for a tool, beyond its own approach); default 1 */
+  int32_t body_contact;    /**< 1: bodies collide with each other and with static bodies; default 1 */
+  int32_t reserved1;       /**< zero */
+  double body_margin;      /**< m: contacts between bodies are made for gaps below this; default 0.001 */
+  double body_friction;    /**< Coulomb coefficient between bodies, >= 0; default 0 */
+  int32_t warm_start;      /**< MICA: 1 starts each step's iteration from the last step's velocities
+                                and impulses (matched by persistent contact keys); 0 from zero; default 1 */
+  int32_t reserved2;       /**< zero */
+  /* Since 0.3: */
+  double relaxation;       /**< MICA, Gauss-Seidel sweep: over-relaxation omega in (0, 2); default 1 (the paper) */
+  /** Iterative solvers: > 0 stops the solve when the step has used this many milliseconds of
+   *  wall-clock time; the step then completes with what the solver reached, mica_step returns
+   *  MICA_WARN_NOT_CONVERGED and the statistics say out_of_time and the residual. Default 0: no budget. */
+  double time_budget_ms;
+  int32_t mica_sweep;      /**< MICA_SWEEP_*; default MICA_SWEEP_GAUSS_SEIDEL */
+  /** Threads for the step (rotations, element assembly, a colour-ordered Gauss-Seidel sweep):
+   *  1 (default) runs the serial code and the paper's sweep order; 0 every CPU the process may
+   *  run on; n > 1 starts n - 1 workers owned by the world (they sleep between steps). See
+   *  docs/performance.md before raising it: a haptic host also needs a core for the servo loop. */
+  int32_t threads;
+  /** Co-rotational bodies: a step linearised at its start's rotations can gain energy when
+   *  elements turn far within it. When a step gained more than this fraction of the bodies'
+   *  energy beyond the work done on them, it is solved again by Newton iterations re-linearised at
+   *  the new rotations, with a line search (docs/stability.md, K1). Default 1e-3. */
+  double relinearise_tolerance;
+  int32_t relinearise_max; /**< at most this many solves per step for that; < 2 turns the check off; default 8 */
+  /** Since 0.4. MICA_SWEEP_FACTORED on co-rotational bodies: every this many solves (one per
+   *  step, more when a step is re-linearised) the factor is refreshed from the current system:
+   *  copied, factored on a background thread (one per body) while the steps go on, and used from
+   *  that many solves later (in lockstep: the step waits for a late factorization, so results do
+   *  not depend on timing). Meant for bodies that keep turning far from the factor's shape; on the
+   *  nidus benchmark (a tool crushing a few elements) it did not pay reliably (0.83-1.29x in
+   *  five runs, docs/performance.md).
+   *  Default 0: factor when the time step, damping or constraint set changes, and when a solve
+   *  drags on. Costs a second core while it runs, and a second factor's memory. */
+  int32_t refactor_interval;
+} mica_world_def;
+
+/** Fills `def` with defaults, writing only its first `struct_size` bytes, and records
+ *  `header_version`. This is the entry point for foreign-function interfaces; C and C++ use
+ *  mica_world_def_default(). Returns MICA_ERR_STRUCT_SIZE if struct_size is too small. */
+MICA_API mica_status mica_world_def_init(mica_world_def* def, uint32_t struct_size,
+                                         uint32_t header_version);
+
+/** The default world definition for the header you compiled with. */
+static inline mica_world_def mica_world_def_default(void) {
+  mica_world_def def;
+  mica_world_def_init(&def, (uint32_t)sizeof def, MICA_VERSION_NUMBER);
+  return def;
+}
+
+/** Creates a world. Fails with MICA_ERR_VERSION_MISMATCH when def->header_version has another
+ *  major version than the library. On failure *out_world is NULL and
+ *  mica_world_last_error(NULL) says why. Any thread. */
+MICA_API mica_status mica_world_create(const mica_world_def* def, mica_world** out_world);
+
+/** Destroys a world and everything in it. NULL is allowed. The world's thread. */
+MICA_API void mica_world_destroy(mica_world* world);
+
+/** The message of the last failed call on `world` ("body 0x...: tet 41 has zero volume"), or,
+ *  for world == NULL, of the last failed call on this thread that had no world (creation).
+ *  Empty when there was none. Valid until the next call on that world (or thread). */
+MICA_API const char* mica_world_last_error(const mica_world* world);
+
+/** Sets gravity (m/s^2). The world's thread. */
+MICA_API mica_status mica_world_set_gravity(mica_world* world, const double gravity[3]);
+/** @} */
+
+/** @name Bodies
+ *  @{ */
+#define MICA_MODEL_COROTATIONAL 0 /**< co-rotational linear elasticity: large rotations, small strains */
+#define MICA_MODEL_LINEAR 1       /**< linear elasticity: constant stiffness, factored once */
+#define MICA_MASS_CONSISTENT 0    /**< consistent mass (rho V / 20)(1 + delta_ab) */
+#define MICA_MASS_LUMPED 1        /**< lumped mass rho V / 4 per node */
+
+/** How to create a body: material, model, mass, damping, placement. Fill with mica_body_def_default(). */
+typedef struct mica_body_def {
+  uint32_t struct_size;  /**< sizeof(mica_body_def) as the caller compiled it */
+  int32_t model;         /**< MICA_MODEL_*; default co-rotational */
+  int32_t mass;          /**< MICA_MASS_*; default consistent */
+  int32_t is_static;     /**< 1: never moves (an obstacle); default 0 */
+  double youngs_modulus; /**< Pa, > 0; default 1e4 */
+  double poisson_ratio;  /**< in [0, 0.5); default 0.3 */
+  double density;        /**< kg/m^3, > 0; default 1000 */
+  double rayleigh_alpha; /**< mass-proportional damping, 1/s, >= 0; default 0 */
+  double rayleigh_beta;  /**< stiffness-proportional damping, s, >= 0; default 0 */
+  double translation[3]; /**< m, added to every node at creation; default 0 */
+  double velocity[3];    /**< m/s, initial velocity of every node; default 0 */
+} mica_body_def;
+
+/** Fills `def` with defaults, writing only its first `struct_size` bytes. Any thread. */
+MICA_API mica_status mica_body_def_init(mica_body_def* def, uint32_t struct_size);
+
+/** The default body definition. */
+static inline mica_body_def mica_body_def_default(void) {
+  mica_body_def def;
+  mica_body_def_init(&def, (uint32_t)sizeof def);
+  return def;
+}
+
+/** Creates a body from caller arrays: `nodes` holds 3 * node_count coordinates (m),
+ *  `tets` holds 4 * tet_count 0-based node indices, each tet with positive volume
+ *  (det[X1-X0, X2-X0, X3-X0] > 0). The arrays are copied. The world's thread. */
+MICA_API mica_status mica_body_create(mica_world* world, const mica_body_def* def,
+                                      const double* nodes, int32_t node_count,
+                                      const int32_t* tets, int32_t tet_count,
+                                      mica_body_id* out_body);
+
+/** Creates a body from a mesh file: Gmsh .msh (2.2 or 4.1 ASCII) or a TetGen .node/.ele
+ *  pair (either name). The world's thread. */
+MICA_API mica_status mica_body_create_from_file(mica_world* world, const mica_body_def* def,
+                                                const char* path, mica_body_id* out_body);
+
+/** Creates a box [lo, hi] (m) meshed as cells[0] x cells[1] x cells[2] cubes cut into
+ *  `tets_per_cell` (5 or 6) tetrahedra. The world's thread. */
+MICA_API mica_status mica_body_create_box(mica_world* world, const mica_body_def* def,
+                                          const double lo[3], const double hi[3],
+                                          const int32_t cells[3], int32_t tets_per_cell,
+                                          mica_body_id* out_body);
+
+/** Destroys a body and the constraints on it. The world's thread. */
+MICA_API mica_status mica_body_destroy(mica_world* world, mica_body_id body);
+
+/** Counts of a body's nodes, tets and surface triangles (any may be NULL). */
+MICA_API mica_status mica_body_get_counts(const mica_world* world, mica_body_id body,
+                                          int32_t* node_count, int32_t* tet_count,
+                                          int32_t* triangle_count);
+
+/** Read-back into caller buffers. `capacity` counts items (nodes or triangles), not doubles.
+ *  With out == NULL only *out_count is written (the size query). With a buffer smaller
+ *  than the result: MICA_ERR_BUFFER_TOO_SMALL, nothing copied, *out_count = needed. */
+MICA_API mica_status mica_body_get_positions(const mica_world* world, mica_body_id body,
+                                             double* out, int32_t capacity, int32_t* out_count);
+/** Current velocities (m/s), 3 doubles per node; as mica_body_get_positions(). */
+MICA_API mica_status mica_body_get_velocities(const mica_world* world, mica_body_id body,
+                                              double* out, int32_t capacity, int32_t* out_count);
+/** Rest positions (m), 3 doubles per node; as mica_body_get_positions(). */
+MICA_API mica_status mica_body_get_rest_positions(const mica_world* world, mica_body_id body,
+                                                  double* out, int32_t capacity,
+                                                  int32_t* out_count);
+/** Surface triangles, 3 node indices each, counter-clockwise seen from outside. */
+MICA_API mica_status mica_body_get_surface(const mica_world* world, mica_body_id body,
+                                           int32_t* out, int32_t capacity, int32_t* out_count);
+
+/** Zero-copy view of the current positions: 3 * node_count doubles owned by the world,
+ *  valid until the next mica_step or destruction of the body or world. */
+MICA_API mica_status mica_body_positions_view(const mica_world* world, mica_body_id body,
+                                              const double** out, int32_t* out_node_count);
+
+/** Sets persistent external forces (N) on nodes: `forces` holds 3 * count values for the
+ *  nodes listed. They add to gravity until changed; zero forces remove them. */
+MICA_API mica_status mica_body_set_node_forces(mica_world* world, mica_body_id body,
+                                               const int32_t* nodes, const double* forces,
+                                               int32_t count);
+
+/** Nodes inside the axis-aligned box [lo, hi] (m), in rest positions when `use_rest` is 1,
+ *  else current. Buffer protocol as mica_body_get_positions(). */
+MICA_API mica_status mica_body_select_nodes_in_box(const mica_world* world, mica_body_id body,
+                                                   const double lo[3], const double hi[3],
+                                                   int32_t use_rest, int32_t* out,
+                                                   int32_t capacity, int32_t* out_count);
+/** Nodes with (p - point) . normal <= tolerance (m), i.e. on the side the normal points away
+ *  from, in rest positions when `use_rest` is 1. Buffer protocol as above. */
+MICA_API mica_status mica_body_select_nodes_by_plane(const mica_world* world, mica_body_id body,
+                                                     const double point[3], const double normal[3],
+                                                     double tolerance, int32_t use_rest,
+                                                     int32_t* out, int32_t capacity,
+                                                     int32_t* out_count);
+
+/** Total kinetic, elastic and gravitational potential energy of a body (J). */
+MICA_API mica_status mica_body_get_energy(const mica_world* world, mica_body_id body,
+                                          double* kinetic, double* elastic, double* potential);
+/** @} */
+
+/** @name Linear projection constraints (LPC)
+ *  Per node a projector S = I - sum of constrained directions; the constrained velocity
+ *  components are prescribed: (I - S) v = (I - S) velocity.
+ *  @{ */
+#define MICA_LPC_FIXED 0    /**< all three directions constrained: S = 0 */
+#define MICA_LPC_PLANE 1    /**< slide on a plane with normal direction[0]: S = I - p p^T */
+#define MICA_LPC_LINE 2     /**< move only along direction[0]: S = d d^T */
+#define MICA_LPC_TWO_DIRS 3 /**< directions direction[0] and direction[1] constrained: S = I - pp^T - qq^T */
+
+/** A projection constraint: its kind, directions and prescribed velocity. Fill with mica_lpc_def_default(). */
+typedef struct mica_lpc_def {
+  uint32_t struct_size;  /**< sizeof(mica_lpc_def) as the caller compiled it */
+  int32_t kind;          /**< MICA_LPC_*; default MICA_LPC_FIXED */
+  double direction[2][3];/**< unit vectors as the kind needs them (normalised by the library) */
+  double velocity[3];    /**< m/s, prescribed velocity of the constrained components; default 0 */
+} mica_lpc_def;
+
+/** Fills `def` with defaults, writing only its first `struct_size` bytes. Any thread. */
+MICA_API mica_status mica_lpc_def_init(mica_lpc_def* def, uint32_t struct_size);
+
+/** The default constraint definition (fixed, zero velocity). */
+static inline mica_lpc_def mica_lpc_def_default(void) {
+  mica_lpc_def def;
+  mica_lpc_def_init(&def, (uint32_t)sizeof def);
+  return def;
+}
+
+/** Adds a projection constraint on `count` nodes of `body`. Where constraints overlap on a
+ *  node, the constrained directions add up and the later constraint's velocity wins on its
+ *  directions. The world's thread. */
+MICA_API mica_status mica_add_lpc(mica_world* world, mica_body_id body, const int32_t* nodes,
+                                  int32_t count, const mica_lpc_def* def, mica_lpc_id* out_lpc);
+
+/** Removes a constraint. The world's thread. */
+MICA_API mica_status mica_lpc_remove(mica_world* world, mica_lpc_id lpc);
+
+/** Changes the prescribed velocity (m/s) of a constraint's constrained components (and drops
+ *  any targets or handle it had). The world's thread. */
+MICA_API mica_status mica_lpc_set_velocity(mica_world* world, mica_lpc_id lpc, const double velocity[3]);
+
+/** Gives each node of the constraint a target position (m): every step the constrained
+ *  components move so that the node reaches its target in that step. `targets` holds
+ *  3 * count values, count = the constraint's node count. The world's thread. */
+MICA_API mica_status mica_lpc_set_targets(mica_world* world, mica_lpc_id lpc, const double* targets,
+                                          int32_t count);
+
+/** Picking: holds every node of `body` within `radius` (m) of `center` (m, current positions)
+ *  on a handle, fully constrained (S = 0). The handle starts at `center` and moves with
+ *  mica_lpc_set_handle_pose(); given a tool (not MICA_NULL_ID), it follows that tool's pose
+ *  instead, like forceps. Release with mica_lpc_remove(). The world's thread. */
+MICA_API mica_status mica_lpc_grab(mica_world* world, mica_body_id body, const double center[3], double radius,
+                                   mica_tool_id tool, mica_lpc_id* out_lpc);
+
+/** Moves a grab's handle: position (m) and unit quaternion (w, x, y, z). The held nodes keep
+ *  their offsets in the handle frame. The world's thread. */
+MICA_API mica_status mica_lpc_set_handle_pose(mica_world* world, mica_lpc_id lpc, const double position[3],
+                                              const double orientation[4]);
+
+/** The nodes a constraint holds; buffer protocol as mica_body_get_positions(). */
+MICA_API mica_status mica_lpc_get_nodes(const mica_world* world, mica_lpc_id lpc, int32_t* out, int32_t capacity,
+                                        int32_t* out_count);
+
+/** Reaction force (N) of a constraint group of the last step: the force on whoever holds the
+ *  constraint (the user's hand in a grasp). Lifting a grasped region up against gravity gives
+ *  a downward force. The world's thread. */
+MICA_API mica_status mica_lpc_get_reaction(const mica_world* world, mica_lpc_id lpc, double out_force[3]);
+/** @} */
+
+/** @name Tools
+ *  Kinematic rigid tools: the host sets their pose; bodies cannot push them, they feel the
+ *  force of the contact.
+ *  @{ */
+#define MICA_TOOL_SPHERE 0  /**< a sphere of `radius` around the tool origin */
+#define MICA_TOOL_PLANE 1   /**< a half-space: bodies stay on the side `normal` points to */
+#define MICA_TOOL_CAPSULE 2 /**< the segment from -half_length to +half_length along local z, inflated by `radius` */
+#define MICA_TOOL_BOX 3     /**< a box of `half_extents` centred on the tool origin */
+#define MICA_TOOL_HULL 4    /**< the convex hull of `hull_points` (4 to 64 points, tool frame) */
+
+/** A kinematic tool: shape, size, initial pose, contact margin. Fill with mica_tool_def_default(). */
+typedef struct mica_tool_def {
+  uint32_t struct_size;  /**< sizeof(mica_tool_def) as the caller compiled it */
+  int32_t shape;         /**< MICA_TOOL_*; default sphere */
+  double radius;         /**< m, sphere; default 0.01 */
+  double normal[3];      /**< plane normal in the tool frame; default (0, 0, 1) */
+  double position[3];    /**< m, initial tool origin; default 0 */
+  double orientation[4]; /**< initial unit quaternion (w, x, y, z); default identity */
+  double margin;         /**< m: contacts are made for gaps below this; default 0.001 */
+  double friction;       /**< Coulomb coefficient between tool and tissue, >= 0; default 0 */
+  double half_length;    /**< m, capsule; default 0.01 */
+  double half_extents[3];/**< m, box; default 0.01 each */
+  const double* hull_points; /**< m, hull: 3 * hull_point_count coordinates in the tool frame (copied) */
+  int32_t hull_point_count;  /**< hull: number of points, 4 to 64 */
+  int32_t reserved0;     /**< zero */
+} mica_tool_def;
+
+/** Fills `def` with defaults, writing only its first `struct_size` bytes. Any thread. */
+MICA_API mica_status mica_tool_def_init(mica_tool_def* def, uint32_t struct_size);
+
+/** The default tool definition (a 1 cm sphere at the origin). */
+static inline mica_tool_def mica_tool_def_default(void) {
+  mica_tool_def def;
+  mica_tool_def_init(&def, (uint32_t)sizeof def);
+  return def;
+}
+
+/** Creates a tool. Every solver handles its contacts (MICA; DIRECT and PCG through the Delassus
+ *  matrix). The world's thread. */
+MICA_API mica_status mica_tool_create(mica_world* world, const mica_tool_def* def, mica_tool_id* out_tool);
+/** Destroys a tool. The world's thread. */
+MICA_API mica_status mica_tool_destroy(mica_world* world, mica_tool_id tool);
+/** Moves a tool: position (m) and unit quaternion (w, x, y, z) for the next step. The world's thread. */
+MICA_API mica_status mica_tool_set_pose(mica_world* world, mica_tool_id tool, const double position[3],
+                                        const double orientation[4]);
+/** The tool's current pose: position (m) and unit quaternion (w, x, y, z); either may be NULL.
+ *  A tool driven by a device takes the device's pose at each step. The world's thread. */
+MICA_API mica_status mica_tool_get_pose(const mica_world* world, mica_tool_id tool, double out_position[3],
+                                        double out_orientation[4]);
+/** Force (N) and torque about the tool origin (N m) the bodies put on the tool in the last step,
+ *  and the number of active contacts; any output may be NULL. The world's thread. */
+MICA_API mica_status mica_tool_get_force(const mica_world* world, mica_tool_id tool, double out_force[3],
+                                         double out_torque[3], int32_t* out_contacts);
+/** @} */
+
+/** @name Stepping
+ *  @{ */
+
+/** Advances the world by `dt` seconds (0 < dt <= 1) with one implicit step.
+ *  Returns MICA_WARN_NOT_CONVERGED when an iterative solver stopped at its cap (the step is
+ *  kept; see mica_world_get_stats()), MICA_ERR_NUMERICAL when the result was not finite
+ *  (the step is undone). The world's thread. */
+MICA_API mica_status mica_step(mica_world* world, double dt);
+/** @} */
+
+/** @name Statistics
+ *  The step is a plan of stages derived from the scene; a stage whose effect is absent
+ *  is not in the plan and never runs.
+ *  @{ */
+#define MICA_STAGE_GRAVITY 0     /**< external loads: gravity and node forces */
+#define MICA_STAGE_ROTATIONS 1   /**< per-element rotations (co-rotational bodies) */
+#define MICA_STAGE_ELEMENTS 2    /**< elastic forces and the stiffness part of A */
+#define MICA_STAGE_DAMPING 3     /**< Rayleigh damping terms */
+#define MICA_STAGE_CONSTRAINTS 4 /**< projection constraints (S, z per node) */
+#define MICA_STAGE_SOLVE 5       /**< the velocity solve */
+#define MICA_STAGE_INTEGRATE 6   /**< positions from velocities */
+#define MICA_STAGE_COLLIDE 7     /**< contacts between tools and body surfaces (runs first) */
+#define MICA_STAGE_FORCES 8      /**< tool forces and constraint reactions (runs last) */
+#define MICA_STAGE_COUNT 9        /**< number of stages */
+
+/** Counters and timing of one stage of the step. */
+typedef struct mica_stage_stats {
+  int32_t runs_last_step; /**< times the stage ran in the last step (0 or 1) */
+  int32_t reserved0;      /**< zero */
+  int64_t runs_total;     /**< since creation */
+  double ms_last_step;    /**< wall-clock milliseconds in the last step */
+  double ms_total;        /**< since creation */
+} mica_stage_stats;
+
+/** Statistics of the last step and since creation: see mica_world_get_stats(). */
+typedef struct mica_world_stats {
+  uint32_t struct_size;          /**< set by the caller: sizeof(mica_world_stats) */
+  int32_t converged;             /**< 1 if every solve of the last step met its tolerance */
+  int64_t step_count;            /**< steps taken */
+  int32_t solver_iterations;     /**< iterations of the last step (summed over bodies; 1 for direct) */
+  int32_t out_of_time;           /**< 1 if a solve of the last step stopped at time_budget_ms (since 0.3) */
+  double solver_residual;        /**< largest relative residual of the last step */
+  double ms_last_step;           /**< wall-clock milliseconds of the last step */
+  mica_stage_stats stages[MICA_STAGE_COUNT]; /**< indexed by MICA_STAGE_* */
+} mica_world_stats;
+
+/** Copies the statistics into `out`, writing at most out->struct_size bytes (set it first).
+ *  The world's thread. */
+MICA_API mica_status mica_world_get_stats(const mica_world* world, mica_world_stats* out);
+
+/** Static name of a stage ("gravity", "rotations", ...), or "unknown". Any thread. */
+MICA_API const char* mica_stage_name(int32_t stage);
+/** @} */
+
+/** @name Output
+ *  @{ */
+/** Writes one body (current positions, velocities and displacements) as a VTK legacy
+ *  unstructured grid that ParaView opens. The world's thread. */
+MICA_API mica_status mica_body_write_vtk(const mica_world* world, mica_body_id body,
+                                         const char* path);
+/** Writes every body of the world into one VTK file (cell scalar "piece" = body order). */
+MICA_API mica_status mica_world_write_vtk(const mica_world* world, const char* path);
+/** @} */
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* MICA_H */
