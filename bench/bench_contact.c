@@ -28,8 +28,8 @@
  * usage: bench_contact [--quick | --full] [--gauss-seidel] [--no-nidus] [--csv FILE] [--tol T]
  *                      [--cells LIST] [--dt LIST] [--shape NAME] [--trace] [--run-limit S] [--nidus-only] [--solver NAME]
  *   default  cells 8 at dt 1, 5, 10, 20 ms and cells 12 at dt 10, 20 ms; every tool; exact and
- *            MICA factored; the nidus (exact and MICA factored). About 10 minutes on one core,
- *            but in libmica 0.4.0 the hull at 8 cells and 10 ms never finishes step 95 (docs/accuracy-vs-time.md).
+ *            MICA factored; the nidus (exact and MICA factored). About 9 minutes on one core
+ *            (docs/accuracy-vs-time.md, "Force quality").
  *   --full   cells 8, 12, 16 x dt 1, 5, 10, 20 ms (the issue's whole grid): hours on one core
  *            (16 cells cost 0.1-2 s per step, 2000 steps at 1 ms); --cells/--dt pick a part
  *   --quick  cells 12, dt 10 ms, every tool, exact and MICA factored; no nidus
