@@ -637,7 +637,10 @@ MICA_API mica_status mica_lpc_get_nodes(const mica_world* world, mica_lpc_id lpc
 
 /** Reaction force of a constraint group in the last step: the force on whoever holds the constraint
  *  (the user's hand in a grasp). Lifting a grasped region up against gravity gives a downward
- *  force. The world's thread (the one thread using the world at a time).
+ *  force. A node held by several groups is counted once: each group C_g gets the share
+ *  C_g (sum of the node's groups' C)^+ of its reaction (two groups fixing it get half each), so
+ *  the groups' reactions add up to what holds the body. The world's thread (the one thread
+ *  using the world at a time).
  *  @param world the world (not changed).
  *  @param lpc the constraint.
  *  @param out_force receives the force, N.

@@ -30,6 +30,7 @@ BodyScratch::BodyScratch(const BodyModel& model) {
   A.assign(model.fem.pattern.block_count(), Mat3::Zero());
   for (Vec3List* w : {&f_int, &f_ext, &b, &v_next, &x_next}) w->assign(n, Vec3::Zero());
   projection.reset(int32_t(n));
+  constrained_sum.assign(n, Mat3::Zero());
 }
 
 Body::Body(const TetMesh& mesh, const BodySettings& settings, const std::string& name, uint64_t key)

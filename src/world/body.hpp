@@ -75,6 +75,7 @@ struct BodyScratch {
   } relin;
   BlockValues A;               // M + h C + h^2 K
   Vec3List f_int, f_ext, b, v_next, x_next;
+  std::vector<Mat3> constrained_sum;  // per node, sum of I - S over its constraint groups (reactions)
   Projection projection;
 
   // What A was built for; a linear body reuses it while unchanged.

@@ -11,6 +11,19 @@
 
 namespace mica {
 
+namespace {
+
+// The Moore-Penrose inverse of a symmetric positive semidefinite 3x3 (a sum of projectors).
+Mat3 pseudo_inverse(const Mat3& m) {
+  const Eigen::SelfAdjointEigenSolver<Mat3> eig(m);
+  Vec3 inverse = Vec3::Zero();
+  for (int k = 0; k < 3; ++k)
+    if (eig.eigenvalues()[k] > 1e-9 * eig.eigenvalues().cwiseAbs().maxCoeff()) inverse[k] = 1 / eig.eigenvalues()[k];
+  return eig.eigenvectors() * inverse.asDiagonal() * eig.eigenvectors().transpose();
+}
+
+}  // namespace
+
 Plan World::plan() const {
   Plan p;
   const bool all = settings_.plan_all_stages;
@@ -337,7 +350,17 @@ void World::compute_forces(const StepContext& ctx) {
     }
   }
   // Constraints: the impulse r = (I - S)(A v - b - G^T lambda) holds the body; whoever holds
-  // the constraint (the user's hand) feels the opposite force, -r / h.
+  // the constraint (the user's hand) feels the opposite force, -r / h. A node held by several
+  // groups gives each group C_g its share C_g (sum_h C_h)^+ r, so that the shares add up to r
+  // (two groups fixing the same node get half each; groups on perpendicular directions, each its own).
+  lpcs_.for_each([&](Id, Lpc& c) {
+    Body& b = bodies_.get(c.body, "body");
+    for (int32_t i : c.nodes) b.constrained_sum[i].setZero();
+  });
+  lpcs_.for_each([&](Id, Lpc& c) {
+    Body& b = bodies_.get(c.body, "body");
+    for (int32_t i : c.nodes) b.constrained_sum[i] += c.constrained;
+  });
   lpcs_.for_each([&](Id, Lpc& c) {
     Body& b = bodies_.get(c.body, "body");
     c.reaction.setZero();
@@ -346,7 +369,10 @@ void World::compute_forces(const StepContext& ctx) {
       Vec3 Av = Vec3::Zero();
       for (int32_t k = b.fem.pattern.row_start[i]; k < b.fem.pattern.row_start[i + 1]; ++k)
         Av += b.A[k] * b.v_next[b.fem.pattern.col[k]];
-      c.reaction -= c.constrained * (Av - b.b[i] - b.contact_impulse[i]) / h;
+      const Vec3 r = Av - b.b[i] - b.contact_impulse[i];
+      const Mat3& sum = b.constrained_sum[i];
+      const Vec3 share = sum == c.constrained ? Vec3(c.constrained * r) : Vec3(c.constrained * pseudo_inverse(sum) * r);
+      c.reaction -= share / h;
     }
   });
 }

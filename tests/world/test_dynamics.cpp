@@ -1,5 +1,6 @@
 // Whole-body dynamics against analytic answers: a cantilever's static tip deflection
-// (Euler-Bernoulli), energy that never grows without damping and decays with it.
+// (Euler-Bernoulli), energy that never grows without damping and decays with it, and the
+// reactions of overlapping constraint groups that add up to the load they carry.
 #include "test_util.hpp"
 
 using namespace mica;
@@ -131,12 +132,54 @@ static void test_free_fall(void**) {
   }
 }
 
+// A clamped beam held at its root by overlapping constraint groups (the whole face fixed, its
+// lower half fixed again, its upper half held along x only) under a tip load P at rest: the
+// groups' reactions add up to what holds the beam, P (each node's reaction counted once, shared
+// among the groups that hold it), and to the reaction of a twin held by one group over the face.
+// (0.4 gave every group the node's whole reaction: the sum was off by the shared nodes' part.)
+static void test_overlapping_constraint_reactions_add_up(void**) {
+  const double L = 0.4, H = 0.1;
+  const Vec3 P(0, -3, 1);
+  Vec3 sums[2];
+  for (int twin = 0; twin < 2; ++twin) {
+    WorldSettings ws;
+    ws.gravity = Vec3::Zero();
+    World world(ws);
+    BodySettings bs;
+    bs.material = {1e6, 0.3, 100};
+    const Id id = world.add_body(make_box_grid(Vec3(0, 0, 0), Vec3(L, H, H), {8, 2, 2}, 5), bs, Vec3::Zero(),
+                                 Vec3::Zero());
+    const Body& beam = world.body(id);
+    const std::vector<int32_t> root = nodes_where(beam, x_of, 0.0);
+    std::vector<Id> groups{world.add_lpc(id, root, LpcSpec{})};
+    if (twin == 0) {
+      std::vector<int32_t> lower, upper;
+      for (int32_t i : root) (beam.fem.rest[i].y() < H / 2 + 1e-9 ? lower : upper).push_back(i);
+      groups.push_back(world.add_lpc(id, lower, LpcSpec{}));
+      LpcSpec along_x;
+      along_x.kind = LpcKind::Plane;  // one direction held
+      along_x.directions[0] = Vec3::UnitX();
+      groups.push_back(world.add_lpc(id, upper, along_x));
+    }
+    const auto tip = nodes_where(beam, x_of, L);
+    world.set_node_forces(id, tip, Vec3List(tip.size(), P / double(tip.size())));
+    for (int k = 0; k < 40; ++k) world.step(1.0);  // large implicit steps: damped toward rest
+    sums[twin].setZero();
+    for (Id g : groups) sums[twin] += world.lpc(g).reaction;
+    print_message("%zu groups: reactions sum to (%.6f, %.6f, %.6f) N; the tip load (%.1f, %.1f, %.1f) N\n",
+                  groups.size(), sums[twin].x(), sums[twin].y(), sums[twin].z(), P.x(), P.y(), P.z());
+    assert_true((sums[twin] - P).norm() <= 1e-6 * P.norm());
+  }
+  assert_true((sums[0] - sums[1]).norm() <= 1e-9 * P.norm());
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_free_fall),
       cmocka_unit_test(test_cantilever_matches_euler_bernoulli),
       cmocka_unit_test(test_energy_never_grows_without_damping),
       cmocka_unit_test(test_damping_decays_energy),
+      cmocka_unit_test(test_overlapping_constraint_reactions_add_up),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
