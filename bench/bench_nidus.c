@@ -83,8 +83,8 @@ typedef struct {
 
 /* Steps a world with a sphere pressing from `y0` down by `depth` at `speed`, then moving up
  * and down by `wobble` around there once a second (so every timed step has a moving tool in
- * contact, as under a hand); times the steps after the warm-up. */
-/* Chatter (the contact issue's measure, read outside the timed call): over the nodes within
+ * contact, as under a hand); times the steps after the warm-up. Chatter (the contact issue's
+ * measure, read outside the timed call): over the nodes within
  * `reach` of the tool's centre, the fraction of steps whose velocity change dv_k = v_k - v_k-1
  * points against the last one (dv_k . dv_k-1 < 0). The contact issue measured 73 % on this scene
  * in 0.4 (21 % on a cube). */
