@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: Apache-2.0
 # abidw.sh <libmica.so.N> <out.abi>: the ABI of libmica as libabigail sees it, limited to the
 # exported functions and the types they reach that the public headers (include/mica) define:
 # what abi/libmica.abi holds and abi/check.sh compares.

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: Apache-2.0
 # check.sh <libmica.so.N built with -g>: fails on any difference between the library's ABI and
 # the baseline abi/libmica.abi (a ctest test, label "abi"; exit 77 without libabigail).
 set -eu

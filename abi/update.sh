@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: Apache-2.0
 # update.sh <build-dir>: rewrites the ABI baseline abi/libmica.abi from the build tree's
 # libmica (its debug twin, target mica_abi). Commit the result with the change that caused it;
 # an incompatible change also bumps MICA_VERSION_MAJOR (see abi/check.sh).

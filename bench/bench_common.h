@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* What every benchmark prints beside its figures: a monotonic clock, a sort order for medians,
  * and the machine it ran on (CPU, the CPUs it may use, the load). Header-only; Linux. */
 #pragma once

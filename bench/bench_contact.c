@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Force quality of tool contact: does the force a held tool feels settle, and does it grow
  * smoothly while the tool goes deeper?
  *

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // CHOLMOD on a body's velocity system: simplicial LDL^T against supernodal LL^T (what
 // DirectSolver and the factored sweep use), analysis, numeric factorization and solves with 1
 // and 3 right-hand sides, on a mesh file (default: the nidus mesh). The system is that of the

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* The nidus-scale scene of Arikatla et al. 2016: a lesion-like blob of about 9.7k tets and
  * 2.7k nodes (8.2k DOF, data/nidus/nidus.msh, made by data/nidus/make_nidus.py), touched by a
  * forceps tip, timed per step on one core. The paper ran this scale at about 100 ms per step

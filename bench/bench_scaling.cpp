@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Time per step against tets on one thread and on several, side by side: the scene of
 // `bench_nidus --scaling` (a 0.1 m cube of n^3 cubes x 6 tets, E = 2e4 Pa, nu = 0.3, rho = 1000,
 // Rayleigh alpha = 2, co-rotational, consistent mass, gravity, base fixed; a 2 cm sphere pressed

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* What one servo cycle costs, and how steady the 1 kHz period is, while the simulation thread
  * steps a large scene as fast as it can (the worst case for the servo thread's core).
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* What each solver costs and how far it is from the exact answer, side by side in one run.
  *
  * Scene: a cube (E = 2e4 Pa) fixed at its base, a sphere pressing into the top while a grasp

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // What a factor of an earlier step misses on the nidus scene, and whether correcting it on a few
 // nodes would help: the preconditioner P = Q A_ref Q^T (A_ref the system of 1, 5 or 50 steps
 // earlier, Q the node rotations since), with the blocks among the M nodes whose rows changed most

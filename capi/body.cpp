@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Bodies: creation from arrays, files and the box generator; read-back; loads; selection.
 #include "capi_internal.hpp"
 #include "mesh/mesh_io.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The C layer's shared pieces: the world handle, the exception guard, and the struct
 // translation helpers. Validate, translate, call, catch: nothing else lives here.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Haptic devices: creation from the def, the servo poll, the servo loop, statistics.
 #include "capi_internal.hpp"
 #include "device_callbacks.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The host's C callback table (mica_device.h) as a core Device.
 #pragma once
 #include "devices/device.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Version, status text, error reporting.
 #include "capi_internal.hpp"
 

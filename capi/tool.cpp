@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Kinematic tools and the forces on them.
 #include "capi_internal.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // World lifetime, settings, stepping, statistics and output.
 #include <fstream>
 

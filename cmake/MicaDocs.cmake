@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # The `docs` target: the Doxygen HTML reference of the public headers, in <build>/docs/html.
 # Not part of ALL; any Doxygen warning fails it (WARN_AS_ERROR in docs/Doxyfile.in).
 find_package(Doxygen QUIET)

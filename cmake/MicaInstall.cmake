@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Install rules: libmica (shared, and static when built), the public headers, a CMake
 # package (find_package(mica) -> mica::mica, mica::mica_static), mica.pc, and the licence
 # (LICENSE, NOTICE), README and CHANGELOG under share/doc/libmica.

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Run by `cmake --install` after libmica is installed (MICA_INSTALL_LIBDIR and
 # CMAKE_INSTALL_PREFIX are set): makes the installed libmica.so.0 loadable, or says how.
 #   - libdir searched by the dynamic loader (an ld.so.conf directory, e.g. /usr/local/lib on

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # MICA_SANITIZE="address;undefined" or "thread": instrument everything we compile.
 if(MICA_SANITIZE)
   string(REPLACE ";" "," _mica_san "${MICA_SANITIZE}")

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* A soft block fixed at one end sags under gravity.
  *
  * Prints the tip deflection over time against the static Euler-Bernoulli estimate for a

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* How the MICA iteration count grows with stiffness (Figure 2 of Arikatla et al. 2016).
  *
  * The same scene for Young's modulus E = 1e3 ... 1e7 Pa (nu = 0.3): a 10 cm cube fixed at

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* A haptic loop as an engine would run it: a simulation thread stepping at 60 Hz and a servo
  * thread polling the device at 1 kHz, concurrently. The device is the Geomagic Touch when
  * OpenHaptics' libHD is present (MICA_HD_LIBRARY), else a simulated stylus that presses into

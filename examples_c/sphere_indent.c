@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* A sphere pressed into a soft cube and pulled out again (the scene of Figure 1 of
  * Arikatla et al. 2016).
  *

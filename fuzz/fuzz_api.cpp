@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // libFuzzer target: the input bytes are a program of C API calls on a world and its twin.
 //
 // The first bytes choose a world definition (tried as given on a throwaway world, then

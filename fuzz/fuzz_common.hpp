@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Shared by the libFuzzer targets: what counts as a clean rejection, what counts as a bug.
 //
 // A loader given any bytes must either return a mesh that keeps its documented promises or

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // libFuzzer target: parse_gmsh on the input bytes (Gmsh 2.2 / 4.1 ASCII).
 // Seeds: fuzz/corpus/gmsh. Dictionary: fuzz/dict/gmsh.dict.
 #include <cstddef>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // libFuzzer target: the whole load path of a body. The input is Gmsh text when its first
 // non-blank byte is '$', else TetGen (.node, NUL byte, .ele as in fuzz_tetgen), so both seed
 // corpora work unchanged. A parsed mesh goes through validate_topology, check_rest_quality,

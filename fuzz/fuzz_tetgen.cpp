@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // libFuzzer target: parse_tetgen on the input split at its first NUL byte into the .node text
 // (before) and the .ele text (after; empty when there is no NUL).
 // Seeds: fuzz/corpus/tetgen. Dictionary: fuzz/dict/tetgen.dict.

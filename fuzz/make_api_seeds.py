@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """Writes the seed corpus of fuzz_api (fuzz/corpus/api/): small programs of C API calls, each a
 scene the fuzzer should start from (a press with every solver, a grab, devices that misbehave, a
 failed step, loaders, tiny time steps, stale ids). The byte layout mirrors the reader in

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Installs what is missing, then configures and builds libmica in ./build (Release).
 # Extra arguments go to the CMake configure step.
 set -euo pipefail

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # The main demo: install what is missing, build, run the scenes, draw their pictures.
 # Output (CSV, PNG, VTK frames for ParaView) goes to ./out/demo.
 #   1. sphere_indent: a sphere presses into a soft cube fixed at its base, holds, and lets go

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Fuzzes the mesh loaders and the C API with libFuzzer (clang, ASan + UBSan) for a bounded time:
 #   bash scripts/fuzz.sh                      # each target FUZZ_SECONDS (default 60) seconds,
 #                                             # fuzz_api FUZZ_API_SECONDS (default the same)

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: Apache-2.0
 # Installs the Debian 12 packages libmica needs to build, test and document itself.
 # Idempotent: does nothing (and prints nothing) when everything is already installed.
 set -eu

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """Plots the cantilever demo's tip deflection over time against the static beam estimate."""
 import csv
 import sys

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """Plots MICA iterations against stiffness from convergence_vs_stiffness.csv: iterations per
 step for each Young's modulus (log y), and the first-step and median counts against E (log-log).
 

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """Raw against filtered device force over a press and release (the paper's Figure 1 b and c)."""
 import csv
 import sys

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """Plots the sphere-indentation demo: tool force over time, and force against depth
 (loading and unloading) with the Hertz half-space estimate for orientation.
 

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # The test suite under a sanitizer, in its own build folder:
 #   bash scripts/sanitize.sh address   # AddressSanitizer + UndefinedBehaviorSanitizer, every test
 #   bash scripts/sanitize.sh thread    # ThreadSanitizer, the tests labelled "threads"

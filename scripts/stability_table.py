@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """Turns the CSVs the stress tests write (tests/stress, one line per run) into the markdown tables
 of docs/stability.md.
 

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # What accuracy costs in time: builds what is missing, runs the whole study and draws it.
 # Output: out/study/*.csv, out/study/*.png, out/study/tables.md, out/study/logs/*.log.
 # See docs/accuracy-vs-time.md and docs/performance.md.

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """Draws the accuracy-against-time study (scripts/study.sh) from the CSVs in its folder, and
 writes tables.md (the tables of docs/accuracy-vs-time.md and docs/performance.md).
 

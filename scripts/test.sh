@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # The whole test suite: install what is missing, build, run every test through ctest.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)

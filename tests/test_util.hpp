@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // cmocka from C++: the headers it needs, and small numeric assertions with messages.
 // cmocka.h defines a function-like macro fail(), which breaks any header declaring a
 // fail() (libstdc++'s basic_ios, mica::fail) included after it: so every core and standard

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* A tool pressed into a soft body and held: see press_scene.h. */
 #include "press_scene.h"
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* A tool pressed into a soft body and held: the scene of the force-quality benchmark
  * (bench/bench_contact.c), meant to be shared with tests and examples. Plain C99 against the
  * public API only (mica.h).

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Analytic anchors: mesh convergence toward Hertz (a sphere indenting a deep block) and toward
  * Euler-Bernoulli (a cantilever under its own weight). Both are static, small-strain linear
  * elasticity problems, so both bodies use MICA_MODEL_LINEAR and the exact solver

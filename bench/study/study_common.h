@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Helpers shared by the accuracy-against-time study programs (bench/study/). Header-only:
  * each program is one translation unit against the public API (mica.h, mica_device.h).
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* The device-side knob: the moving-average window N of the rendered force (filter_window),
  * against its delay and its smoothness, with the simulated stylus driven through
  * mica_device_poll() in lockstep with the simulation (16 servo polls of 1 ms per 16 ms step,

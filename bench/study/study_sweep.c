@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* What accuracy costs in time: every solver knob of the C API, swept on one haptic scene, each
  * configuration timed in-process and compared with the exact solver on the same scene.
  *

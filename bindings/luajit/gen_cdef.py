@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """Generates mica_cdef.lua (the LuaJIT ffi.cdef of libmica) from the public headers.
 
 usage: gen_cdef.py CC OUT.lua HEADER...

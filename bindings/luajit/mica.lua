@@ -1,3 +1,4 @@
+-- SPDX-License-Identifier: Apache-2.0
 -- libmica for LuaJIT: the C API through the ffi, plus a few helpers.
 --
 --   local mica = require("mica")

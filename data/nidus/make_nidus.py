@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """Makes data/nidus/nidus.msh: a lesion-like irregular blob (the scale of an AVM nidus, about
 3.5 cm across) meshed with linear tetrahedra, in the size of the nidus scene of Arikatla et al.
 2016 (9667 tets, 2734 nodes, 8202 DOF).

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /**
  * @file mica_device.h
  * @brief libmica: haptic devices, the 1 kHz servo path, force filtering and safety.

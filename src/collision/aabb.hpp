@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Axis-aligned bounding boxes in world coordinates (closed: touching boxes overlap).
 #pragma once
 #include <cmath>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // An AABB tree over a body's surface triangles: built once from the rest shape, refitted to the
 // deformed positions every step (the topology of the tree stays; only the boxes move).
 #pragma once

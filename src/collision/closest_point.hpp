@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Closest points on segments and triangles, with the barycentric weights of the result.
 #pragma once
 #include "core/types.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Contacts: where a body touches a tool or another body, with the normal, the gap and a
 // persistent key. Each contact gives one normal row of G (and two tangent rows with friction).
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The geometric stiffness of a tool contact on a surface triangle.
 //
 // A contact row is the gap's gradient at the step's start: the body point (weights w) pushed

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The convex hull of a small point set as outward face planes and face polygons, built once per tool.
 #pragma once
 #include <array>

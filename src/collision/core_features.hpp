@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A tool as a core rounded by a radius (a sphere: its centre; a capsule: its axis; a box or a
 // hull: a polytope inside it, rounded by a little: tool.hpp), and the contacts between the
 // core's features and a body's surface triangle or node.

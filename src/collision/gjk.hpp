@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Distance between two convex polytopes given by their support functions (GJK), with the closest
 // points. Polytopes make it exact up to rounding, in a finite number of steps.
 #pragma once

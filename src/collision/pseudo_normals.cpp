@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "collision/pseudo_normals.hpp"
 
 #include <algorithm>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Angle-weighted pseudo-normals of a closed, outward-wound triangle surface (Baerentzen & Aanaes,
 // "Signed distance computation using the angle weighted pseudonormal", IEEE TVCG 2005). With q the
 // surface point nearest to p, p is outside exactly when (p - q) . n > 0, n the pseudo-normal of

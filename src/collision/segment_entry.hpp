@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Where a straight path first enters a tool's solid shape: a ray cast against the tool at its pose.
 #pragma once
 #include "collision/tool.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Kinematic rigid tools: the host sets their pose every step; bodies cannot push them.
 #pragma once
 #include <memory>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A tool's motion within a step, for contacts that keep a body on the side of the tool it was on
 // at the step's start. The contacts are made against the tool at its new pose; a tool that moves
 // farther in a step than its own size can end past a thin body, whose nodes are then nearer its

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Narrow phase between a tool and one surface triangle of a body.
 #pragma once
 #include "collision/tool.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // MICA_ASSERT(condition, what): an invariant of the library's own code (not a check of the
 // caller's input, which fails with Error(InvalidArgument) and a message for the caller). A broken
 // invariant is a bug in libmica: it throws Error(Internal) naming the condition, the place and

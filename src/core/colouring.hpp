@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A colouring of blocks of consecutive items (nodes, elements) for parallel loops: the items
 // are cut into blocks of consecutive indices, and blocks that share nothing may take one colour.
 // A loop runs colour by colour; the blocks of a colour go to different threads, and each block

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The core reports failure by throwing mica::Error; the C layer turns it into a status.
 #pragma once
 #include <stdexcept>

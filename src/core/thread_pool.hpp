@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A small persistent pool for the step's parallel loops, owned by one World.
 //
 // Why not OpenMP: libmica is embedded in hosts (game engines, simulators with their own job

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Basic numeric types shared by every part of the core.
 #pragma once
 #include <Eigen/Dense>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A haptic device backend as the core sees it. read() and write() run on the servo thread at
 // 1 kHz: they must not allocate, lock or block, and they report failure by status, never by
 // throwing. The C callback table of mica_device.h is adapted to this interface in capi/.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Writing a backend's name into DeviceInfo's fixed, NUL-terminated buffer.
 #pragma once
 #include <algorithm>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* The part of OpenHaptics' HD API that libmica uses, declared here so that libmica builds
  * without OpenHaptics: src/devices/touch_device.cpp loads these functions at run time with
  * dlsym (it never links them), and tests/devices/fake_hd/fake_hd.c implements them.

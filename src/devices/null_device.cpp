@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "devices/null_device.hpp"
 
 #include "devices/device_name.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A device that stays at the origin and renders nothing: a host without hardware still runs
 // the whole servo path.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Simulated devices for tests and demos without hardware, both on a deterministic clock:
 // read number k (from 0) reports time k * kServoPeriod, however fast or slow it is called.
 //  - SimulatedStylus replays a trajectory and ignores the force: an open-loop user.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The Geomagic Touch (and other OpenHaptics devices) through the HD API of OpenHaptics,
 // loaded at run time: libmica neither includes nor links OpenHaptics, so it builds and runs
 // without it, and only creating this device needs the library.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Scripted stylus motion for the simulated devices: a position as a function of time, given
 // as a function or as samples read from a CSV file.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A symmetric-pattern sparse matrix of 3x3 blocks (block CSR): one block row per node.
 // The pattern is built once from the mesh; values are refilled every step without allocation.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Element colouring for parallel assembly: the tets are cut into blocks of consecutive indices,
 // and two blocks that hold tets sharing a node never share a colour, so the blocks of one colour
 // scatter into disjoint blocks of A and disjoint forces. Blocks of one tet give the plain

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The finite-element model of one body: what is constant (rest shape, elements, mass,
 // matrix pattern) and the routines that assemble A = M + h C + h^2 K and the forces from it.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The energies of a co-rotational model along a step, and the twist stiffness its linearisation
 // leaves out: the FEM side of the re-linearisation check (world/relinearise.cpp).
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The rotation of a deformation gradient for co-rotational elasticity.
 #pragma once
 #include "core/types.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The stiffness the warped stiffness R Ke R^T leaves out.
 //
 // The co-rotational energy of an element is, in the signed singular values s of F (the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // One linear tetrahedron of isotropic linear elasticity, in a co-rotated frame.
 //
 // The 12x12 element stiffness Ke = V B^T D B is never stored: its 3x3 blocks have the closed

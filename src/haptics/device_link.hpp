@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // One device attached to the world: the servo cycle (read, map, evaluate, filter, limit,
 // write) on the servo thread, and the exchange with the simulation thread — the device pose
 // goes one way, the force model of each step the other — through lock-free buffers.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // What the simulation thread hands to the servo thread after each step, and how the servo
 // thread turns it into a force between steps (mica-method.md, section 5).
 //

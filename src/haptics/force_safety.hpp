@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The last stage before a force reaches the device: never send a non-finite value, fade the
 // force out when the simulation stops publishing, clamp its magnitude and limit how fast it
 // grows.

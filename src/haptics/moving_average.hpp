@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The paper's force smoothing: a moving average over the last N servo samples, restarted at
 // every change of contact (onset and release) so the window only ever holds samples of one
 // contact state: n_k = min(N, k - k_change + 1).

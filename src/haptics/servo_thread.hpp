@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A thread that calls a tick function at a fixed rate (1 kHz for the servo loop), on absolute
 // deadlines of a steady clock: deadlines stay on the grid start + k * period, so the rate does
 // not drift. A tick that overruns skips the deadlines it missed instead of running the late

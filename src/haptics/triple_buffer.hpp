@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Hands the newest value from one writer thread to one reader thread without locks: the
 // simulation thread publishes a force model, the servo thread reads the newest one.
 //

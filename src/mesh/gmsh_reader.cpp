@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Gmsh ASCII mesh reader, format versions 2.2 and 4.1: keeps the 4-node tetrahedra.
 // Nodes are renumbered 0..n-1 in the order the $Nodes section lists them; nodes that no
 // tetrahedron uses are dropped. Memory reserved for a count read from the file is capped by

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Loading a mesh file: choose the reader from the extension, read whole files into memory,
 // and the other helpers the readers share (declared in text_scanner.hpp).
 #include "mesh/mesh_io.hpp"

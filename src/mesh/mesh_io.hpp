@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Reading tetrahedral meshes from files and writing VTK for ParaView.
 // Every parse error names the file, the line and what was expected.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A linear tetrahedral mesh: node positions and 4-node elements (0-based indices).
 // Convention: a valid rest element has positive signed volume,
 // det[X1-X0, X2-X0, X3-X0] > 0 (X0, X1, X2 counter-clockwise seen from X3).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // TetGen .node/.ele reader. '#' starts a comment anywhere on a line; blank lines are skipped.
 // The first point index of the .node file (0 or 1) sets the numbering of both files. Points
 // are renumbered 0..n-1 in file order; points that no tetrahedron uses (such as the edge

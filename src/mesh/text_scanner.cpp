@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Line and token scanning for the mesh readers.
 #include "mesh/text_scanner.hpp"
 

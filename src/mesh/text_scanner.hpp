@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Private to the mesh readers: walking a text file line by line and token by token, with
 // errors of the shape "<name>: line <N>: expected <what>, got '<token>'" (Errc::Parse unless
 // told otherwise), plus the file and mesh helpers the readers share.

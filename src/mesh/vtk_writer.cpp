@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // VTK legacy ASCII writer: all pieces as one unstructured grid of linear tetrahedra
 // (VTK cell type 10, whose positive orientation is ours), a cell scalar "piece" telling the
 // pieces apart, and the requested per-node vectors. Doubles are written with 17 significant

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The rows of G: each contact's normal row and, with friction, two tangent rows. A row is a
 // velocity component  sum_k coef_k d . v(body_k, node_k)  over the nodes of the touching points.
 // Layout the solvers rely on: a contact's normal row comes first, its two tangent rows (if any)

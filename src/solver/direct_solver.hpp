@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The exact velocity solve: sparse Cholesky (CHOLMOD, supernodal) of the projected system.
 // The symbolic analysis is done once per pattern; the numeric factorization whenever the
 // caller says the matrix or the constraints changed (a linear body factors once).

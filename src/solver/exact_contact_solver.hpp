@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Contact through the Delassus matrix: W = G A^-1 G^T formed column by column with each body's
 // linear solver, and its complementarity problem solved to round-off (Lemke's pivoting without
 // friction; with Coulomb friction block Gauss-Seidel over the contacts, frictional_contact.hpp).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "solver/factored_mica.hpp"
 
 #include "solver/mica_solver.hpp"

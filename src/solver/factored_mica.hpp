@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // MICA with a factored anticipation: the same problem and outer loop as MicaSolver (anticipate
 // the contact velocities, update the impulses by projected Gauss-Seidel, update the velocities,
 // stop on the change of the solution and a balanced momentum), with the block-diagonal

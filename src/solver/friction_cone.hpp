@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The isotropic Coulomb cone of one contact, shared by every contact solver: an impulse
 // (l_n, l_t1, l_t2) on a normal and two orthonormal tangents is admissible when
 //     l_n >= 0   and   |(l_t1, l_t2)| <= mu l_n.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "solver/frictional_contact.hpp"
 
 #include <Eigen/QR>

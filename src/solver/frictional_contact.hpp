@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Contact with isotropic Coulomb friction on a dense Delassus matrix M (rows as in lcp.hpp's
 // cone_error: per contact a normal row and up to two tangent rows):
 //     w = M z + q;  0 <= z_n _|_ w_n >= 0;  |z_t| <= mu z_n;  sliding opposes w_t.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A sparse Cholesky factor of a recent state of a body's velocity system, K_f = S A_f S + I - S,
 // kept with the node rotations R_f of the step it was built from. A later co-rotated system
 // differs from it mostly by how far each node has turned since, which the warped preconditioner

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Dense reference solvers for linear complementarity problems (LCP): given M (n x n) and q,
 // find z with
 //     z >= 0,   w = M z + q >= 0,   z_r w_r = 0 for every row r.

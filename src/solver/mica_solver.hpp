@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // MICA: Modified Iterative Constraint Anticipation (Arikatla, Ortiz, De, Enquobahrie 2016).
 // One loop resolves projection constraints and contact together:
 //

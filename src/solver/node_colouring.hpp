@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Node colouring for the colour-ordered (multicolour) block Gauss-Seidel sweep. The nodes are cut
 // into blocks of consecutive indices, and two blocks share a colour only when A has no block
 // (i, j) between a node of one and a node of the other: the blocks of a colour update

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Projected (filtered) preconditioned conjugate gradient with a block-Jacobi preconditioner.
 #pragma once
 #include <chrono>

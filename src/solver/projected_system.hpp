@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The velocity system of one body under projection constraints.
 // With v = y + z, y = S y, the constrained problem S (A v - b) = 0, (I - S) v = z becomes
 // the symmetric positive definite system (S A S + I - S) y = S (b - A z).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Linear projection constraints (LPC) on one body's nodes. Node i keeps the velocity
 // components in the range of S_i (a symmetric projector) free and prescribes the rest:
 // (I - S_i) v_i = z_i. Fixed: S_i = 0; slide on a plane with normal p: S_i = I - p p^T.

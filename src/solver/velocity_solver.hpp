@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The velocity solve of a step, one contract for every method. Per body k (a SolverBody)
 //   A_k v_k = b_k + G_k^T lambda   on the free directions S_k,   (I - S_k) v_k = z_k,
 // and per contact (ContactRows) 0 <= lambda_n _|_ G_n v + bias_n >= 0 with the tangent pair on

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A deformable (or static) body in three parts: the model it was made with (never changed after
 // creation), the state a step starts from and leaves, and the per-step work arrays, sized once at
 // creation so that stepping does not allocate. Body is the three together; a function that needs

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Co-rotational re-linearisation (K1 in docs/stability.md).
 //
 // The step A v+ = M v + h (f_R(x) + f_ext) is backward Euler with the element rotations R frozen

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Objects named by 64-bit ids that carry a kind and a generation, so a stale or foreign id
 // is detected instead of dereferenced: bits 0-31 slot + 1, 32-55 generation, 56-63 kind.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Per-stage counters and timings of the step, and the solver's report.
 #pragma once
 #include <array>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The step: one linearised backward-Euler step at velocity level, per body
 //   A v+ = b,  A = M + h C + h^2 K,  b = M v + h (f_int(x) + f_ext),  x+ = x + h v+,
 // under the projection constraints (I - S) v+ = z. Each stage runs only when the plan holds it.

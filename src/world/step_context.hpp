@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // What one step works with, built once at its start (World::advance) and handed to its stages:
 // the step size, the one deadline of the step's time budget, the thread pool (null: serial), the
 // plan, the dynamic bodies and the tools collision numbered. The solver sees the SolveContext part.

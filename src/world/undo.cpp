@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Undoing a failed step: World::step saves what the step writes before it can fail and puts it
 // back when it fails (issue 16: a device-driven tool stayed at the device's new pose and the
 // factored sweep's refresh schedule shifted, so a failed step left traces in later ones).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The world: bodies, constraints, settings, and the step. Every mutating call validates
 // everything before it changes anything, so a call that throws leaves the world as it was.
 #pragma once

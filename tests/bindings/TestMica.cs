@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Tests of the C# binding (bindings/csharp/com.libmica.mica/Runtime): its declarations against the
 // header manifest (the drift guard), the sphere-indent scene against the C reference, errors,
 // the SafeHandle, the log callback and a device backend written in C#.

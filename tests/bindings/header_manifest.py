@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """Reads the public headers and writes a C program that prints the manifest of the C API.
 
 usage: header_manifest.py OUT.c HEADER...

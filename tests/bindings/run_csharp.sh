@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: Apache-2.0
 # run_csharp.sh <TestMica.cs>: compiles the C# binding (the Unity package's Runtime/) with its
 # test using mcs and runs it on mono (exit 77, a skip, without them or the manifest).
 set -eu

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: Apache-2.0
 # run_luajit.sh <test_luajit.lua>: runs the LuaJIT binding's tests against the generated cdef
 # (exit 77, a skip, without luajit or the generated files).
 set -eu

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: Apache-2.0
 # run_python.sh <test_python.py>: runs the Python binding's tests with Debian's python3
 # (exit 77, a skip, without python3, numpy or the generated manifest).
 set -eu

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* The reference for the binding tests: the scene of examples_c/sphere_indent.c (same parameters,
  * same operations in the same order), printing the tool force of every step at full precision.
  * Each binding replays the scene and compares its forces with this output.

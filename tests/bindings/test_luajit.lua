@@ -1,3 +1,4 @@
+-- SPDX-License-Identifier: Apache-2.0
 -- Tests of the LuaJIT binding (bindings/luajit): the generated cdef against the header
 -- manifest (the drift guard), the sphere-indent scene against the C reference, errors, devices.
 -- Environment (tests/bindings/CMakeLists.txt): MICA_LIBRARY, MICA_MANIFEST_TSV, MICA_REFERENCE;

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Tests of the Python binding (bindings/python/mica): its declarations against the header
 manifest (the drift guard), the sphere-indent scene against the C reference, errors, warnings,
 view lifetime, and devices implemented in Python.

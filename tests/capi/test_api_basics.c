@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* The happy paths through the C ABI, each checked against physics or against an independent
  * count, never against the library's own output alone:
  * - versions and defaults as documented in mica.h;

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Bad input through the C ABI: every entry point of mica.h, given bad input, returns a clear
  * status and a message that names what was wrong, leaves the world exactly as it was, and never
  * crashes.

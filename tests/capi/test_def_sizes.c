@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Drop-in upgrades within SONAME 0: every def is accepted from its size in 0.2.0 (the first
  * release) up to the current sizeof, the fields an older caller lacks take their defaults, and
  * only a smaller or a larger (newer header) size is refused. Any 0.x header_version is accepted.

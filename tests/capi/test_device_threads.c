@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* The functions mica_device.h calls safe on other threads, run there while the world's thread
  * creates, steps and destroys: mica_device_get_stats (any thread) and mica_device_get_info (any
  * thread but the servo thread) on two reader threads, mica_device_poll on a servo thread, while

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* The haptic loop through the C API: a simulation thread at 60 Hz and libmica's 1 kHz servo
  * thread, with a virtual hand (mass-spring-damper) reaching into a soft block. */
 #include <setjmp.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* What an adversarial run against 0.4.0 found (issue 16), through the C API: a mesh whose tets
  * repeat, device poses that are not unit or not finite once mapped, time steps too small for
  * double precision, a failed step that was not undone whole, and loaders given a FIFO, a device

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Direct manipulation through the C API: grab, drag, feel, release. */
 #include <setjmp.h>
 #include <stdarg.h>

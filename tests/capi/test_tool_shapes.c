@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Every tool shape through the C API presses a soft block the way its geometry says: the hull of
  * a box's eight corners is the box, so they must give the same force; a capsule lying flat
  * presses like a cylinder of its radius; a plane lifted into the block pushes everything up. */

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Body against body (collide_bodies): a node outside the other body, beside one of its edges or
 // corners, is outside with a positive gap, whichever of the triangles sharing that edge the search
 // meets first; a node inside is inside.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The triangle AABB tree returns exactly the triangles whose boxes overlap a query box, before and
 // after refitting to moved vertices.
 #include "collision/bvh.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Angle-weighted pseudo-normals tell inside from outside at every nearest point of a closed
 // surface, faces, edges and corners alike, where one face normal does not.
 #include "collision/closest_point.hpp"

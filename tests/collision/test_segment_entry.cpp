@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Where a segment first enters a tool: closed forms for each shape, and for random segments the
 // same answer as marching along the segment with the signed distance, in a rotated, shifted frame.
 #include "collision/segment_entry.hpp"

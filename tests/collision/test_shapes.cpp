@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Tool shapes: signed distances and normals against closed forms in rotated and translated frames,
 // the convex hull against the box and against a sampled surface, validation, and bounds.
 #include "collision/tool.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Tool contacts of a tool that moved: a tool that went past part of a thin slab in one step keeps
 // it on the side it was on at the step's start (the contacts' normals point there, and meeting
 // them leaves the tool behind); a tool that moves a little keeps the nearest-point contacts.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Tool against one triangle: closed-form sphere and plane contacts, MPR for boxes, hulls and
 // capsules against known depths, all in a rotated and translated scene.
 #include "collision/triangle_contact.hpp"

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # The fake OpenHaptics HD library (tests/devices/fake_hd/) that devices/test_touch_backend
 # loads through MICA_HD_LIBRARY instead of libHD.so. Included by tests/CMakeLists.txt after
 # the core test targets exist.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The devices that need no hardware: the null device, the simulated stylus (a function or a
 // CSV file, linearly interpolated) and the virtual hand, whose spring-damper is checked
 // against its analytic step response, static deflection and energy.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The Touch backend against tests/devices/fake_hd, an HD library scripted frame by frame and
 // loaded the way the real one is: through MICA_HD_LIBRARY and dlopen. Covers unit conversion,
 // the one-frame-per-servo-cycle protocol, the forces sent, the scheduler, HD errors mapped to

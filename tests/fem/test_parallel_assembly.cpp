@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The step's parallel loops against the serial ones: the pool itself (every thread runs, the
 // barrier orders), rotations bit for bit, assembly by element colours equal up to round-off
 // (the sums run in colour order) and the same for every thread count above one; none of it

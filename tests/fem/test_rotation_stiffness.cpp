@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The co-rotational energy's derivatives: the element force is its exact gradient, and the warped
 // stiffness R Ke R^T plus the twist modes is its exact Hessian (fem/rotation_stiffness.hpp), both
 // against central finite differences of the energy; the projected twist stiffness is positive

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Element-level physics: patch test, rigid-motion invariance, stiffness against a finite
 // difference of the forces, and mass totals.
 #include "fem/fem_model.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Counts heap allocations made by the current thread, so a test can assert that a servo-path
 // call allocates nothing:
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The whole servo cycle (read, map, evaluate, filter, limit, write) allocates nothing, renders
 // the published force model at the device's pose, and fails safe.
 #include "devices/null_device.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The servo path's force between simulation steps: the local model is exactly linear in the
 // tool position, hold ignores it, the coupling pulls the device toward the tool and damps
 // their relative motion, and the passivity bound is K T / 2.

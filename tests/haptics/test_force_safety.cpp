@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The last stage before the device: non-finite forces become zero, the magnitude is clamped
 // along the same direction, growth is rate-limited while drops pass at once, a stalled
 // simulation fades the force linearly to exactly zero, and apply() allocates nothing.

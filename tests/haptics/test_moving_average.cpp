@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The servo-rate force filter: an exact moving average, restarted at contact onset (the first
 // in-contact output is the raw force) and at release, with no drift over long runs and no
 // allocation per sample.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The fixed-rate loop: every deadline ticked or skipped, never burst, a measured rate, an overrun that skips deadlines instead of bursting, and start/stop
 // bookkeeping. Only bounds that hold however late the scheduler runs the thread are asserted (a
 // loaded CI machine may starve it for tens of milliseconds): how many ticks a machine manages is

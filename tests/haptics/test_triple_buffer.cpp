@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The lock-free hand-over from the simulation thread to the servo thread: the reader always
 // gets the newest whole value, never a torn one, and never goes back in time. Also run under
 // ThreadSanitizer (-DMICA_SANITIZE=thread).

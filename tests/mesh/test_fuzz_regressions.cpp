@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Inputs from fuzzing the mesh loaders (fuzz/, scripts/fuzz.sh) and the hostile inputs tried
 // alongside: each must end in a clean mica::Error (or, where the format says what the bytes
 // mean, in exactly that mesh), never in undefined behaviour, a crash or a model with

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Mesh files in and out: Gmsh 2.2 / 4.1 and TetGen readers, their error messages, load_mesh,
 // and the VTK legacy writer read back by a small parser.
 #include <unistd.h>

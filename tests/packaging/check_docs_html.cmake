@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # cmake -DHTML=<build>/docs/html -P check_docs_html.cmake
 # The API reference as built: every picture a page shows is there, and no page is named after
 # the build machine's paths (md_<page>.html).

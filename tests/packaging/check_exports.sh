@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: Apache-2.0
 # check_exports.sh <libmica.so> <expected SONAME>
 # The shared library exports the C API (mica_*) and nothing else, under the expected SONAME.
 set -eu

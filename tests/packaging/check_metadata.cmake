@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # cmake -DSOURCE_DIR=<source> -DVERSION=<project version> -P check_metadata.cmake
 # Every package of libmica names the same licence (Apache-2.0) and version: the top-level
 # LICENSE and NOTICE, mica.pc, the CMake package, the Unity package, the Python pyproject, the

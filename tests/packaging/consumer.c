@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* A program built against the *installed* libmica (pkg-config or find_package(mica)):
  * a box fixed on its x = 0 face sags under gravity. Exits non-zero with a message on failure. */
 #include <mica/mica.h>

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: Apache-2.0
 # run_consumer_cmake.sh <cmake> <consumer project dir> <work dir> <staged prefix>
 # Configures, builds and runs the find_package(mica) consumer against the staged install.
 # CC, CMAKE_GENERATOR and CONSUMER_FLAGS (e.g. sanitizer flags) come from the environment.

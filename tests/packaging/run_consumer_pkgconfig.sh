@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: Apache-2.0
 # run_consumer_pkgconfig.sh <staged prefix> <consumer.c> <work dir>
 # Builds consumer.c against the staged install as docs/getting-started.md says for a prefix the
 # dynamic loader does not search: `$CC ... $(pkg-config --cflags --libs mica)

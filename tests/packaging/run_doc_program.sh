@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: Apache-2.0
 # run_doc_program.sh <staged prefix> <page.md> <heading> <work dir> <expected output (grep -E)> [documented command]
 # The first C program under "## <heading>" of a docs page, taken from the page itself, built and
 # run against the staged install the way docs/getting-started.md ("Running a program") says for

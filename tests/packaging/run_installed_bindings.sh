@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: Apache-2.0
 # run_installed_bindings.sh <staged prefix> <python dir> <lua dir>
 # The Python package and the LuaJIT module as `cmake --install` put them under the staged
 # prefix find the staged libmica by themselves: no MICA_LIBRARY, no LD_LIBRARY_PATH (only the

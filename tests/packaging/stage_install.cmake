@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # cmake -DBUILD_DIR=<build> -DPREFIX=<dir> -P stage_install.cmake
 # A fresh `cmake --install` of the build tree into PREFIX (no stale files from earlier runs),
 # then the files a user relies on: the licence under share/doc/libmica, the headers, mica.pc

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Sourced by the run_*.sh scripts with $prefix set: points PKG_CONFIG_PATH at the staged
 # install's mica.pc (GNUInstallDirs may have put it under lib/ or lib/<multiarch>/).
 pc=$(find "$prefix" -path '*/pkgconfig/mica.pc' | head -n 1)

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Random LCPs with fixed seeds, shared by test_lcp.cpp and test_lcp_oracle.cpp. No cmocka
 // here: include this before "test_util.hpp".
 #pragma once

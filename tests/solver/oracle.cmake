@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Siconos numerics, the independent oracle of tests/solver/test_lcp_oracle.cpp (Lemke) and
 # tests/solver/test_frictional_contact_oracle.cpp (fc3d): a test-only dependency (Debian:
 # libsiconos-numerics-dev). Included by tests/CMakeLists.txt after the core test targets exist.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // One velocity problem for the tests of every solver (VelocitySolver, velocity_solver.hpp), built
 // without a World: a 0.1 m cube of n^3 cells x 6 tets (E = 2e4 Pa, nu = 0.3, rho = 1000), its
 // bottom face fixed, a little sheared (so the co-rotational A is warped), moving up at 5 cm/s

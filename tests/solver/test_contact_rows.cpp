@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The normal row's bias: a gap the tool's own motion closed this step is made way for at the
 // tool's speed; only penetration present at the step's start is recovered at max_recovery_speed.
 #include "solver/contact_rows.hpp"

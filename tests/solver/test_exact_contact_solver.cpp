@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The exact contact solver (the reference every other solver is tested against): its solution
 // meets the conditions of the problem to round-off, with and without friction; without contact
 // it is the plain projected solve; a body's factor is kept while its A and constraints stay, and

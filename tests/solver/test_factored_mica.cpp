@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The factored MICA solver against the exact one on the same problem, through the solver
 // contract: velocities and impulses agree to the tolerance, with and without friction, from a
 // cold and a warm start, with the factor of the current system and with one warped from an

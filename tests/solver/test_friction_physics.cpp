@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Coulomb friction in whole steps, every solver: a stiff block on a static plane under tilted
 // gravity slides with the textbook acceleration g (sin theta - mu cos theta) whichever tangent
 // direction it slides along (a box bound per tangent row gave mu sqrt 2 on the diagonal: 41 %

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The isotropic Coulomb cone: the disk projection every contact solver shares, the exact solve of
 // one contact (friction_cone.hpp) against hand-solved cases, the natural residual cone_error
 // (lcp.hpp), and the dense solver (frictional_contact.hpp) on random problems, checked against

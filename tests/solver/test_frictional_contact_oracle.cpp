@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Independent oracle for solve_frictional_contact: Siconos numerics' 3-D frictional contact
 // solver (SICONOS_FRICTION_3D_NSGS through fc3d_driver; its rows are ordered normal, t1, t2 per
 // contact as ours, and its velocity is u = M r + q, with the Coulomb law in De Saxce's form,

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The factored sweep with a factor refreshed in the background (LaggedFactor): results do not
 // depend on when the worker finishes (lockstep adoption), a refreshed factor keeps a turning body
 // to fewer iterations than the first step's, a changed constraint set refactors at once, and a

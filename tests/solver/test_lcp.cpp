@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The dense LCP solvers: Lemke on hand-solved and random problems (positive definite,
 // positive semidefinite and singular as with redundant contacts, infeasible), projected
 // Gauss-Seidel against Lemke. (Friction, which is not an LCP: test_frictional_contact.cpp.)

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Independent oracle for solve_lcp_lemke: Siconos numerics' lexicographic Lemke solver
 // (SICONOS_LCP_LEMKE through linearComplementarity_driver), a test-only dependency wired by
 // tests/solver/oracle.cmake. On the random LCPs of test_lcp.cpp both must satisfy

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The linear solvers of one body's projected system (S A S + I - S) y = S (b - A z), v = y + z:
 // CHOLMOD (DirectSolver) against a dense Cholesky of the same matrix, and projected PCG
 // (PcgSolver) against CHOLMOD, for solve and solve_homogeneous; PCG stops at its deadline.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // MICA against the exact reference (MICA_SOLVER_DIRECT: CHOLMOD, the exact Delassus matrix and
 // its complementarity problem solved to round-off), stepping the same scene side by side; the
 // solver alone against the exact one on one problem (solver_problem.hpp); and the physics of the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The colourings behind the parallel step: nodes (the colour-ordered MBGS sweep) and elements
 // (parallel assembly) are valid on structured boxes and on the nidus mesh, and the checks catch
 // an invalid colouring.

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Numerical-stability stress tests (tests/stress/, docs/stability.md). Included by
 # tests/CMakeLists.txt after mica_test_core exists.
 #

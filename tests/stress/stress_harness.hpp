@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The stress harness: steps a World and checks after every step what numerical stability means
 // here, recording the worst values for the CSV that docs/stability.md is generated from.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The long run (ctest label "long"): 100000 steps of 16 ms (27 simulated minutes) of a sphere
 // driven into a soft block by a virtual hand through a DeviceLink, the servo loop polled 16 times
 // per step in lockstep with the simulation (as tests/capi/test_haptics.c does through the C API),

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The stress matrix: hard cases (mica-method.md section 6) across Young's modulus 1e2..1e9 Pa,
 // Poisson ratio 0..0.499 and time steps 1e-4..5e-2 s, each run checked by stress::Monitor for
 // finite results, energy growth beyond the work of the drivers, penetration, tunnelling, false

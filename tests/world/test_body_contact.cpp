@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Contact between bodies: a cube dropped on a static slab comes to rest carrying its weight,
 // two deformable bodies pressed together agree with the exact reference, and a contact that
 // reports a node inside the other body has it inside.

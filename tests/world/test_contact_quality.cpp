@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The force a hand feels through a tool, checked against what physics says of it:
 // - coverage: a tool pressed anywhere on a surface cell (a node, an edge's middle, a face's
 //   centre, and the points between) makes contact, stays out of the body to within its margin,

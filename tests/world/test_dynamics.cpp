@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Whole-body dynamics against analytic answers: a cantilever's static tip deflection
 // (Euler-Bernoulli), energy that never grows without damping and decays with it, and the
 // reactions of overlapping constraint groups that add up to the load they carry.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Fast tools: a tool pressed in at speed is made way for at its speed (its own approach is not
 // penetration to recover slowly), and a tool driven through a thin slab in one step pushes the
 // slab ahead instead of passing through it; a tool turned about itself feels what it did.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The step runs only the stages the scene calls for, and leaving a stage out changes
 // nothing: a scene without gravity or damping gives the same motion as one where both are
 // present with zero values.

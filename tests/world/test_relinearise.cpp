@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Co-rotational re-linearisation (K1 in docs/stability.md, WorldSettings::relinearise_*): a
 // released 180-degree twist must not gain energy; a scene whose elements turn little is left
 // exactly as the frozen-rotation step computes it; and re-linearising a small-rotation scene on

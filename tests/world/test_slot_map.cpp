@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // SlotMap: ids with kind and generation, and lookups from other threads while the owning thread
 // inserts and erases (issue 16: mica_device_get_stats on a reader thread freed under it by
 // mica_device_create's reallocation). Labelled `threads`: CI runs it under ThreadSanitizer, and

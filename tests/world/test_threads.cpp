@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // WorldSettings::threads: a world stepped on 2 (or 3) threads against the same world on one,
 // side by side. MICA's sweep runs in colour order on more than one thread (its iterates differ,
 // its fixed point does not), so velocities and impulses agree within the solver tolerance; the

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """libmica from Python: deformable bodies and haptic tools through ctypes (no compiler needed).
 
     import mica

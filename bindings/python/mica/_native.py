@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The raw ctypes layer: the library, the struct mirrors, the constants and every prototype.
 
 Everything here mirrors include/mica/mica.h and mica_device.h one to one (same names, same

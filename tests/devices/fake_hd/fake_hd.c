@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* The fake HD library: see fake_hd.h. Every HD call locks `state_lock`; the scheduler's
  * callbacks run under `schedule_lock` and take `state_lock` inside it, never the reverse. */
 #include "fake_hd.h"

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* A stand-in for OpenHaptics' HD library (libfake_hd.so, test-only): the HD functions
  * libmica's Touch backend loads, over a scripted stylus, plus these controls for the tests.
  * Lengths are HD's: mm, mm/s. */

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // libmica for C# (Unity, Mono, .NET): a thin object layer over MicaNative.
 //
 //   var def = Mica.WorldDef();

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The raw C API of libmica (include/mica/mica.h and mica_device.h) for C#: one [DllImport] per
 // function, blittable mirrors of the structs (the C names, the C field order; int for flags,
 // fixed buffers for arrays), the constants and the callback delegates.
