@@ -26,9 +26,11 @@ def main(csv_path: str, png_path: str) -> None:
         ax.set_ylabel("force on the stylus, y (N)")
         ax.set_title(title)
         ax.grid(alpha=0.3)
-    axes[0].legend(loc="upper right", fontsize=8)
+    # Below the panels: inside, it hid the peak of the press.
+    handles, labels = axes[0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="lower center", ncol=2, fontsize=8)
     fig.suptitle("1 kHz servo loop against a 60 Hz simulation (libmica haptic_loop)")
-    fig.tight_layout()
+    fig.tight_layout(rect=(0, 0.07, 1, 1))
     fig.savefig(png_path)
 
 
