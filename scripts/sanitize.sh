@@ -21,7 +21,7 @@ cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMICA_SANITIZE="
 targets=()
 if [[ $kind == thread ]]; then
   read -r -a targets < <(ctest --test-dir "$build" "${select[@]}" --show-only=json-v1 | python3 -c \
-    'import json, os, sys; print(" ".join(sorted({os.path.basename(t["command"][0]) for t in json.load(sys.stdin)["tests"]})))')
+    'import json, os, sys; print(" ".join(sorted({os.path.basename(t["command"][0]) for t in json.load(sys.stdin)["tests"] if t.get("command")})))')
 fi
 cmake --build "$build" -j "$(nproc 2>/dev/null || echo 2)" ${targets[@]:+--target "${targets[@]}"}
 # Leaks count as failures; UBSan stops at the first report (the build sets -fno-sanitize-recover).
