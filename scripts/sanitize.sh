@@ -20,8 +20,9 @@ cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMICA_SANITIZE="
 # Only what the selected tests run is built (CI time: the thread build needs a dozen programs).
 targets=()
 if [[ $kind == thread ]]; then
+  # A test's program is its target: <concern>/<name> is <concern>_<name>, examples/<name> is <name>.
   read -r -a targets < <(ctest --test-dir "$build" "${select[@]}" --show-only=json-v1 | python3 -c \
-    'import json, os, sys; print(" ".join(sorted({os.path.basename(t["command"][0]) for t in json.load(sys.stdin)["tests"] if t.get("command")})))')
+    'import json, sys; print(" ".join(sorted({n.split("/", 1)[1] if n.startswith("examples/") else n.replace("/", "_") for n in (t["name"] for t in json.load(sys.stdin)["tests"])})))')
 fi
 cmake --build "$build" -j "$(nproc 2>/dev/null || echo 2)" ${targets[@]:+--target "${targets[@]}"}
 # Leaks count as failures; UBSan stops at the first report (the build sets -fno-sanitize-recover).
