@@ -97,23 +97,40 @@ Vec3 tool_point_velocity(const Tool& tool, const Vec3& p) {
   return tool.velocity + tool.angular_velocity.cross(p - tool.position);
 }
 
+// The nearest point of a surface to p within reach (tri -1: none), and the outward
+// pseudo-normal of the face, edge or vertex it lies on (which side of the surface p is on).
+struct NearestSurfacePoint {
+  int32_t tri = -1;
+  TrianglePoint point{};
+  double distance = HUGE_VAL;
+  Vec3 face, outward;  // the triangle's normal, the pseudo-normal at the point
+};
+
+NearestSurfacePoint nearest_surface_point(const SurfaceView& s, const Vec3& p, double reach) {
+  const Vec3List& x = *s.x;
+  NearestSurfacePoint n;
+  s.bvh->query(Aabb{p, p}.inflated(reach), [&](int32_t tri) {
+    const Tri& t = (*s.triangles)[tri];
+    const TrianglePoint q = closest_on_triangle(p, x[t[0]], x[t[1]], x[t[2]]);
+    const double d = (p - q.point).norm();
+    if (d < n.distance) {
+      n.distance = d;
+      n.tri = tri;
+      n.point = q;
+    }
+  });
+  if (n.tri < 0) return n;
+  const Tri& t = (*s.triangles)[n.tri];
+  n.face = (x[t[1]] - x[t[0]]).cross(x[t[2]] - x[t[0]]).normalized();
+  n.outward = s.normals->at(n.tri, t, n.point.weights, n.face);
+  return n;
+}
+
 // Whether point p lies behind the body's surface with the surface point `distance` from it as
 // its nearest: on the inner side of the pseudo-normal there, and no surface point nearer.
 bool behind_surface_at(const SurfaceView& body, const Vec3& p, double distance) {
-  const Vec3List& x = *body.x;
-  const double reach = distance * (1 + 1e-6) + 1e-12;  // the point itself, within round-off
-  bool nearest = true, behind = false;
-  body.bvh->query(Aabb{p, p}.inflated(reach), [&](int32_t tri) {
-    if (!nearest) return;
-    const Tri& t = (*body.triangles)[tri];
-    const TrianglePoint q = closest_on_triangle(p, x[t[0]], x[t[1]], x[t[2]]);
-    const double d = (p - q.point).norm();
-    if (d < distance * (1 - 1e-6) - 1e-12) nearest = false;  // another point is nearer: not this one's
-    if (d > reach || behind) return;
-    const Vec3 face = (x[t[1]] - x[t[0]]).cross(x[t[2]] - x[t[0]]).normalized();
-    behind = (p - q.point).dot(body.normals->at(tri, t, q.weights, face)) < 0;
-  });
-  return nearest && behind;
+  const NearestSurfacePoint n = nearest_surface_point(body, p, distance * (1 + 1e-6) + 1e-12);  // within round-off
+  return n.tri >= 0 && n.distance >= distance * (1 - 1e-6) - 1e-12 && (p - n.point.point).dot(n.outward) < 0;
 }
 
 }  // namespace
@@ -261,40 +278,23 @@ void collide_tool(const Tool& tool, int32_t tool_index, uint64_t tool_key, const
 void collide_bodies(const SurfaceView& a, const SurfaceView& b, double margin_at_rest, double friction,
                     std::vector<Contact>& out) {
   const Vec3List& xa = *a.x;
-  const Vec3List& xb = *b.x;
   const double margin = margin_at_rest + a.travel + b.travel;
   const double reach = std::max(margin, b.depth);
   for (int32_t node : *a.nodes) {
     const Vec3& p = xa[node];
     // The nearest triangle of b within reach, and which side of it p is on.
-    double best = HUGE_VAL;
-    int32_t best_tri = -1;
-    TrianglePoint best_point{};
-    b.bvh->query(Aabb{p, p}.inflated(reach), [&](int32_t tri) {
-      const Tri& t = (*b.triangles)[tri];
-      const TrianglePoint q = closest_on_triangle(p, xb[t[0]], xb[t[1]], xb[t[2]]);
-      const double d = (p - q.point).norm();
-      if (d < best) {
-        best = d;
-        best_tri = tri;
-        best_point = q;
-      }
-    });
-    if (best_tri < 0 || best > reach) continue;
-    const Tri& t = (*b.triangles)[best_tri];
-    const Vec3 face = (xb[t[1]] - xb[t[0]]).cross(xb[t[2]] - xb[t[0]]).normalized();  // outward
-    // The side: from the pseudo-normal of the face, edge or vertex the nearest point lies on.
-    const Vec3 outward = b.normals->at(best_tri, t, best_point.weights, face);
-    const Vec3 d = p - best_point.point;
-    const bool inside = d.dot(outward) < 0;
-    const double gap = inside ? -best : best;
+    const NearestSurfacePoint n = nearest_surface_point(b, p, reach);
+    if (n.tri < 0 || n.distance > reach) continue;
+    const Vec3 d = p - n.point.point;
+    const bool inside = d.dot(n.outward) < 0;
+    const double gap = inside ? -n.distance : n.distance;
     if (gap >= margin) continue;
     // The normal separates a's node from b: along d outside, against it inside.
-    Vec3 normal = best > 1e-12 ? Vec3((inside ? -d : d) / best) : outward.normalized();
-    if (!normal.allFinite()) normal = face;  // a node on a collapsed feature: the face has to do
+    Vec3 normal = n.distance > 1e-12 ? Vec3((inside ? -d : d) / n.distance) : n.outward.normalized();
+    if (!normal.allFinite()) normal = n.face;  // a node on a collapsed feature: the face has to do
     Contact c{contact_key(a.key, b.key, uint64_t(node)), -1, node_point(a.index, node), BodyPoint{}, normal, p, gap,
               friction, Vec3::Zero()};
-    if (b.index >= 0) c.b = triangle_point(b.index, t, best_point.weights);  // a static b is an obstacle
+    if (b.index >= 0) c.b = triangle_point(b.index, (*b.triangles)[n.tri], n.point.weights);  // a static b is an obstacle
     out.push_back(c);
   }
 }

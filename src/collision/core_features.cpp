@@ -95,10 +95,10 @@ bool node_core(const ToolCore& core, const Vec3& x, FeatureHit& hit, int32_t& fa
       if (within) consider(height, F.normal, int32_t(f), -1);
     }
     for (size_t e = 0; e < P.edges.size(); ++e) {
-      const Vec3 a = P.vertices[size_t(P.edges[e][0])], d = P.vertices[size_t(P.edges[e][1])] - a;
-      const double t = d.dot(p - a) / d.squaredNorm();
-      if (!(t > 0 && t < 1)) continue;
-      const Vec3 off = p - (a + t * d);
+      const Vec3 &a = P.vertices[size_t(P.edges[e][0])], &b = P.vertices[size_t(P.edges[e][1])];
+      const double t = closest_on_segment(p, a, b);
+      if (!(t > 0 && t < 1)) continue;  // at an end: a corner's
+      const Vec3 off = p - (a + t * (b - a));
       consider(off.norm(), off.normalized(), -1, int32_t(e));
     }
     for (const Vec3& v : P.vertices) consider((p - v).norm(), (p - v).normalized(), -1, -1);
