@@ -4,6 +4,7 @@
 #include <Eigen/QR>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 #include "core/error.hpp"
 #include "solver/friction_cone.hpp"
@@ -131,13 +132,19 @@ FrictionalSolution solve_frictional_contact(const Eigen::MatrixXd& M, const Eige
   }
   double demand = 0;  // the impulse each normal row alone asks for
   for (const Block& b : blocks) demand = std::max(demand, -q(b.row[0]) / b.W(0, 0));
-  auto converged = [&] {
-    s.w.noalias() = M * s.z;  // afresh: the incremental updates drift by round-off
-    s.w += q;
+  // fresh: w = M z + q afresh (the sweeps' incremental updates drift by round-off); otherwise the
+  // sweeps' w, which costs nothing to check and is refreshed before it may say "solved".
+  auto check = [&](bool fresh) {
+    if (fresh) {
+      s.w.noalias() = M * s.z;
+      s.w += q;
+    }
     s.error = cone_error(M, contacts, s.z, s.w);
     s.scale = std::max(demand, s.z.size() ? s.z.cwiseAbs().maxCoeff() : 0.0);
     return s.error <= settings.tolerance * s.scale;
   };
+  auto converged = [&] { return check(true); };
+  auto converged_after_sweep = [&] { return check(s.sweeps % 64 == 0) && converged(); };
   // Block Gauss-Seidel converges, but linearly, and slowly where contacts are nearly redundant
   // (several contact points on the nodes of one face: W is close to singular). So batches of
   // sweeps alternate with Newton steps on the natural map F (cone_error's residual vector), which
@@ -157,13 +164,26 @@ FrictionalSolution solve_frictional_contact(const Eigen::MatrixXd& M, const Eige
   // A Newton step factors the dense n x n Jacobian: past kMaxNewtonRows rows (hundreds of
   // contacts, a body gone wild) twenty of them per batch took minutes a step; sweeps only there.
   const bool newton = n <= kMaxNewtonRows;
+  // Progress is judged every kStallWindow sweeps: a window that did not halve the best relative
+  // residual switches to the damped sweeps, a second such window stops ("stalled"). A problem that
+  // stalls (friction near redundant contacts, which need not have a unique solution) would
+  // otherwise spend its whole budget, 10^4 sweeps and ~100 Newton steps, at the same residual.
+  // Halving per window is the slowest rate that reaches 1e-10 from 1e-1 (30 halvings) within
+  // the default budget, so the rule gives up only on what the budget would not have solved.
+  constexpr int32_t kStallWindow = 256;
+  bool damped = false, stalled = false;
+  double best = std::numeric_limits<double>::infinity(), best_at_window = best;
+  int32_t window_end = kStallWindow;
   s.solved = converged();
-  for (int32_t batch = 8; !s.solved && s.sweeps < 2 * settings.max_sweeps; batch = std::min(2 * batch, 512)) {
+  for (int32_t batch = 8; !s.solved && !stalled && s.sweeps < 2 * settings.max_sweeps;
+       batch = std::min(2 * batch, 512)) {
+    damped = damped || s.sweeps >= settings.max_sweeps;
     const int32_t sweeps_end = std::min(s.sweeps + batch, 2 * settings.max_sweeps);
     while (!s.solved && s.sweeps < sweeps_end && !out_of_time()) {
-      sweep(M, blocks, s.sweeps < settings.max_sweeps ? 1.0 : 0.5, s.z, s.w);
+      sweep(M, blocks, damped ? 0.5 : 1.0, s.z, s.w);
       ++s.sweeps;
-      s.solved = converged();
+      s.solved = converged_after_sweep();
+      best = std::min(best, s.error / s.scale);
     }
     for (int k = 0; k < 20 && newton && !s.solved && !out_of_time(); ++k) {
       natural_map(M, blocks, s.z, s.w, F, &J);
@@ -182,8 +202,17 @@ FrictionalSolution solve_frictional_contact(const Eigen::MatrixXd& M, const Eige
       if (!lowered) break;  // back to the sweeps
       s.z.swap(z_trial);
       s.solved = converged();
+      best = std::min(best, s.error / s.scale);
     }
     if (s.out_of_time) break;
+    if (s.sweeps >= window_end) {
+      if (!(best <= 0.5 * best_at_window) && std::isfinite(best_at_window)) {
+        stalled = damped;
+        damped = true;
+      }
+      best_at_window = best;
+      window_end = s.sweeps + kStallWindow;
+    }
   }
   // Newton steps may leave a cone by round-off: the impulses returned are admissible.
   for (const Block& b : blocks) {
@@ -196,7 +225,10 @@ FrictionalSolution solve_frictional_contact(const Eigen::MatrixXd& M, const Eige
   char text[200];
   std::snprintf(text, sizeof text,
                 "%s after %d sweeps and %d Newton steps: cone residual %.3g, %.3g of the impulse scale %.3g",
-                s.solved ? "converged" : s.out_of_time ? "stopped at the deadline" : "sweep limit reached",
+                s.solved        ? "converged"
+                : s.out_of_time ? "stopped at the deadline"
+                : stalled       ? "stalled"
+                                : "sweep limit reached",
                 int(s.sweeps), int(s.newton_steps), s.error, s.scale > 0 ? s.error / s.scale : 0.0, s.scale);
   s.message = text;
   return s;

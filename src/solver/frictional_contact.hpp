@@ -22,7 +22,7 @@ struct FrictionalSettings {
   // Solved when cone_error <= tolerance * the impulse scale: the largest of |z| and, per
   // contact, the impulse -q_n / M_nn its normal row alone asks for.
   double tolerance = 1e-10;
-  int32_t max_sweeps = 5000;  // block Gauss-Seidel sweeps, then as many damped ones (see .cpp)
+  int32_t max_sweeps = 5000;  // block Gauss-Seidel sweeps, then as many damped ones; a stall stops sooner (.cpp)
   std::optional<std::chrono::steady_clock::time_point> deadline;  // stop (unsolved) once past it
 };
 
