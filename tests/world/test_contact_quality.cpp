@@ -172,19 +172,38 @@ static void test_every_press_point_makes_contact(void**) {
   }
 }
 
-// A 1 cm sphere on 5 mm cells pressed 2 mm (the contact spans a few nodes): the force at each
-// grid point is within 10 % of its neighbours' (no holes, no ridges along the mesh's edges). The
-// capsule is printed beside it: 10.6 % (its axis along the cells' diagonals or across them).
+// Each tool pressed 2 mm over a grid of a cell (the contact spanning a few nodes): the force at
+// each grid point is within 10 % of its neighbours' (no holes, no ridges along the mesh's edges).
+// What varies is the mesh's, not the contact's, and goes with the cell: the capsule (its axis
+// along a row of nodes or between two) varies by 10.6 % on 5 mm cells and 2.3 % on 3.3 mm cells,
+// so it is checked on those. The hull is a hexagonal prism, a flat face down, its edges across
+// the mesh's. The octahedron's point is printed, not checked: a point load on linear elements
+// is stiffer inside a face than on a node (0.07-0.14 N over a 5 mm cell), however good the contact.
 static void test_force_is_even_over_a_cell(void**) {
-  for (const Shape& shape : small_tools(0.01)) {
-    if (shape.tool.shape != ToolShape::Sphere && shape.tool.shape != ToolShape::Capsule) continue;
+  const double r = 0.01;
+  Shape prism{"prism", Tool{}, r / 2};
+  prism.tool.shape = ToolShape::ConvexHull;
+  for (int k = 0; k < 6; ++k)
+    for (double y : {-r / 2, r / 2})
+      prism.tool.hull_points.push_back(Vec3(r * std::cos(k * M_PI / 3 + 0.3), y, r * std::sin(k * M_PI / 3 + 0.3)));
+  struct Case {
+    Shape shape;
+    int cells;
+    bool checked;
+  };
+  std::vector<Case> cases;
+  for (const Shape& shape : small_tools(r)) {
+    if (shape.tool.shape == ToolShape::ConvexHull) cases.push_back({prism, 8, true});
+    cases.push_back({shape, shape.tool.shape == ToolShape::Capsule ? 12 : 8, shape.tool.shape != ToolShape::ConvexHull});
+  }
+  for (const Case& c : cases) {
     double deepest = 0;
-    const std::vector<double> grid = press_grid(shape, 8, 0.002, &deepest);
+    const std::vector<double> grid = press_grid(c.shape, c.cells, 0.002, &deepest);
     const double worst = largest_neighbour_difference(grid);
-    print_message("%-8s (1 cm) %.4f..%.4f N over the cell, neighbours within %.1f %%\n", shape.name,
-                  *std::min_element(grid.begin(), grid.end()), *std::max_element(grid.begin(), grid.end()),
-                  100 * worst);
-    if (shape.tool.shape == ToolShape::Sphere) assert_le(worst, 0.10);
+    print_message("%-8s (1 cm, %2d cells) %.4f..%.4f N over the cell, neighbours within %.1f %%%s\n", c.shape.name,
+                  c.cells, *std::min_element(grid.begin(), grid.end()), *std::max_element(grid.begin(), grid.end()),
+                  100 * worst, c.checked ? "" : " (a point: not checked)");
+    if (c.checked) assert_le(worst, 0.10);
   }
 }
 
@@ -255,7 +274,9 @@ static void test_deeper_press_never_drops_the_force(void**) {
   }
 }
 
-int main(void) {
+int main(int argc, char** argv) {
+  // One check by name (ctest runs the four as four tests, side by side).
+  if (argc > 1) cmocka_set_test_filter(argv[1]);
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_every_press_point_makes_contact),
       cmocka_unit_test(test_force_is_even_over_a_cell),
