@@ -122,16 +122,6 @@ static const char kTwoTetMsh[] =
 #define SENTINEL_D (-12345.678)
 #define SENTINEL_I (-777)
 
-#define REQUIRE_OK(call)                                                                             \
-  do {                                                                                               \
-    const mica_status s_ = (call);                                                                   \
-    if (s_ != MICA_OK) {                                                                             \
-      print_error("%s:%d: %s returned %s\n  last error: %s\n", __FILE__, __LINE__, #call,            \
-                  mica_status_string(s_), mica_world_last_error(NULL));                              \
-      _fail(__FILE__, __LINE__);                                                                     \
-    }                                                                                                \
-  } while (0)
-
 #define REQUIRE_OK_W(world, call)                                                                    \
   do {                                                                                               \
     const mica_status s_ = (call);                                                                   \
@@ -141,6 +131,9 @@ static const char kTwoTetMsh[] =
       _fail(__FILE__, __LINE__);                                                                     \
     }                                                                                                \
   } while (0)
+
+/* For calls without a world: the message is on the thread. */
+#define REQUIRE_OK(call) REQUIRE_OK_W(NULL, call)
 
 #define EXPECT_STATUS(expected, call)                                                                \
   do {                                                                                               \
@@ -547,6 +540,44 @@ static inline mica_status bytes_unwritten(bad_call* c, const unsigned char* byte
 static inline uint32_t bad_struct_size(int i, size_t size) {
   const uint32_t sizes[3] = {0, 1, (uint32_t)size + 8};
   return sizes[i];
+}
+
+/* Any def, in a buffer larger than each: an oversized struct_size is safe to try. */
+typedef union any_def {
+  mica_world_def world;
+  mica_body_def body;
+  mica_lpc_def lpc;
+  mica_tool_def tool;
+  unsigned char bytes[sizeof(mica_world_def) + sizeof(mica_body_def) + sizeof(mica_lpc_def) + sizeof(mica_tool_def)];
+} any_def;
+
+enum def_kind { WORLD_DEF, BODY_DEF, LPC_DEF, TOOL_DEF };
+
+/* mica_<kind>_def_init (.with.arg = the kind) with a NULL def. */
+static inline mica_status def_init_without_def(bad_call* c) {
+  switch (c->with.arg) {
+    case WORLD_DEF: return mica_world_def_init(NULL, (uint32_t)sizeof(mica_world_def), MICA_VERSION_NUMBER);
+    case BODY_DEF: return mica_body_def_init(NULL, (uint32_t)sizeof(mica_body_def));
+    case LPC_DEF: return mica_lpc_def_init(NULL, (uint32_t)sizeof(mica_lpc_def));
+    default: return mica_tool_def_init(NULL, (uint32_t)sizeof(mica_tool_def));
+  }
+}
+
+/* mica_<kind>_def_init (.with.arg = the kind) with a struct_size that is not the def's (variant
+ * i) leaves the def alone, every byte of it. */
+static inline mica_status def_init_with_bad_size(bad_call* c) {
+  any_def d;
+  memset(&d, 0xcd, sizeof d);
+  mica_status s = MICA_OK;
+  switch (c->with.arg) {
+    case WORLD_DEF:
+      s = mica_world_def_init(&d.world, bad_struct_size(c->i, sizeof d.world), MICA_VERSION_NUMBER);
+      break;
+    case BODY_DEF: s = mica_body_def_init(&d.body, bad_struct_size(c->i, sizeof d.body)); break;
+    case LPC_DEF: s = mica_lpc_def_init(&d.lpc, bad_struct_size(c->i, sizeof d.lpc)); break;
+    default: s = mica_tool_def_init(&d.tool, bad_struct_size(c->i, sizeof d.tool)); break;
+  }
+  return bytes_unwritten(c, d.bytes, sizeof d.bytes, 0xcd, s);
 }
 
 /* Creation of a world from a def that must fail: the world pointer, set beforehand, is cleared. */

@@ -39,10 +39,6 @@ static mica_status pose_without_world(bad_call* c) {
   return mica_tool_set_pose(NULL, g_tool, kP, kQ);
 }
 static mica_status force_without_world(bad_call* c) { return get_force(c, NULL, g_tool); }
-static mica_status def_init_without_def(bad_call* c) {
-  (void)c;
-  return mica_tool_def_init(NULL, (uint32_t)sizeof(mica_tool_def));
-}
 static mica_status create_with_null(bad_call* c) {
   const mica_tool_def good = mica_tool_def_default();
   mica_tool_id out = 0;
@@ -57,7 +53,8 @@ static const bad_case kNullCases[] = {
     {"mica_tool_destroy: NULL world", destroy_without_world, MICA_ERR_NULL_ARGUMENT, "world", .no_world = NO_WORLD},
     {"mica_tool_set_pose: NULL world", pose_without_world, MICA_ERR_NULL_ARGUMENT, "world", .no_world = NO_WORLD},
     {"mica_tool_get_force: NULL world", force_without_world, MICA_ERR_NULL_ARGUMENT, "world", .no_world = NO_WORLD},
-    {"mica_tool_def_init: NULL def", def_init_without_def, MICA_ERR_NULL_ARGUMENT, "def", .no_world = NO_WORLD},
+    {"mica_tool_def_init: NULL def", def_init_without_def, MICA_ERR_NULL_ARGUMENT, "def", .with.arg = TOOL_DEF,
+     .no_world = NO_WORLD},
     {"mica_tool_create: NULL def", create_with_null, MICA_ERR_NULL_ARGUMENT, "def", .with.arg = 0},
     {"mica_tool_create: NULL out_tool", create_with_null, MICA_ERR_NULL_ARGUMENT, "out_tool", .with.arg = 1},
     {"mica_tool_set_pose: NULL position", pose_with_null, MICA_ERR_NULL_ARGUMENT, "position", .with.arg = 0},
@@ -117,25 +114,12 @@ static mica_status create_spoiled(bad_call* c) {
 }
 
 static mica_status create_with_bad_size(bad_call* c) {
-  struct {
-    mica_tool_def d;
-    char pad[16];
-  } d;
+  any_def d;
   memset(&d, 0, sizeof d);
-  d.d = mica_tool_def_default();
-  d.d.struct_size = bad_struct_size(c->i, sizeof d.d);
-  return create_tool(c, c->fx->world, &d.d);
+  d.tool = mica_tool_def_default();
+  d.tool.struct_size = bad_struct_size(c->i, sizeof d.tool);
+  return create_tool(c, c->fx->world, &d.tool);
 }
-/* mica_tool_def_init leaves a def of another size alone, every byte of it. */
-static mica_status def_init_with_bad_size(bad_call* c) {
-  union {
-    mica_tool_def d;
-    unsigned char bytes[sizeof(mica_tool_def) + 16];
-  } u;
-  memset(&u, 0xcd, sizeof u);
-  return bytes_unwritten(c, u.bytes, sizeof u.bytes, 0xcd, mica_tool_def_init(&u.d, bad_struct_size(c->i, sizeof u.d)));
-}
-
 static const bad_case kDefCases[] = {
     {"mica_tool_create: non-finite radius", create_spoiled, MICA_ERR_INVALID_ARGUMENT, NULL, 3,
      {.tool_def = radius_nonfinite}},
@@ -153,14 +137,14 @@ static const bad_case kDefCases[] = {
      {.tool_def = margin_nonfinite}},
     {"mica_tool_create: radius <= 0", create_spoiled, MICA_ERR_INVALID_ARGUMENT, NULL, COUNT_OF(kBadRadius),
      {.tool_def = radius_outside}},
-    {"mica_tool_create: margin < 0", create_spoiled, MICA_ERR_INVALID_ARGUMENT, NULL, 1,
-     {.tool_def = margin_negative}},
+    {"mica_tool_create: margin < 0", create_spoiled, MICA_ERR_INVALID_ARGUMENT, NULL, 1, {.tool_def = margin_negative}},
     {"mica_tool_create: zero plane normal", create_spoiled, MICA_ERR_INVALID_ARGUMENT, NULL, 1,
      {.tool_def = plane_normal_zero}},
     {"mica_tool_create: shape", create_spoiled, MICA_ERR_INVALID_ARGUMENT, "shape", COUNT_OF(kBadShape),
      {.tool_def = shape}},
     {"mica_tool_create: struct_size", create_with_bad_size, MICA_ERR_STRUCT_SIZE, "struct_size", 3},
-    {"mica_tool_def_init: struct_size", def_init_with_bad_size, MICA_ERR_STRUCT_SIZE, NULL, 3, .no_world = NO_WORLD},
+    {"mica_tool_def_init: struct_size", def_init_with_bad_size, MICA_ERR_STRUCT_SIZE, NULL, 3, .with.arg = TOOL_DEF,
+     .no_world = NO_WORLD},
 };
 
 /* ------------------------------------------------------------------------------------------ */
