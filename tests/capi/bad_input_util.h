@@ -381,26 +381,20 @@ static inline void check_failure(fixture* fx, snapshot* before, mica_status got,
 
 /* EXPECT_FAIL(fx, status, call, needles...): the call on fx->world fails with `status`, its
  * message (on the world) names every needle, and nothing changed. Pass NULL for no needle. */
-#define EXPECT_FAIL(fx, expected, call, ...)                                                         \
-  do {                                                                                               \
-    snapshot before_;                                                                                \
-    take_snapshot((fx), &before_);                                                                   \
-    (fx)->log_calls = 0;                                                                             \
-    const mica_status got_ = (call);                                                                 \
-    check_failure((fx), &before_, got_, (expected), 0, #call, (const char* const[]){__VA_ARGS__, NULL}, \
-                  __FILE__, __LINE__);                                                               \
-  } while (0)
+#define EXPECT_FAIL(fx, expected, call, ...) EXPECT_FAIL_ON_(0, fx, expected, call, #call, __VA_ARGS__)
 
 /* The same for a call made without a world (world == NULL, creation): the message is on the
  * thread. The fixture world must still be unchanged. */
-#define EXPECT_FAIL_NO_WORLD(fx, expected, call, ...)                                                \
+#define EXPECT_FAIL_NO_WORLD(fx, expected, call, ...) EXPECT_FAIL_ON_(1, fx, expected, call, #call, __VA_ARGS__)
+
+#define EXPECT_FAIL_ON_(on_thread, fx, expected, call, text, ...)                                     \
   do {                                                                                               \
     snapshot before_;                                                                                \
     take_snapshot((fx), &before_);                                                                   \
     (fx)->log_calls = 0;                                                                             \
     const mica_status got_ = (call);                                                                 \
-    check_failure((fx), &before_, got_, (expected), 1, #call, (const char* const[]){__VA_ARGS__, NULL}, \
-                  __FILE__, __LINE__);                                                               \
+    check_failure((fx), &before_, got_, (expected), (on_thread), (text),                             \
+                  (const char* const[]){__VA_ARGS__, NULL}, __FILE__, __LINE__);                     \
   } while (0)
 
 /* ------------------------------------------------------------------------------------------ */
