@@ -37,6 +37,17 @@ press_scene_def press_scene_def_default(void) {
   return d;
 }
 
+press_scene_def press_scene_sphere_indent_def(void) {
+  press_scene_def d = press_scene_def_default();
+  d.depth = 0.015;
+  d.rayleigh_beta = 0.005;
+  d.solver = MICA_SOLVER_MICA;
+  d.sweep = MICA_SWEEP_FACTORED;
+  d.tolerance = 1e-6;
+  d.max_iterations = 2000;
+  return d;
+}
+
 const char* press_scene_shape_name(int32_t shape) {
   switch (shape) {
     case MICA_TOOL_SPHERE: return "sphere";
