@@ -101,6 +101,13 @@ mica_status press_scene_step(press_scene* s, int32_t k, double force[3], int32_t
 
 void press_scene_destroy(press_scene* s);
 
+/* Where a tool comes down onto `body` (the nidus of press_scene_create, bench/bench_nidus.c): its
+ * rest bounds `lo`, `hi`, and in `top` the centroid of its rest nodes lifted onto its surface (the
+ * highest crossing of the vertical line through the centroid with a surface triangle). Returns
+ * MICA_ERR_INVALID_ARGUMENT when no surface lies above the centroid, MICA_ERR_OUT_OF_MEMORY, or
+ * a failed getter's status. */
+mica_status press_scene_top(mica_world* world, mica_body_id body, double lo[3], double hi[3], double top[3]);
+
 /* "sphere", "capsule", "box", "hull" (or "?"). */
 const char* press_scene_shape_name(int32_t shape);
 
