@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /* What every benchmark prints beside its figures: a monotonic clock, a sort order for medians,
- * and the machine it ran on (CPU, the CPUs it may use, the load). Header-only; Linux. */
+ * and the machine it ran on (CPU, the CPUs it may use, the load). Header-only (static inline: a
+ * benchmark takes what it needs); Linux. */
 #pragma once
 /* Needs _GNU_SOURCE (CPU_COUNT), defined by the including file before any header. */
 #include <sched.h>
@@ -8,18 +9,18 @@
 #include <string.h>
 #include <time.h>
 
-static double now_ms(void) {
+static inline double now_ms(void) {
   struct timespec t;
   clock_gettime(CLOCK_MONOTONIC, &t);
   return 1e3 * (double)t.tv_sec + 1e-6 * (double)t.tv_nsec;
 }
 
-static int cmp(const void* a, const void* b) {
+static inline int cmp(const void* a, const void* b) {
   const double x = *(const double*)a, y = *(const double*)b;
   return (x > y) - (x < y);
 }
 
-static void machine(char* buf, size_t size) {
+static inline void machine(char* buf, size_t size) {
   char model[160] = "unknown CPU";
   FILE* f = fopen("/proc/cpuinfo", "r");
   if (f) {

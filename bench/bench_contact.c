@@ -2,7 +2,7 @@
 /* Force quality of tool contact: does the force a held tool feels settle, and does it grow
  * smoothly while the tool goes deeper?
  *
- * Scene (bench/scenes/press_scene.h): the cube of examples_c/sphere_indent.c (10 cm, fixed at
+ * Scene (scenes/press_scene.h): the cube of examples_c/sphere_indent.c (10 cm, fixed at
  * its bottom, E = 1e4 Pa, nu = 0.4, rho = 1000, Rayleigh alpha = 2/s, beta = 0, no gravity),
  * cells^3 cubes x 5 tets. A tool starts 5 mm above the top face over its centre, goes down at
  * constant speed to 10 mm below it in 1 s, and is held there for 1 s. Tools: a sphere R = 2 cm;
@@ -48,7 +48,7 @@
 #include <mica/mica.h>
 
 #include "bench_common.h"
-#include "scenes/press_scene.h"
+#include "press_scene.h"
 
 static int trace = 0;             /* --trace: one line per step */
 static double run_limit_s = 120;  /* --run-limit: wall-clock seconds for one run */

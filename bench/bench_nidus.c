@@ -44,6 +44,7 @@
 #include <mica/mica.h>
 
 #include "bench_common.h"
+#include "press_scene.h"
 
 static double quantile(double* v, int n, double q) {
   qsort(v, (size_t)n, sizeof v[0], cmp);
@@ -176,35 +177,10 @@ static int nidus(const char* path, double tol, int steps, int warmup, double E, 
   CHECK(mica_body_create_from_file(world, &bd, path, &body));
   const long rss1 = status_kb("VmRSS:");
   CHECK(mica_body_get_counts(world, body, &fig.nodes, &fig.tets, NULL));
-  double* x = malloc(sizeof(double) * 3 * (size_t)fig.nodes);
-  CHECK(mica_body_get_rest_positions(world, body, x, fig.nodes, NULL));
-  double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL}, c[3] = {0, 0, 0};
-  for (int32_t i = 0; i < fig.nodes; ++i)
-    for (int a = 0; a < 3; ++a) {
-      lo[a] = fmin(lo[a], x[3 * i + a]);
-      hi[a] = fmax(hi[a], x[3 * i + a]);
-      c[a] += x[3 * i + a] / fig.nodes;
-    }
-  /* The top of the blob over its centre: the highest crossing of the vertical line through the
-   * centroid with a surface triangle. */
-  double top = -HUGE_VAL;
-  int32_t ntri = 0;
-  CHECK(mica_body_get_surface(world, body, NULL, 0, &ntri));
-  int32_t* tri = malloc(sizeof(int32_t) * 3 * (size_t)ntri);
-  CHECK(mica_body_get_surface(world, body, tri, ntri, &ntri));
-  for (int32_t t = 0; t < ntri; ++t) {
-    const double* a = x + 3 * tri[3 * t];
-    const double* b = x + 3 * tri[3 * t + 1];
-    const double* d = x + 3 * tri[3 * t + 2];
-    const double det = (b[0] - a[0]) * (d[2] - a[2]) - (d[0] - a[0]) * (b[2] - a[2]);
-    if (fabs(det) < 1e-18) continue;
-    const double u = ((c[0] - a[0]) * (d[2] - a[2]) - (d[0] - a[0]) * (c[2] - a[2])) / det;
-    const double v = ((b[0] - a[0]) * (c[2] - a[2]) - (c[0] - a[0]) * (b[2] - a[2])) / det;
-    if (u < 0 || v < 0 || u + v > 1) continue;
-    top = fmax(top, a[1] + u * (b[1] - a[1]) + v * (d[1] - a[1]));
-  }
-  free(tri);
-  free(x);
+  /* The top of the blob over its centre (scenes/press_scene.h): c is its centroid lifted onto the
+   * surface, lo and hi its bounds. */
+  double lo[3], hi[3], c[3];
+  CHECK(press_scene_top(world, body, lo, hi, c));
   /* Held by its lowest fifth. */
   const double cut[3] = {0, lo[1] + 0.2 * (hi[1] - lo[1]), 0}, up[3] = {0, 1, 0};
   int32_t n = 0;
@@ -215,7 +191,7 @@ static int nidus(const char* path, double tol, int steps, int warmup, double E, 
   mica_lpc_id base;
   CHECK(mica_add_lpc(world, body, held, n, &fixed, &base));
   free(held);
-  const double R = 0.002, y0 = top + R + 0.0005;
+  const double R = 0.002, y0 = c[1] + R + 0.0005;
   mica_tool_def td = mica_tool_def_default();
   td.radius = R;
   td.margin = 0.0005;

@@ -4,6 +4,7 @@
  *
  * usage: bench_servo [seconds] [cells-per-side]   (default 10 s, 12^3 x 6 = 10368 tets)
  */
+#define _GNU_SOURCE
 #include <math.h>
 #include <pthread.h>
 #include <stdatomic.h>
@@ -14,15 +15,12 @@
 #include <mica/mica.h>
 #include <mica/mica_device.h>
 
+#include "bench_common.h"
+
 static double now_s(void) {
   struct timespec ts;
   clock_gettime(CLOCK_MONOTONIC, &ts);
   return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static int cmp(const void* a, const void* b) {
-  const double x = *(const double*)a, y = *(const double*)b;
-  return (x > y) - (x < y);
 }
 
 static void press(double t, double p[3], void* user) {

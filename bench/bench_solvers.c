@@ -8,6 +8,7 @@
  *
  * usage: bench_solvers [cells-per-side]      (default 8: 3 x 8^3 x 6 = 3072 tets)
  */
+#define _GNU_SOURCE
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -16,18 +17,9 @@
 
 #include <mica/mica.h>
 
+#include "bench_common.h"
+
 #define STEPS 40
-
-static double now_ms(void) {
-  struct timespec t;
-  clock_gettime(CLOCK_MONOTONIC, &t);
-  return 1e3 * (double)t.tv_sec + 1e-6 * (double)t.tv_nsec;
-}
-
-static int cmp(const void* a, const void* b) {
-  const double x = *(const double*)a, y = *(const double*)b;
-  return (x > y) - (x < y);
-}
 
 typedef struct {
   mica_world* world;

@@ -31,6 +31,8 @@
 
 #include <mica/mica.h>
 
+#include "press_scene.h"
+
 #define CHECK(call)                                                                       \
   do {                                                                                    \
     mica_status s_ = (call);                                                              \
@@ -48,62 +50,24 @@ int main(int argc, char** argv) {
     fprintf(stderr, "usage: sphere_indent [output-folder] [steps >= 12]\n");
     return 1;
   }
-  /* Cube [-L/2, L/2] x [0, L] x [-L/2, L/2], the sphere centred above (0, L, 0). */
-  const double L = 0.1, E = 1e4, nu = 0.4, rho = 1000.0, dt = 0.01;
-  const double R = 0.02, margin = 0.0015, start_gap = 0.005, max_depth = 0.015;
-  const int cells_per_side = 12, vtk_every = 10;
-  mica_world* world = NULL;
-
-  mica_world_def wdef = mica_world_def_default();
-  wdef.gravity[0] = wdef.gravity[1] = wdef.gravity[2] = 0;
-  wdef.solver = MICA_SOLVER_MICA;
-  wdef.mica_sweep = MICA_SWEEP_FACTORED; /* the sweep a haptic host should use (docs/solvers.md) */
-  wdef.max_iterations = 2000;
-  wdef.tolerance = 1e-6;
-  if (mica_world_create(&wdef, &world) != MICA_OK) {
-    fprintf(stderr, "mica_world_create: %s\n", mica_world_last_error(NULL));
+  /* The scene, built by scenes/press_scene.c (shared with the benchmarks and the bindings'
+   * reference): the cube [-L/2, L/2] x [0, L] x [-L/2, L/2], L = 10 cm, fixed at its bottom face
+   * y = 0, and the sphere centred above (0, L, 0), its lowest point start_gap above the top face.
+   * MICA with the factored sweep, the sweep a haptic host should use (docs/solvers.md). */
+  const press_scene_def def = press_scene_sphere_indent_def();
+  const double E = def.youngs_modulus, nu = def.poisson_ratio, rho = def.density, dt = def.dt;
+  const double R = def.size, margin = def.margin, start_gap = def.gap, max_depth = def.depth;
+  const int cells_per_side = def.cells, vtk_every = 10;
+  press_scene scene;
+  if (press_scene_create(&def, &scene) != MICA_OK) {
+    fprintf(stderr, "%s\n", scene.error);
     return 1;
   }
-
-  mica_body_def bdef = mica_body_def_default();
-  bdef.youngs_modulus = E;
-  bdef.poisson_ratio = nu;
-  bdef.density = rho;
-  bdef.rayleigh_alpha = 2.0;   /* 1/s */
-  bdef.rayleigh_beta = 0.005;  /* s */
-  const double lo[3] = {-L / 2, 0, -L / 2}, hi[3] = {L / 2, L, L / 2};
-  const int32_t cells[3] = {cells_per_side, cells_per_side, cells_per_side};
-  mica_body_id cube;
-  CHECK(mica_body_create_box(world, &bdef, lo, hi, cells, 5, &cube));
-
-  /* Fix the bottom face y = 0. */
-  const double origin[3] = {0, 0, 0}, up[3] = {0, 1, 0};
-  int32_t count = 0;
-  CHECK(mica_body_select_nodes_by_plane(world, cube, origin, up, 1e-9, 1, NULL, 0, &count));
-  int32_t* bottom = malloc(sizeof(int32_t) * (size_t)count);
-  if (!bottom) return 1;
-  CHECK(mica_body_select_nodes_by_plane(world, cube, origin, up, 1e-9, 1, bottom, count, &count));
-  mica_lpc_def fixed = mica_lpc_def_default();
-  fixed.kind = MICA_LPC_FIXED;
-  mica_lpc_id base;
-  CHECK(mica_add_lpc(world, cube, bottom, count, &fixed, &base));
-  free(bottom);
-
-  /* The sphere, its lowest point start_gap above the top face. */
-  const double identity[4] = {1, 0, 0, 0};
-  const double y_start = L + R + start_gap;
-  mica_tool_def tdef = mica_tool_def_default();
-  tdef.shape = MICA_TOOL_SPHERE;
-  tdef.radius = R;
-  tdef.margin = margin;
-  tdef.position[0] = 0;
-  tdef.position[1] = y_start;
-  tdef.position[2] = 0;
-  mica_tool_id sphere;
-  CHECK(mica_tool_create(world, &tdef, &sphere));
-
-  int32_t nodes = 0, tets = 0;
-  CHECK(mica_body_get_counts(world, cube, &nodes, &tets, NULL));
+  mica_world* world = scene.world;
+  const mica_tool_id sphere = scene.tool;
+  const double L = scene.center[1]; /* the top face */
+  const double y_start = scene.y_start;
+  const int32_t nodes = scene.nodes, tets = scene.tets;
 
   /* Trajectory: down over n_load steps, hold, up over n_unload steps, rest. */
   const int n_load = steps / 3, n_hold = steps / 6, n_unload = steps / 3;
@@ -114,7 +78,7 @@ int main(int argc, char** argv) {
          L, cells_per_side, nodes, tets, E, nu, rho);
   printf("sphere R = %.3f m, margin %.4f m, speed %.4f m/s to depth %.4f m; dt = %.3f s, %d steps; "
          "MICA tol %.0e, cap %d\n",
-         R, margin, speed, max_depth, dt, steps, wdef.tolerance, wdef.max_iterations);
+         R, margin, speed, max_depth, dt, steps, def.tolerance, def.max_iterations);
   printf("%7s %10s %12s %8s %6s %5s\n", "t (s)", "depth (m)", "force_y (N)", "contacts", "iters", "conv");
 
   char path[1024];
@@ -150,7 +114,7 @@ int main(int argc, char** argv) {
     int32_t contacts = 0;
     mica_world_stats stats = {sizeof stats};
     if (k > 0) {
-      CHECK(mica_tool_set_pose(world, sphere, pos, identity));
+      CHECK(mica_tool_set_pose(world, sphere, pos, scene.orientation));
       const mica_status s = mica_step(world, dt);
       CHECK(s);
       CHECK(mica_tool_get_force(world, sphere, force, NULL, &contacts));
@@ -197,7 +161,7 @@ int main(int argc, char** argv) {
          not_converged);
   printf("CSV %s/sphere_indent.csv, VTK frames %s/sphere_indent_*.vtk (every %d steps)\n", out_dir, out_dir,
          vtk_every);
-  mica_world_destroy(world);
+  press_scene_destroy(&scene);
 
   int failed = 0;
   if (bad_finite) { fprintf(stderr, "check failed: %d steps with a non-finite force\n", bad_finite); failed = 1; }

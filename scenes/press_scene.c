@@ -37,6 +37,17 @@ press_scene_def press_scene_def_default(void) {
   return d;
 }
 
+press_scene_def press_scene_sphere_indent_def(void) {
+  press_scene_def d = press_scene_def_default();
+  d.depth = 0.015;
+  d.rayleigh_beta = 0.005;
+  d.solver = MICA_SOLVER_MICA;
+  d.sweep = MICA_SWEEP_FACTORED;
+  d.tolerance = 1e-6;
+  d.max_iterations = 2000;
+  return d;
+}
+
 const char* press_scene_shape_name(int32_t shape) {
   switch (shape) {
     case MICA_TOOL_SPHERE: return "sphere";
@@ -79,37 +90,38 @@ static void hull_points(double size, double out[24]) {
   }
 }
 
-/* The nidus: centroid of the rest nodes, bounds, and the highest crossing of the vertical line
- * through the centroid with a surface triangle (as bench_nidus.c). */
-static mica_status nidus_top(press_scene* s, double lo[3], double hi[3], double* top) {
-  double* x = malloc(sizeof(double) * 3 * (size_t)s->nodes);
-  if (!x) return fail(s, MICA_ERR_OUT_OF_MEMORY, "out of memory");
-  mica_status st = mica_body_get_rest_positions(s->world, s->body, x, s->nodes, NULL);
+mica_status press_scene_top(mica_world* world, mica_body_id body, double lo[3], double hi[3], double top[3]) {
+  int32_t nodes = 0;
+  mica_status st = mica_body_get_counts(world, body, &nodes, NULL, NULL);
+  if (st < 0) return st;
+  double* x = malloc(sizeof(double) * 3 * (size_t)(nodes > 0 ? nodes : 1));
+  if (!x) return MICA_ERR_OUT_OF_MEMORY;
+  st = mica_body_get_rest_positions(world, body, x, nodes, NULL);
   if (st < 0) {
     free(x);
-    TRY(st, "mica_body_get_rest_positions");
+    return st;
   }
-  double* c = s->center;
+  double* c = top;
   c[0] = c[1] = c[2] = 0;
   for (int a = 0; a < 3; ++a) {
     lo[a] = HUGE_VAL;
     hi[a] = -HUGE_VAL;
   }
-  for (int32_t i = 0; i < s->nodes; ++i)
+  for (int32_t i = 0; i < nodes; ++i)
     for (int a = 0; a < 3; ++a) {
       lo[a] = fmin(lo[a], x[3 * i + a]);
       hi[a] = fmax(hi[a], x[3 * i + a]);
-      c[a] += x[3 * i + a] / s->nodes;
+      c[a] += x[3 * i + a] / nodes;
     }
   int32_t ntri = 0;
-  mica_body_get_surface(s->world, s->body, NULL, 0, &ntri);
+  mica_body_get_surface(world, body, NULL, 0, &ntri);
   int32_t* tri = malloc(sizeof(int32_t) * 3 * (size_t)(ntri > 0 ? ntri : 1));
   if (!tri) {
     free(x);
-    return fail(s, MICA_ERR_OUT_OF_MEMORY, "out of memory");
+    return MICA_ERR_OUT_OF_MEMORY;
   }
-  st = mica_body_get_surface(s->world, s->body, tri, ntri, &ntri);
-  *top = -HUGE_VAL;
+  st = mica_body_get_surface(world, body, tri, ntri, &ntri);
+  double y = -HUGE_VAL;
   for (int32_t t = 0; st >= 0 && t < ntri; ++t) {
     const double* a = x + 3 * tri[3 * t];
     const double* b = x + 3 * tri[3 * t + 1];
@@ -119,13 +131,21 @@ static mica_status nidus_top(press_scene* s, double lo[3], double hi[3], double*
     const double u = ((c[0] - a[0]) * (d[2] - a[2]) - (d[0] - a[0]) * (c[2] - a[2])) / det;
     const double v = ((b[0] - a[0]) * (c[2] - a[2]) - (c[0] - a[0]) * (b[2] - a[2])) / det;
     if (u < 0 || v < 0 || u + v > 1) continue;
-    *top = fmax(*top, a[1] + u * (b[1] - a[1]) + v * (d[1] - a[1]));
+    y = fmax(y, a[1] + u * (b[1] - a[1]) + v * (d[1] - a[1]));
   }
   free(tri);
   free(x);
-  TRY(st, "mica_body_get_surface");
-  if (!isfinite(*top)) return fail(s, MICA_ERR_INVALID_ARGUMENT, "no surface above the centroid of %s", s->def.mesh);
-  c[1] = *top;
+  if (st < 0) return st;
+  if (!isfinite(y)) return MICA_ERR_INVALID_ARGUMENT;
+  c[1] = y;
+  return MICA_OK;
+}
+
+/* The nidus: where the tool comes down (press_scene_top) into s->center. */
+static mica_status nidus_top(press_scene* s, double lo[3], double hi[3]) {
+  const mica_status st = press_scene_top(s->world, s->body, lo, hi, s->center);
+  if (st == MICA_ERR_INVALID_ARGUMENT) return fail(s, st, "no surface above the centroid of %s", s->def.mesh);
+  TRY(st, "press_scene_top");
   return MICA_OK;
 }
 
@@ -183,8 +203,8 @@ mica_status press_scene_create(const press_scene_def* def, press_scene* s) {
   } else {
     TRY(mica_body_create_from_file(s->world, &bd, d->mesh, &s->body), d->mesh);
     TRY(mica_body_get_counts(s->world, s->body, &s->nodes, &s->tets, NULL), "mica_body_get_counts");
-    double lo[3], hi[3], top;
-    mica_status st = nidus_top(s, lo, hi, &top);
+    double lo[3], hi[3];
+    mica_status st = nidus_top(s, lo, hi);
     if (st < 0) return st;
     st = fix_below(s, lo[1] + 0.2 * (hi[1] - lo[1]), 0);
     if (st < 0) return st;

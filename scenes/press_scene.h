@@ -1,7 +1,8 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /* A tool pressed into a soft body and held: the scene of the force-quality benchmark
- * (bench/bench_contact.c), meant to be shared with tests and examples. Plain C99 against the
- * public API only (mica.h).
+ * (bench/bench_contact.c), of examples_c/sphere_indent.c and of the bindings' reference run
+ * (tests/bindings/sphere_indent_ref.c), which build it here and move the tool themselves
+ * (mica_tool_set_pose on s.tool). Plain C99 against the public API only (mica.h).
  *
  * Two bodies:
  * - a box body (cells > 0): the cube of examples_c/sphere_indent.c, [-L/2, L/2] x [0, L] x
@@ -28,8 +29,8 @@
  *   for (int k = 1; k <= s.steps; ++k) { double f[3]; press_scene_step(&s, k, f); ... }
  *   press_scene_destroy(&s);
  */
-#ifndef MICA_BENCH_PRESS_SCENE_H
-#define MICA_BENCH_PRESS_SCENE_H
+#ifndef MICA_SCENES_PRESS_SCENE_H
+#define MICA_SCENES_PRESS_SCENE_H
 
 #include <stddef.h>
 #include <stdint.h>
@@ -80,6 +81,11 @@ typedef struct press_scene {
 /* The defaults listed in press_scene_def. */
 press_scene_def press_scene_def_default(void);
 
+/* The scene of examples_c/sphere_indent.c (Figure 1 of Arikatla et al. 2016): the defaults but
+ * a 15 mm deep press (the example also lifts the sphere out again), Rayleigh beta = 0.005 s, and
+ * MICA with the factored sweep at tolerance 1e-6, cap 2000. */
+press_scene_def press_scene_sphere_indent_def(void);
+
 /* Builds the world, body, fixation and tool. On failure returns the status (< 0), leaves
  * nothing allocated and puts the reason into s->error. */
 mica_status press_scene_create(const press_scene_def* def, press_scene* s);
@@ -95,6 +101,13 @@ mica_status press_scene_step(press_scene* s, int32_t k, double force[3], int32_t
 
 void press_scene_destroy(press_scene* s);
 
+/* Where a tool comes down onto `body` (the nidus of press_scene_create, bench/bench_nidus.c): its
+ * rest bounds `lo`, `hi`, and in `top` the centroid of its rest nodes lifted onto its surface (the
+ * highest crossing of the vertical line through the centroid with a surface triangle). Returns
+ * MICA_ERR_INVALID_ARGUMENT when no surface lies above the centroid, MICA_ERR_OUT_OF_MEMORY, or
+ * a failed getter's status. */
+mica_status press_scene_top(mica_world* world, mica_body_id body, double lo[3], double hi[3], double top[3]);
+
 /* "sphere", "capsule", "box", "hull" (or "?"). */
 const char* press_scene_shape_name(int32_t shape);
 
@@ -102,4 +115,4 @@ const char* press_scene_shape_name(int32_t shape);
 }
 #endif
 
-#endif /* MICA_BENCH_PRESS_SCENE_H */
+#endif /* MICA_SCENES_PRESS_SCENE_H */
