@@ -73,6 +73,7 @@ struct Run {
 void build(Run& r, int n, int32_t threads) {
   WorldSettings ws;
   ws.solver = SolverKind::Mica;
+  ws.mica_sweep = MicaSweep::GaussSeidel;  // the paper's sweep, colour-ordered on several threads
   ws.tolerance = 1e-6;
   ws.max_iterations = 100000;
   ws.threads = threads;

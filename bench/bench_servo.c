@@ -53,6 +53,7 @@ int main(int argc, char** argv) {
   mica_world_def wd = mica_world_def_default();
   wd.gravity[1] = 0;
   wd.solver = MICA_SOLVER_MICA;
+  wd.mica_sweep = MICA_SWEEP_GAUSS_SEIDEL; /* the paper's sweep */
   wd.tolerance = 1e-4;
   wd.max_iterations = 500;
   mica_world* world;

@@ -52,6 +52,7 @@ static int run(double E, int steps, int cells_per_side, int cap, FILE* csv, int*
   mica_world_def wdef = mica_world_def_default();
   wdef.gravity[0] = wdef.gravity[1] = wdef.gravity[2] = 0;
   wdef.solver = MICA_SOLVER_MICA;
+  wdef.mica_sweep = MICA_SWEEP_GAUSS_SEIDEL; /* the paper's sweep */
   wdef.tolerance = 1e-8;
   wdef.max_iterations = cap;
   if (mica_world_create(&wdef, &world) != MICA_OK) {

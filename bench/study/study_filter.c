@@ -52,6 +52,7 @@ static int run(int mode, int window, samples* s) {
   mica_world_def wd = mica_world_def_default();
   wd.gravity[1] = 0;
   wd.solver = MICA_SOLVER_MICA;
+  wd.mica_sweep = MICA_SWEEP_GAUSS_SEIDEL; /* the paper's sweep */
   wd.tolerance = 1e-5;
   wd.max_iterations = 5000;
   mica_world* w = NULL;

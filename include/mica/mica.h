@@ -129,19 +129,21 @@ typedef struct mica_world mica_world;
  *  the call. Must not call back into the same world. */
 typedef void (*mica_log_fn)(int32_t level, const char* message, void* user);
 
-/** Velocity solvers. */
-#define MICA_SOLVER_DIRECT 0 /**< sparse Cholesky (CHOLMOD) of the projected system: exact */
+/** Velocity solvers. The default world (since 0.5) uses MICA_SOLVER_MICA with MICA_SWEEP_FACTORED,
+ *  the haptic choice: contact and grasping in one iterative solve that converges in tens of
+ *  iterations on stiff and fine meshes (docs/getting-started.md, "Choosing a solver"). */
+#define MICA_SOLVER_DIRECT 0 /**< sparse Cholesky (CHOLMOD) of the projected system: exact, the reference; costly with many contacts (the default before 0.5) */
 #define MICA_SOLVER_PCG 1    /**< projected conjugate gradient, block-Jacobi preconditioner */
-#define MICA_SOLVER_MICA 2   /**< MICA: constraint anticipation, PGS on contacts, modified block Gauss-Seidel */
+#define MICA_SOLVER_MICA 2   /**< MICA: constraint anticipation, PGS on contacts, and the velocity sweep of `mica_sweep`; the default */
 
-#define MICA_SWEEP_GAUSS_SEIDEL 0 /**< MICA's velocity sweep as in the paper: modified block Gauss-Seidel */
+#define MICA_SWEEP_GAUSS_SEIDEL 0 /**< MICA's velocity sweep as in the paper: modified block Gauss-Seidel; cheap per iteration, slow to converge on stiff or fine meshes */
 /** MICA with a factored anticipation: a sparse Cholesky factor of a recent system (the first
  *  step's after any change of time step, damping or constraint set), warped by node rotations,
  *  preconditions the velocity solve (conjugate gradients) and gives the contact rows their
  *  compliance; far fewer iterations on stiff or fine meshes. A solve that has used 100
  *  conjugate-gradient iterations (crushed elements turning fast under a tool) refactors the
  *  current system and ends in a few more; `refactor_interval` also refreshes the factor in the
- *  background (docs/solvers.md). */
+ *  background (docs/solvers.md). The default. */
 #define MICA_SWEEP_FACTORED 1
 
 /** How to create a world: fill with mica_world_def_default(), then change fields. */
@@ -149,7 +151,7 @@ typedef struct mica_world_def {
   uint32_t struct_size;    /**< sizeof(mica_world_def) as the caller compiled it */
   uint32_t header_version; /**< MICA_VERSION_NUMBER the caller compiled with */
   double gravity[3];       /**< m/s^2; default (0, -9.81, 0) */
-  int32_t solver;          /**< MICA_SOLVER_*; default MICA_SOLVER_DIRECT */
+  int32_t solver;          /**< MICA_SOLVER_*; default MICA_SOLVER_MICA (0.2-0.4: MICA_SOLVER_DIRECT) */
   int32_t max_iterations;  /**< cap for iterative solvers; default 200 */
   double tolerance;        /**< relative residual for iterative solvers; default 1e-8 */
   /** 1: run every stage of the step even when the scene does not call for it (for
@@ -175,7 +177,8 @@ typedef struct mica_world_def {
    *  wall-clock time; the step then completes with what the solver reached, mica_step returns
    *  MICA_WARN_NOT_CONVERGED and the statistics say out_of_time and the residual. Default 0: no budget. */
   double time_budget_ms;
-  int32_t mica_sweep;      /**< MICA_SWEEP_*; default MICA_SWEEP_GAUSS_SEIDEL */
+  int32_t mica_sweep;      /**< MICA_SWEEP_*; default MICA_SWEEP_FACTORED (0.3-0.4: MICA_SWEEP_GAUSS_SEIDEL);
+                                a caller whose header lacks the field (0.2) gets the default */
   /* Since 0.4 (threads was reserved3 in 0.3: a 0.3 def gets the default, 1): */
   /** Threads for the step (rotations, element assembly, a colour-ordered Gauss-Seidel sweep):
    *  1 (default) runs the serial code and the paper's sweep order; 0 every CPU the process may

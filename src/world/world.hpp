@@ -35,8 +35,9 @@ constexpr size_t kExactRowsWarning = 500;
 // relaxation, refactor_interval, refactor_after: solver/velocity_solver.hpp) and the world's.
 struct WorldSettings : SolverSettings {
   Vec3 gravity{0, -9.81, 0};
-  SolverKind solver = SolverKind::Direct;
-  MicaSweep mica_sweep = MicaSweep::GaussSeidel;
+  // The haptic default (since 0.5): MICA with the factored sweep. Direct is the exact reference.
+  SolverKind solver = SolverKind::Mica;
+  MicaSweep mica_sweep = MicaSweep::Factored;
   bool plan_all_stages = false;  // run every stage even when its effect is absent
   double max_recovery_speed = 1.0; // m/s, clamps the recovery of penetration (normal_bias)
   double time_budget_ms = 0;       // > 0: every iterative solve of a step stops this long after the step began

@@ -121,12 +121,13 @@ static const int32_t kCells[3] = {3, 1, 1};
     }                                                                                                \
   } while (0)
 
-/* The fixture world with the given solver; NULL on failure. */
-static fixture* new_fixture(int32_t solver) {
+/* The fixture world with the given solver (and, for MICA, sweep); NULL on failure. */
+static fixture* new_fixture(int32_t solver, int32_t sweep) {
   fixture* fx = calloc(1, sizeof *fx);
   if (!fx) return NULL;
   mica_world_def wd = mica_world_def_default();
   wd.solver = solver;
+  wd.mica_sweep = sweep;
   wd.log = record_log;
   wd.log_user = fx;
   if (mica_world_create(&wd, &fx->world) != MICA_OK) return NULL;
@@ -158,7 +159,7 @@ static fixture* new_fixture(int32_t solver) {
 }
 
 static int setup(void** state) {
-  fixture* fx = new_fixture(MICA_SOLVER_DIRECT);
+  fixture* fx = new_fixture(MICA_SOLVER_DIRECT, MICA_SWEEP_FACTORED);
   *state = fx;
   return fx ? 0 : -1;
 }
@@ -1927,8 +1928,8 @@ static void test_tools_bad_input(void** state) {
  * velocity after a 1 s step about 16e308 / 3 m/s, beyond DBL_MAX. Every solver must report
  * MICA_ERR_NUMERICAL and undo the step completely, the statistics included (the header: "on
  * an error the world is left exactly as it was"); none may return MICA_OK. */
-static void check_numerical_failure(int32_t solver) {
-  fixture* fx = new_fixture(solver);
+static void check_numerical_failure(int32_t solver, int32_t sweep) {
+  fixture* fx = new_fixture(solver, sweep);
   assert_non_null(fx);
   REQUIRE_OK_W(fx->world, mica_lpc_remove(fx->world, fx->lpc));
   int32_t nodes[64];
@@ -1974,15 +1975,19 @@ static void check_numerical_failure(int32_t solver) {
 
 static void test_numerical_failure_direct(void** state) {
   (void)state;
-  check_numerical_failure(MICA_SOLVER_DIRECT);
+  check_numerical_failure(MICA_SOLVER_DIRECT, MICA_SWEEP_FACTORED);
 }
 static void test_numerical_failure_pcg(void** state) {
   (void)state;
-  check_numerical_failure(MICA_SOLVER_PCG);
+  check_numerical_failure(MICA_SOLVER_PCG, MICA_SWEEP_FACTORED);
 }
 static void test_numerical_failure_mica(void** state) {
   (void)state;
-  check_numerical_failure(MICA_SOLVER_MICA);
+  check_numerical_failure(MICA_SOLVER_MICA, MICA_SWEEP_GAUSS_SEIDEL);
+}
+static void test_numerical_failure_mica_factored(void** state) {
+  (void)state;
+  check_numerical_failure(MICA_SOLVER_MICA, MICA_SWEEP_FACTORED);
 }
 
 static void test_error_message_scopes(void** state) {
@@ -2037,6 +2042,7 @@ int main(void) {
       cmocka_unit_test(test_numerical_failure_direct),
       cmocka_unit_test(test_numerical_failure_pcg),
       cmocka_unit_test(test_numerical_failure_mica),
+      cmocka_unit_test(test_numerical_failure_mica_factored),
       cmocka_unit_test_setup_teardown(test_error_message_scopes, setup, teardown),
   };
   return cmocka_run_group_tests(tests, group_setup, group_teardown);
