@@ -165,6 +165,9 @@ MICA_API mica_status mica_world_get_stats(const mica_world* world, mica_world_st
       r.stages[k].ms_last_step = s.stages[k].ms_last_step;
       r.stages[k].ms_total = s.stages[k].ms_total;
     }
+    const std::vector<mica::Contact>& contacts = world->world.contacts();
+    r.contacts = int32_t(contacts.size());
+    r.body_contacts = int32_t(std::count_if(contacts.begin(), contacts.end(), [](const mica::Contact& c) { return c.tool < 0; }));
     std::memcpy(static_cast<void*>(out), &r, out->struct_size);
     return MICA_OK;
   });

@@ -78,6 +78,11 @@ typedef int32_t mica_status;
 #define MICA_WARN_NOT_CONVERGED 1
 /** Warning: the haptic device reported a warning (warm motors, force clamped by the device). */
 #define MICA_WARN_DEVICE 2
+/** Warning (since 0.5): the body was created overlapping another body deeper than body contacts
+ *  look (about one surface edge). The body exists; the two do not collide with each other until
+ *  their bounding boxes part (a tangled pair would cost seconds a step). The log callback
+ *  (MICA_LOG_WARNING) and mica_world_last_error() name both bodies and the depth. */
+#define MICA_WARN_BODIES_OVERLAP 3
 #define MICA_ERR_NULL_ARGUMENT (-1)    /**< a required pointer is NULL */
 #define MICA_ERR_INVALID_ARGUMENT (-2) /**< a value is outside its domain (NaN, negative, bad enum) */
 #define MICA_ERR_OUT_OF_RANGE (-3)     /**< an index is outside its array */
@@ -252,7 +257,8 @@ MICA_API void mica_world_destroy(mica_world* world);
 
 /** The message of the last failed call on `world` ("mica_body_create: tet 41 has zero volume"), or,
  *  for world == NULL, of the last failed call on this thread that had no world (creation, the
- *  *_init functions). Thread: the world's (NULL: any; each thread has its own).
+ *  *_init functions). A call that returned MICA_WARN_BODIES_OVERLAP leaves its warning here too.
+ *  Thread: the world's (NULL: any; each thread has its own).
  *  @param world a world, or NULL.
  *  @return the message, never NULL; empty when no call failed. Valid until the next call on that
  *          world (or, for NULL, on this thread). */
@@ -314,7 +320,9 @@ static inline mica_body_def mica_body_def_default(void) {
  *         X2-X0, X3-X0] > 0).
  *  @param tet_count number of tets, >= 1.
  *  @param out_body receives the body's id.
- *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` or a required pointer is NULL);
+ *  @return MICA_OK; MICA_WARN_BODIES_OVERLAP (created, but deep inside another body: the two do not
+ *          collide until they part; the message names them); or MICA_ERR_NULL_ARGUMENT (`world` or a
+ *          required pointer is NULL);
  *          MICA_ERR_STRUCT_SIZE (`def->struct_size`); MICA_ERR_INVALID_ARGUMENT (a count, a def
  *          field or a coordinate out of its domain); MICA_ERR_OUT_OF_RANGE (a node index outside
  *          0..node_count-1); MICA_ERR_BAD_MESH (a degenerate or inverted tet);
@@ -331,7 +339,9 @@ MICA_API mica_status mica_body_create(mica_world* world, const mica_body_def* de
  *  @param def the body's definition.
  *  @param path the file (UTF-8, as fopen takes it).
  *  @param out_body receives the body's id.
- *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` or a required pointer is NULL);
+ *  @return MICA_OK; MICA_WARN_BODIES_OVERLAP (created, but deep inside another body: the two do not
+ *          collide until they part; the message names them); or MICA_ERR_NULL_ARGUMENT (`world` or a
+ *          required pointer is NULL);
  *          MICA_ERR_STRUCT_SIZE (`def->struct_size`); MICA_ERR_INVALID_ARGUMENT (a def field);
  *          MICA_ERR_UNSUPPORTED (an extension other than .msh, .node, .ele); MICA_ERR_IO (the file
  *          cannot be read, or is a FIFO, a device such as /dev/zero, a directory or larger than
@@ -350,7 +360,9 @@ MICA_API mica_status mica_body_create_from_file(mica_world* world, const mica_bo
  *  @param cells cubes along x, y and z, each >= 1.
  *  @param tets_per_cell 5 or 6.
  *  @param out_body receives the body's id.
- *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` or a required pointer is NULL);
+ *  @return MICA_OK; MICA_WARN_BODIES_OVERLAP (created, but deep inside another body: the two do not
+ *          collide until they part; the message names them); or MICA_ERR_NULL_ARGUMENT (`world` or a
+ *          required pointer is NULL);
  *          MICA_ERR_STRUCT_SIZE (`def->struct_size`); MICA_ERR_INVALID_ARGUMENT (corners, cell
  *          counts, tets_per_cell or a def field); MICA_ERR_OUT_OF_MEMORY. */
 MICA_API mica_status mica_body_create_box(mica_world* world, const mica_body_def* def,
@@ -797,6 +809,9 @@ typedef struct mica_world_stats {
   double solver_residual;        /**< largest relative residual of the last step */
   double ms_last_step;           /**< wall-clock milliseconds of the last step */
   mica_stage_stats stages[MICA_STAGE_COUNT]; /**< indexed by MICA_STAGE_* */
+  /* Since 0.5: */
+  int32_t contacts;              /**< contacts the last step made (tool and body features closer than their margins) */
+  int32_t body_contacts;         /**< of them, between two bodies (or a body and a static body) */
 } mica_world_stats;
 
 /** Copies the statistics of the last step and since creation into `out`, writing at most
