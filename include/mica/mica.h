@@ -57,7 +57,7 @@ extern "C" {
 /** Major version: incompatible ABI changes. */
 #define MICA_VERSION_MAJOR 0
 /** Minor version: compatible additions. */
-#define MICA_VERSION_MINOR 4
+#define MICA_VERSION_MINOR 5
 /** Patch version: fixes. */
 #define MICA_VERSION_PATCH 0
 /** major * 10000 + minor * 100 + patch */
