@@ -241,6 +241,7 @@ int main(int argc, char** argv) {
       usage(stdout);
       return 0;
     } else {
+      fprintf(stderr, "%s: unknown option, or an option without its value: %s\n\n", argv[0], argv[i]);
       usage(stderr);
       return 2;
     }

@@ -15,6 +15,7 @@
 
 #include "mesh/mesh_io.hpp"
 #include "world/world.hpp"
+#include "cli.h"
 
 using namespace mica;
 using Clock = std::chrono::steady_clock;
@@ -52,7 +53,17 @@ void time_factor(const char* name, Factor& f, const Eigen::SparseMatrix<double>&
 
 }  // namespace
 
+static const char kUsage[] =
+    "usage: bench_factor [mesh]\n"
+    "CHOLMOD's simplicial LDL^T against supernodal LL^T on a body's first velocity system\n"
+    "(co-rotational, E = 1e4 Pa, nu = 0.4, alpha = 2, dt = 10 ms): analysis, factorization, solves.\n"
+    "  mesh    a .msh or .node/.ele file (default data/nidus/nidus.msh)\n"
+    "  --help  this text\n"
+    "Run it as: OPENBLAS_NUM_THREADS=1 taskset -c 1 build/bench/bench_factor data/nidus/nidus.msh\n";
+
 int main(int argc, char** argv) {
+  const int cli = cli_check(argc, argv, kUsage, NULL);
+  if (cli >= 0) return cli;
   const std::string path = argc > 1 ? argv[1] : "data/nidus/nidus.msh";
   WorldSettings ws;
   ws.gravity = Vec3::Zero();

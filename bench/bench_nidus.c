@@ -22,6 +22,10 @@
  *          `refactor interval` steps (0 skips it), then with the paper's Gauss-Seidel sweep (0 steps
  *          skip it), and prints each and their ratios; `linear` makes the body linear (constant
  *          stiffness: the factor is exact and never changes; the interval is then moot)
+ *        bench_nidus --defaults [mesh] [steps]
+ *          the press with the default world as mica_world_def_default() gives it (tolerance 1e-8,
+ *          cap 200; gravity off), then with solver DIRECT, then with MICA's Gauss-Seidel sweep (the
+ *          0.4 defaults), `steps` timed steps each (default 110): total seconds and steps not converged
  *        bench_nidus --scaling <out.csv> [max-tets] [factored|gauss-seidel]
  *          time per step against tets on box grids (MICA's factored sweep unless told otherwise): a 0.1 m cube of n^3 cubes x 6 tets
  *          (E = 2e4 Pa, alpha = 2, gravity, base fixed), a 2 cm sphere 6 mm deep +- 3 mm at
@@ -44,6 +48,7 @@
 #include <mica/mica.h>
 
 #include "bench_common.h"
+#include "cli.h"
 #include "press_scene.h"
 
 static double quantile(double* v, int n, double q) {
@@ -150,17 +155,31 @@ static int press(mica_world* world, mica_body_id body, mica_tool_id tool, const 
 
 static const char* sweep_name(int32_t sweep) { return sweep == MICA_SWEEP_FACTORED ? "factored" : "gauss-seidel"; }
 
-static int nidus(const char* path, double tol, int steps, int warmup, double E, double dt, int32_t sweep,
-                 int32_t refactor, int32_t model, figures* result) {
-  mica_world* world = NULL;
+/* The solver of a world def in words ("MICA (factored sweep, refactor_interval 0)"). */
+static void solver_text(const mica_world_def* wd, char* text, size_t size) {
+  if (wd->solver == MICA_SOLVER_MICA)
+    snprintf(text, size, "MICA (%s sweep, refactor_interval %d)", sweep_name(wd->mica_sweep), (int)wd->refactor_interval);
+  else
+    snprintf(text, size, "%s", wd->solver == MICA_SOLVER_DIRECT ? "DIRECT" : "PCG");
+}
+
+/* The benchmark's world: MICA with `sweep` at tolerance `tol` (cap 100000), no gravity (the
+ * lesion is carried by the tissue around it). */
+static mica_world_def bench_world(double tol, int32_t sweep, int32_t refactor) {
   mica_world_def wd = mica_world_def_default();
-  wd.gravity[1] = 0; /* the lesion is carried by the tissue around it */
+  wd.gravity[1] = 0;
   wd.solver = MICA_SOLVER_MICA;
   wd.tolerance = tol;
   wd.max_iterations = 100000;
   wd.mica_sweep = sweep;
   wd.refactor_interval = refactor;
-  if (mica_world_create(&wd, &world) != MICA_OK) {
+  return wd;
+}
+
+static int nidus(const char* path, const mica_world_def* wd, int steps, int warmup, double E, double dt, int32_t model,
+                 figures* result) {
+  mica_world* world = NULL;
+  if (mica_world_create(wd, &world) != MICA_OK) {
     fprintf(stderr, "%s\n", mica_world_last_error(NULL));
     return 1;
   }
@@ -211,10 +230,13 @@ static int nidus(const char* path, double tol, int steps, int warmup, double E, 
   printf("# bench_nidus: %s\n", m);
   printf("# mesh %s: %d nodes (%d DOF), %d tets, %.1f x %.1f x %.1f mm; held by %d nodes (lowest fifth)\n", path,
          fig.nodes, 3 * fig.nodes, fig.tets, 1e3 * (hi[0] - lo[0]), 1e3 * (hi[1] - lo[1]), 1e3 * (hi[2] - lo[2]), n);
+  char solver[96];
+  solver_text(wd, solver, sizeof solver);
   printf("# E = %.3g Pa, nu = 0.4, rho = 1000, alpha = 2; forceps tip: sphere R = %.1f mm, 2 mm deep +- 1 mm at 1 Hz; "
-"MICA (%s sweep, refactor_interval %d) tol %.0e, dt = %g ms; %s body; %d warm-up steps, %d timed; %ld thread(s) in the process\n",
-         E, 1e3 * R, sweep_name(sweep), refactor, tol, 1e3 * dt, model == MICA_MODEL_LINEAR ? "linear" : "co-rotational",
-         warmup, steps, threads);
+"%s tol %.0e (cap %d), dt = %g ms; %s body; %d warm-up steps, %d timed; %ld thread(s) in the process\n",
+         E, 1e3 * R, solver, wd->tolerance, (int)wd->max_iterations, 1e3 * dt,
+         model == MICA_MODEL_LINEAR ? "linear" : "co-rotational", warmup, steps, threads);
+  printf("total s (timed steps) %.2f\n", 1e-3 * fig.mean * steps);
   printf("median ms/step        %.3f\n", fig.median);
   printf("p95 ms/step           %.3f\n", fig.p95);
   printf("mean ms/step          %.3f\n", fig.mean);
@@ -302,7 +324,49 @@ static int scaling(const char* csv_path, int max_tets, int32_t sweep) {
   return 0;
 }
 
+/* The default world against the solvers it replaced: the same press with mica_world_def_default()
+ * as it comes (only gravity off: tolerance 1e-8, cap 200), then with solver DIRECT (the default
+ * before 0.5), then with MICA's Gauss-Seidel sweep (the default sweep before 0.5). */
+static int defaults(const char* path, int steps) {
+  printf("# command: OMP_THREAD_LIMIT=1 OPENBLAS_NUM_THREADS=1 build/bench/bench_nidus --defaults %s %d\n", path, steps);
+  const char* names[3] = {"the default world", "solver DIRECT", "MICA, Gauss-Seidel sweep"};
+  figures fig[3];
+  for (int k = 0; k < 3; ++k) {
+    mica_world_def wd = mica_world_def_default();
+    wd.gravity[1] = 0;
+    if (k == 1) wd.solver = MICA_SOLVER_DIRECT;
+    if (k == 2) wd.mica_sweep = MICA_SWEEP_GAUSS_SEIDEL;
+    printf("\n## %s\n", names[k]);
+    if (nidus(path, &wd, steps, 2, 1e4, 0.01, MICA_MODEL_COROTATIONAL, &fig[k])) return 1;
+  }
+  printf("\n%-26s %12s %14s %18s\n", "world", "total s", "median ms/step", "steps not converged");
+  for (int k = 0; k < 3; ++k)
+    printf("%-26s %12.2f %14.2f %11d of %d\n", names[k], 1e-3 * fig[k].mean * steps, fig[k].median, fig[k].capped, steps);
+  return 0;
+}
+
+static const char* const kOptions[] = {"--defaults", "--scaling", NULL};
+static const char kUsage[] =
+    "usage: bench_nidus [mesh] [tolerance] [steps] [warm-up] [E] [dt] [gauss-seidel steps] [refactor interval] [linear]\n"
+    "       bench_nidus --defaults [mesh] [steps]\n"
+    "       bench_nidus --scaling <out.csv> [max-tets] [factored|gauss-seidel]\n"
+    "The nidus-scale scene (data/nidus/nidus.msh, 9668 tets) touched by a 2 mm forceps tip, timed per\n"
+    "step on one core.\n"
+    "  (no option)  MICA with the factored sweep, again with the factor refreshed every `refactor\n"
+    "               interval` steps, then with the Gauss-Seidel sweep; defaults data/nidus/nidus.msh\n"
+    "               1e-6 200 40 1e4 0.01 30 4; `linear` makes the body linear\n"
+    "  --defaults   the default world as mica_world_def_default() gives it (tolerance 1e-8, cap\n"
+    "               200), then solver DIRECT, then the Gauss-Seidel sweep: `steps` timed steps each\n"
+    "               (default 110), total seconds and steps not converged\n"
+    "  --scaling    time per step against tets on box grids, 1k to 100k tets, into out.csv\n"
+    "  --help       this text\n"
+    "Run it as: OMP_THREAD_LIMIT=1 OPENBLAS_NUM_THREADS=1 build/bench/bench_nidus\n";
+
 int main(int argc, char** argv) {
+  const int cli = cli_check(argc, argv, kUsage, kOptions);
+  if (cli >= 0) return cli;
+  if (argc > 1 && strcmp(argv[1], "--defaults") == 0)
+    return defaults(argc > 2 ? argv[2] : "data/nidus/nidus.msh", argc > 3 ? atoi(argv[3]) : 110);
   if (argc > 1 && strcmp(argv[1], "--scaling") == 0) {
     if (argc < 3) {
       fprintf(stderr, "usage: bench_nidus --scaling <out.csv> [max-tets] [factored|gauss-seidel]\n");
@@ -334,16 +398,18 @@ int main(int argc, char** argv) {
   const int32_t model = linear ? MICA_MODEL_LINEAR : MICA_MODEL_COROTATIONAL;
   figures factored, refreshed, gs;
   printf("\n## factored sweep\n");
-  if (nidus(path, tol, steps, warmup, E, dt, MICA_SWEEP_FACTORED, 0, model, &factored)) return 1;
+  const mica_world_def wf = bench_world(tol, MICA_SWEEP_FACTORED, 0), wr = bench_world(tol, MICA_SWEEP_FACTORED, refactor),
+                       wg = bench_world(tol, MICA_SWEEP_GAUSS_SEIDEL, 0);
+  if (nidus(path, &wf, steps, warmup, E, dt, model, &factored)) return 1;
   if (refactor > 0) {
     printf("\n## factored sweep, factor refreshed every %d steps in the background\n", refactor);
-    if (nidus(path, tol, steps, warmup, E, dt, MICA_SWEEP_FACTORED, refactor, model, &refreshed)) return 1;
+    if (nidus(path, &wr, steps, warmup, E, dt, model, &refreshed)) return 1;
     printf("\nmedian ms/step: factored %.2f, refreshed every %d steps %.2f: %.2fx\n", factored.median, refactor,
            refreshed.median, factored.median / refreshed.median);
   }
   if (gs_steps == 0) return 0;
   printf("\n## gauss-seidel sweep (the paper's)\n");
-  if (nidus(path, tol, gs_steps, warmup, E, dt, MICA_SWEEP_GAUSS_SEIDEL, 0, model, &gs)) return 1;
+  if (nidus(path, &wg, gs_steps, warmup, E, dt, model, &gs)) return 1;
   printf("\nmedian ms/step: factored %.2f, gauss-seidel %.2f: %.1fx faster; target 5 ms (paper: ~100 ms)\n",
          factored.median, gs.median, gs.median / factored.median);
   return 0;

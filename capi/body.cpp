@@ -42,10 +42,22 @@ BodyInput translate(const mica_body_def* def) {
   return in;
 }
 
-mica_status create(mica_world* world, const mica_body_def* def, const mica::TetMesh& mesh, mica_body_id* out) {
+// Adds the body; a body created deep inside another is made, and reported with
+// MICA_WARN_BODIES_OVERLAP and the message (the core logged it).
+mica_status create(mica_world* world, const mica_body_def* def, const mica::TetMesh& mesh, const char* function,
+                   mica_body_id* out) {
   const BodyInput in = translate(def);
   *out = world->world.add_body(mesh, in.settings, in.translation, in.velocity);
-  return MICA_OK;
+  const std::vector<mica::BodyOverlap>& overlaps = world->world.overlaps_at_creation();
+  if (overlaps.empty()) return MICA_OK;
+  try {
+    std::string message = std::string(function) + ": " + world->world.overlap_message(*out, overlaps.front());
+    if (overlaps.size() > 1) message += " (and " + std::to_string(overlaps.size() - 1) + " more bodies, in the log)";
+    world->last_error = std::move(message);
+  } catch (...) {
+    // Out of memory for the message: the status still says it.
+  }
+  return MICA_WARN_BODIES_OVERLAP;
 }
 
 void check_count(int32_t count, int32_t min, const char* name) {
@@ -91,7 +103,7 @@ MICA_API mica_status mica_body_create(mica_world* world, const mica_body_def* de
     mesh.tets.resize(size_t(tet_count));
     for (int32_t e = 0; e < tet_count; ++e)
       for (int a = 0; a < 4; ++a) mesh.tets[e][a] = tets[4 * int64_t(e) + a];
-    return create(world, def, mesh, out_body);
+    return create(world, def, mesh, "mica_body_create", out_body);
   });
 }
 
@@ -101,7 +113,7 @@ MICA_API mica_status mica_body_create_from_file(mica_world* world, const mica_bo
     require(world, "world");
     require(out_body, "out_body");
     require(path, "path");
-    return create(world, def, mica::load_mesh(path), out_body);
+    return create(world, def, mica::load_mesh(path), "mica_body_create_from_file", out_body);
   });
 }
 
@@ -114,7 +126,7 @@ MICA_API mica_status mica_body_create_box(mica_world* world, const mica_body_def
     require(cells, "cells");
     const mica::TetMesh mesh =
         mica::make_box_grid(vec3(lo, "lo"), vec3(hi, "hi"), {cells[0], cells[1], cells[2]}, tets_per_cell);
-    return create(world, def, mesh, out_body);
+    return create(world, def, mesh, "mica_body_create_box", out_body);
   });
 }
 

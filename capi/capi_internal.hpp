@@ -23,7 +23,7 @@ struct mica_world {
 
 namespace mica_capi {
 
-// This library's version as text ("0.4.0"), for messages.
+// This library's version as text ("0.5.0"), for messages.
 inline std::string version_text(uint32_t number = MICA_VERSION_NUMBER) {
   return std::to_string(number / 10000) + "." + std::to_string(number / 100 % 100) + "." + std::to_string(number % 100);
 }

@@ -19,7 +19,7 @@ mica_world_def world_defaults() {
   d.struct_size = sizeof d;
   d.header_version = MICA_VERSION_NUMBER;
   d.gravity[1] = -9.81;
-  d.solver = MICA_SOLVER_DIRECT;
+  d.solver = MICA_SOLVER_MICA;  // since 0.5: the haptic default (0.2-0.4: MICA_SOLVER_DIRECT)
   d.max_iterations = 200;
   d.tolerance = 1e-8;
   d.pgs_sweeps = 1;
@@ -28,7 +28,7 @@ mica_world_def world_defaults() {
   d.body_margin = 0.001;
   d.warm_start = 1;
   d.relaxation = 1.0;
-  d.mica_sweep = MICA_SWEEP_GAUSS_SEIDEL;
+  d.mica_sweep = MICA_SWEEP_FACTORED;  // since 0.5 (0.3-0.4: MICA_SWEEP_GAUSS_SEIDEL)
   d.threads = 1;
   d.relinearise_tolerance = 1e-3;
   d.relinearise_max = 8;
@@ -165,6 +165,9 @@ MICA_API mica_status mica_world_get_stats(const mica_world* world, mica_world_st
       r.stages[k].ms_last_step = s.stages[k].ms_last_step;
       r.stages[k].ms_total = s.stages[k].ms_total;
     }
+    const std::vector<mica::Contact>& contacts = world->world.contacts();
+    r.contacts = int32_t(contacts.size());
+    r.body_contacts = int32_t(std::count_if(contacts.begin(), contacts.end(), [](const mica::Contact& c) { return c.tool < 0; }));
     std::memcpy(static_cast<void*>(out), &r, out->struct_size);
     return MICA_OK;
   });

@@ -15,6 +15,8 @@
 #include <time.h>
 
 #include <mica/mica.h>
+
+#include "cli.h"
 #include <mica/mica_device.h>
 
 #define SERVO_HZ 1000
@@ -83,7 +85,18 @@ static void* servo_thread(void* arg) {
     }                                                                                                 \
   } while (0)
 
+static const char kUsage[] =
+    "usage: haptic_loop [output-folder] [seconds]\n"
+    "A 60 Hz simulation thread and a 1 kHz servo thread: the Geomagic Touch when OpenHaptics' libHD\n"
+    "is found (MICA_HD_LIBRARY), else a simulated stylus pressing into a soft block. Prints the rates\n"
+    "and forces and writes haptic_loop.csv (time, raw and rendered force) into the output folder.\n"
+    "  output-folder  where the CSV goes (default .)\n"
+    "  seconds        how long the loop runs (default 2)\n"
+    "  --help         this text\n";
+
 int main(int argc, char** argv) {
+  const int cli = cli_check(argc, argv, kUsage, NULL);
+  if (cli >= 0) return cli;
   const char* out_dir = argc > 1 ? argv[1] : ".";
   static loop L;
   L.seconds = argc > 2 ? atof(argv[2]) : 2.0;

@@ -31,6 +31,7 @@
 
 #include <mica/mica.h>
 
+#include "cli.h"
 #include "press_scene.h"
 
 #define CHECK(call)                                                                       \
@@ -43,7 +44,19 @@
     }                                                                                     \
   } while (0)
 
+static const char kUsage[] =
+    "usage: sphere_indent [output-folder] [steps]\n"
+    "A 2 cm sphere pressed 15 mm into a soft 10 cm cube fixed at its bottom, held and pulled out\n"
+    "(Figure 1 of Arikatla et al. 2016). Prints time, depth, tool force, contacts and iterations;\n"
+    "writes sphere_indent.csv and VTK frames (sphere_indent_*.vtk) into the output folder. Exits 1\n"
+    "if the force is not finite, pulls, does not grow while loading or stays after release.\n"
+    "  output-folder  where the files go (default .)\n"
+    "  steps          10 ms steps of the whole press (default 300)\n"
+    "  --help         this text\n";
+
 int main(int argc, char** argv) {
+  const int cli = cli_check(argc, argv, kUsage, NULL);
+  if (cli >= 0) return cli;
   const char* out_dir = argc > 1 ? argv[1] : ".";
   const int steps = argc > 2 ? atoi(argv[2]) : 300;
   if (steps < 12) {

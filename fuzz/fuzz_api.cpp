@@ -325,7 +325,7 @@ class Program {
   // fuzzer is after wrong answers, not long ones (libFuzzer's timeout is 10 s, under ASan).
   static constexpr double kStepSeconds = 2.0;
 
-  static bool documented(mica_status s) { return s >= MICA_ERR_OUT_OF_MEMORY && s <= MICA_WARN_DEVICE; }
+  static bool documented(mica_status s) { return s >= MICA_ERR_OUT_OF_MEMORY && s <= MICA_WARN_BODIES_OVERLAP; }
 
   // Runs f(world, side) on A, then on B if A accepted; checks statuses, messages and the twins.
   template <class F>

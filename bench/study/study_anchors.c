@@ -36,6 +36,7 @@
 #include <mica/mica.h>
 
 #include "study_common.h"
+#include "cli.h"
 
 #define HERTZ_R 0.01
 #define HERTZ_D 0.0005
@@ -249,7 +250,18 @@ static level_result beam_level(int n, int model) {
   return r;
 }
 
+static const char kUsage[] =
+    "usage: study_anchors <out-dir> [quick]\n"
+    "Mesh convergence toward the analytic anchors: Hertz (a sphere indenting a deep block) and\n"
+    "Euler-Bernoulli (a cantilever under its own weight), linear bodies, MICA_SOLVER_DIRECT. Writes\n"
+    "<out-dir>/anchors.csv and <out-dir>/hertz_curve.csv.\n"
+    "  out-dir  where the CSV files go\n"
+    "  quick    the coarser meshes only (a smoke test)\n"
+    "  --help   this text\n";
+
 int main(int argc, char** argv) {
+  const int cli = cli_check(argc, argv, kUsage, NULL);
+  if (cli >= 0) return cli;
   if (argc < 2) {
     fprintf(stderr, "usage: study_anchors <out-dir> [quick]\n");
     return 2;

@@ -29,6 +29,7 @@
 #include <mica/mica_device.h>
 
 #include "study_common.h"
+#include "cli.h"
 
 #define POLLS_PER_STEP 16
 #define STEP_S 0.016
@@ -52,6 +53,7 @@ static int run(int mode, int window, samples* s) {
   mica_world_def wd = mica_world_def_default();
   wd.gravity[1] = 0;
   wd.solver = MICA_SOLVER_MICA;
+  wd.mica_sweep = MICA_SWEEP_GAUSS_SEIDEL; /* the paper's sweep */
   wd.tolerance = 1e-5;
   wd.max_iterations = 5000;
   mica_world* w = NULL;
@@ -118,7 +120,17 @@ fail:
   return 1;
 }
 
+static const char kUsage[] =
+    "usage: study_filter <out-dir>\n"
+    "The rendered force's moving-average window against its delay and smoothness, the simulated stylus\n"
+    "polled in lockstep with the simulation. Writes <out-dir>/filter.csv and\n"
+    "<out-dir>/filter_samples.csv.\n"
+    "  out-dir  where the CSV files go\n"
+    "  --help   this text\n";
+
 int main(int argc, char** argv) {
+  const int cli = cli_check(argc, argv, kUsage, NULL);
+  if (cli >= 0) return cli;
   if (argc < 2) {
     fprintf(stderr, "usage: study_filter <out-dir>\n");
     return 2;

@@ -47,6 +47,7 @@
 #include <mica/mica.h>
 
 #include "study_common.h"
+#include "cli.h"
 
 #define L_CUBE 0.1
 #define R_TOOL 0.02
@@ -555,7 +556,18 @@ static void fmt(FILE* f, double v) {
   else fprintf(f, ",%.6g", v);
 }
 
+static const char kUsage[] =
+    "usage: study_sweep <out-dir> [quick]\n"
+    "What accuracy costs in time: every solver knob of the C API swept on one haptic scene, each\n"
+    "configuration timed and compared with the exact solver. Writes <out-dir>/sweep.csv and\n"
+    "<out-dir>/stiffness_steps.csv (docs/accuracy-vs-time.md).\n"
+    "  out-dir  where the CSV files go\n"
+    "  quick    a few configurations (a smoke test)\n"
+    "  --help   this text\n";
+
 int main(int argc, char** argv) {
+  const int cli = cli_check(argc, argv, kUsage, NULL);
+  if (cli >= 0) return cli;
   if (argc < 2) {
     fprintf(stderr, "usage: study_sweep <out-dir> [quick]\n");
     return 2;

@@ -57,7 +57,7 @@ extern "C" {
 /** Major version: incompatible ABI changes. */
 #define MICA_VERSION_MAJOR 0
 /** Minor version: compatible additions. */
-#define MICA_VERSION_MINOR 4
+#define MICA_VERSION_MINOR 5
 /** Patch version: fixes. */
 #define MICA_VERSION_PATCH 0
 /** major * 10000 + minor * 100 + patch */
@@ -78,6 +78,11 @@ typedef int32_t mica_status;
 #define MICA_WARN_NOT_CONVERGED 1
 /** Warning: the haptic device reported a warning (warm motors, force clamped by the device). */
 #define MICA_WARN_DEVICE 2
+/** Warning (since 0.5): the body was created overlapping another body deeper than body contacts
+ *  look (about one surface edge). The body exists; the two do not collide with each other until
+ *  their bounding boxes part (a tangled pair would cost seconds a step). The log callback
+ *  (MICA_LOG_WARNING) and mica_world_last_error() name both bodies and the depth. */
+#define MICA_WARN_BODIES_OVERLAP 3
 #define MICA_ERR_NULL_ARGUMENT (-1)    /**< a required pointer is NULL */
 #define MICA_ERR_INVALID_ARGUMENT (-2) /**< a value is outside its domain (NaN, negative, bad enum) */
 #define MICA_ERR_OUT_OF_RANGE (-3)     /**< an index is outside its array */
@@ -129,19 +134,21 @@ typedef struct mica_world mica_world;
  *  the call. Must not call back into the same world. */
 typedef void (*mica_log_fn)(int32_t level, const char* message, void* user);
 
-/** Velocity solvers. */
-#define MICA_SOLVER_DIRECT 0 /**< sparse Cholesky (CHOLMOD) of the projected system: exact */
+/** Velocity solvers. The default world (since 0.5) uses MICA_SOLVER_MICA with MICA_SWEEP_FACTORED,
+ *  the haptic choice: contact and grasping in one iterative solve that converges in tens of
+ *  iterations on stiff and fine meshes (docs/getting-started.md, "Choosing a solver"). */
+#define MICA_SOLVER_DIRECT 0 /**< sparse Cholesky (CHOLMOD) of the projected system: exact, the reference; costly with many contacts (the default before 0.5) */
 #define MICA_SOLVER_PCG 1    /**< projected conjugate gradient, block-Jacobi preconditioner */
-#define MICA_SOLVER_MICA 2   /**< MICA: constraint anticipation, PGS on contacts, modified block Gauss-Seidel */
+#define MICA_SOLVER_MICA 2   /**< MICA: constraint anticipation, PGS on contacts, and the velocity sweep of `mica_sweep`; the default */
 
-#define MICA_SWEEP_GAUSS_SEIDEL 0 /**< MICA's velocity sweep as in the paper: modified block Gauss-Seidel */
+#define MICA_SWEEP_GAUSS_SEIDEL 0 /**< MICA's velocity sweep as in the paper: modified block Gauss-Seidel; cheap per iteration, slow to converge on stiff or fine meshes */
 /** MICA with a factored anticipation: a sparse Cholesky factor of a recent system (the first
  *  step's after any change of time step, damping or constraint set), warped by node rotations,
  *  preconditions the velocity solve (conjugate gradients) and gives the contact rows their
  *  compliance; far fewer iterations on stiff or fine meshes. A solve that has used 100
  *  conjugate-gradient iterations (crushed elements turning fast under a tool) refactors the
  *  current system and ends in a few more; `refactor_interval` also refreshes the factor in the
- *  background (docs/solvers.md). */
+ *  background (docs/solvers.md). The default. */
 #define MICA_SWEEP_FACTORED 1
 
 /** How to create a world: fill with mica_world_def_default(), then change fields. */
@@ -149,7 +156,7 @@ typedef struct mica_world_def {
   uint32_t struct_size;    /**< sizeof(mica_world_def) as the caller compiled it */
   uint32_t header_version; /**< MICA_VERSION_NUMBER the caller compiled with */
   double gravity[3];       /**< m/s^2; default (0, -9.81, 0) */
-  int32_t solver;          /**< MICA_SOLVER_*; default MICA_SOLVER_DIRECT */
+  int32_t solver;          /**< MICA_SOLVER_*; default MICA_SOLVER_MICA (0.2-0.4: MICA_SOLVER_DIRECT) */
   int32_t max_iterations;  /**< cap for iterative solvers; default 200 */
   double tolerance;        /**< relative residual for iterative solvers; default 1e-8 */
   /** 1: run every stage of the step even when the scene does not call for it (for
@@ -175,7 +182,8 @@ typedef struct mica_world_def {
    *  wall-clock time; the step then completes with what the solver reached, mica_step returns
    *  MICA_WARN_NOT_CONVERGED and the statistics say out_of_time and the residual. Default 0: no budget. */
   double time_budget_ms;
-  int32_t mica_sweep;      /**< MICA_SWEEP_*; default MICA_SWEEP_GAUSS_SEIDEL */
+  int32_t mica_sweep;      /**< MICA_SWEEP_*; default MICA_SWEEP_FACTORED (0.3-0.4: MICA_SWEEP_GAUSS_SEIDEL);
+                                a caller whose header lacks the field (0.2) gets the default */
   /* Since 0.4 (threads was reserved3 in 0.3: a 0.3 def gets the default, 1): */
   /** Threads for the step (rotations, element assembly, a colour-ordered Gauss-Seidel sweep):
    *  1 (default) runs the serial code and the paper's sweep order; 0 every CPU the process may
@@ -249,7 +257,8 @@ MICA_API void mica_world_destroy(mica_world* world);
 
 /** The message of the last failed call on `world` ("mica_body_create: tet 41 has zero volume"), or,
  *  for world == NULL, of the last failed call on this thread that had no world (creation, the
- *  *_init functions). Thread: the world's (NULL: any; each thread has its own).
+ *  *_init functions). A call that returned MICA_WARN_BODIES_OVERLAP leaves its warning here too.
+ *  Thread: the world's (NULL: any; each thread has its own).
  *  @param world a world, or NULL.
  *  @return the message, never NULL; empty when no call failed. Valid until the next call on that
  *          world (or, for NULL, on this thread). */
@@ -311,7 +320,9 @@ static inline mica_body_def mica_body_def_default(void) {
  *         X2-X0, X3-X0] > 0).
  *  @param tet_count number of tets, >= 1.
  *  @param out_body receives the body's id.
- *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` or a required pointer is NULL);
+ *  @return MICA_OK; MICA_WARN_BODIES_OVERLAP (created, but deep inside another body: the two do not
+ *          collide until they part; the message names them); or MICA_ERR_NULL_ARGUMENT (`world` or a
+ *          required pointer is NULL);
  *          MICA_ERR_STRUCT_SIZE (`def->struct_size`); MICA_ERR_INVALID_ARGUMENT (a count, a def
  *          field or a coordinate out of its domain); MICA_ERR_OUT_OF_RANGE (a node index outside
  *          0..node_count-1); MICA_ERR_BAD_MESH (a degenerate or inverted tet);
@@ -328,7 +339,9 @@ MICA_API mica_status mica_body_create(mica_world* world, const mica_body_def* de
  *  @param def the body's definition.
  *  @param path the file (UTF-8, as fopen takes it).
  *  @param out_body receives the body's id.
- *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` or a required pointer is NULL);
+ *  @return MICA_OK; MICA_WARN_BODIES_OVERLAP (created, but deep inside another body: the two do not
+ *          collide until they part; the message names them); or MICA_ERR_NULL_ARGUMENT (`world` or a
+ *          required pointer is NULL);
  *          MICA_ERR_STRUCT_SIZE (`def->struct_size`); MICA_ERR_INVALID_ARGUMENT (a def field);
  *          MICA_ERR_UNSUPPORTED (an extension other than .msh, .node, .ele); MICA_ERR_IO (the file
  *          cannot be read, or is a FIFO, a device such as /dev/zero, a directory or larger than
@@ -347,7 +360,9 @@ MICA_API mica_status mica_body_create_from_file(mica_world* world, const mica_bo
  *  @param cells cubes along x, y and z, each >= 1.
  *  @param tets_per_cell 5 or 6.
  *  @param out_body receives the body's id.
- *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` or a required pointer is NULL);
+ *  @return MICA_OK; MICA_WARN_BODIES_OVERLAP (created, but deep inside another body: the two do not
+ *          collide until they part; the message names them); or MICA_ERR_NULL_ARGUMENT (`world` or a
+ *          required pointer is NULL);
  *          MICA_ERR_STRUCT_SIZE (`def->struct_size`); MICA_ERR_INVALID_ARGUMENT (corners, cell
  *          counts, tets_per_cell or a def field); MICA_ERR_OUT_OF_MEMORY. */
 MICA_API mica_status mica_body_create_box(mica_world* world, const mica_body_def* def,
@@ -794,6 +809,9 @@ typedef struct mica_world_stats {
   double solver_residual;        /**< largest relative residual of the last step */
   double ms_last_step;           /**< wall-clock milliseconds of the last step */
   mica_stage_stats stages[MICA_STAGE_COUNT]; /**< indexed by MICA_STAGE_* */
+  /* Since 0.5: */
+  int32_t contacts;              /**< contacts the last step made (tool and body features closer than their margins) */
+  int32_t body_contacts;         /**< of them, between two bodies (or a body and a static body) */
 } mica_world_stats;
 
 /** Copies the statistics of the last step and since creation into `out`, writing at most

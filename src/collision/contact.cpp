@@ -5,6 +5,7 @@
 
 #include "collision/closest_point.hpp"
 #include "collision/core_features.hpp"
+#include "collision/nearest_surface_point.hpp"
 #include "collision/tool_sweep.hpp"
 
 namespace mica {
@@ -95,35 +96,6 @@ void merge_duplicate_features(std::vector<Contact>& out, size_t first) {
 
 Vec3 tool_point_velocity(const Tool& tool, const Vec3& p) {
   return tool.velocity + tool.angular_velocity.cross(p - tool.position);
-}
-
-// The nearest point of a surface to p within reach (tri -1: none), and the outward
-// pseudo-normal of the face, edge or vertex it lies on (which side of the surface p is on).
-struct NearestSurfacePoint {
-  int32_t tri = -1;
-  TrianglePoint point{};
-  double distance = HUGE_VAL;
-  Vec3 face, outward;  // the triangle's normal, the pseudo-normal at the point
-};
-
-NearestSurfacePoint nearest_surface_point(const SurfaceView& s, const Vec3& p, double reach) {
-  const Vec3List& x = *s.x;
-  NearestSurfacePoint n;
-  s.bvh->query(Aabb{p, p}.inflated(reach), [&](int32_t tri) {
-    const Tri& t = (*s.triangles)[tri];
-    const TrianglePoint q = closest_on_triangle(p, x[t[0]], x[t[1]], x[t[2]]);
-    const double d = (p - q.point).norm();
-    if (d < n.distance) {
-      n.distance = d;
-      n.tri = tri;
-      n.point = q;
-    }
-  });
-  if (n.tri < 0) return n;
-  const Tri& t = (*s.triangles)[n.tri];
-  n.face = (x[t[1]] - x[t[0]]).cross(x[t[2]] - x[t[0]]).normalized();
-  n.outward = s.normals->at(n.tri, t, n.point.weights, n.face);
-  return n;
 }
 
 // Whether point p lies behind the body's surface with the surface point `distance` from it as

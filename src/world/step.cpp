@@ -277,7 +277,7 @@ void World::collide(StepContext& ctx) {
   if (!settings_.body_contact) return;
   for (const SurfaceView& a : views)
     for (const SurfaceView& b : views)
-      if (a.index >= 0 && &a != &b && (b.index < 0 || bounds_overlap(a, b)))
+      if (a.index >= 0 && &a != &b && (b.index < 0 || bounds_overlap(a, b)) && !contacts_skipped(a.key, b.key))
         collide_bodies(a, b, settings_.body_margin, settings_.body_friction, contacts_);
 }
 
@@ -418,6 +418,7 @@ void World::commit(const StepContext& ctx) {
     t.previous_position = t.position;
     t.previous_orientation = t.orientation;
   });
+  if (!overlapping_.empty()) forget_parted_overlaps();  // by the bounds this step's collide refitted
 }
 
 }  // namespace mica

@@ -72,8 +72,21 @@ Id World::add_body(const TetMesh& mesh, const BodySettings& settings, const Vec3
                                             block_size_for(int32_t(body->tets.size()), 16, 1024));
     body->node_colours = colour_nodes(body->fem.pattern, block_size_for(body->fem.node_count(), 8, 512));
   }
+  std::vector<BodyOverlap> overlaps = find_overlaps(*body);  // may throw: nothing changed yet
+  overlapping_.reserve(overlapping_.size() + overlaps.size());
   const Id id = bodies_.insert(std::move(body));
   ++bodies_created_;
+  last_overlaps_ = std::move(overlaps);
+  for (const BodyOverlap& o : last_overlaps_) {
+    overlapping_.emplace_back(id, o.other);
+    if (settings_.log) {
+      try {
+        settings_.log(LogLevel::Warning, overlap_message(id, o));
+      } catch (...) {
+        // Out of memory for the message: the body exists, overlaps_at_creation() still says it.
+      }
+    }
+  }
   return id;
 }
 

@@ -35,8 +35,9 @@ constexpr size_t kExactRowsWarning = 500;
 // relaxation, refactor_interval, refactor_after: solver/velocity_solver.hpp) and the world's.
 struct WorldSettings : SolverSettings {
   Vec3 gravity{0, -9.81, 0};
-  SolverKind solver = SolverKind::Direct;
-  MicaSweep mica_sweep = MicaSweep::GaussSeidel;
+  // The haptic default (since 0.5): MICA with the factored sweep. Direct is the exact reference.
+  SolverKind solver = SolverKind::Mica;
+  MicaSweep mica_sweep = MicaSweep::Factored;
   bool plan_all_stages = false;  // run every stage even when its effect is absent
   double max_recovery_speed = 1.0; // m/s, clamps the recovery of penetration (normal_bias)
   double time_budget_ms = 0;       // > 0: every iterative solve of a step stops this long after the step began
@@ -92,6 +93,16 @@ struct Lpc {
   Vec3 reaction = Vec3::Zero();  // N: the force on whoever holds the constraint (the user), last step
 };
 
+// A body created overlapping another deeper than contacts look (World::add_body): the two do
+// not collide with each other until their bounds part.
+struct BodyOverlap {
+  Id other = 0;         // the body it overlaps
+  double depth = 0;     // m: the deepest surface node of either inside the other
+  int32_t node = -1;    // that node
+  bool node_of_created = true;  // the node is the created body's (else the other's)
+  double reach = 0;     // m: how deep body contacts look for that node (the other body's surface edge, or the margin)
+};
+
 // Throws Error(InvalidArgument) naming the first setting out of its domain.
 void validate(const WorldSettings& settings);
 
@@ -102,7 +113,14 @@ class World {
   const WorldSettings& settings() const { return settings_; }
   void set_gravity(const Vec3& g);
 
+  // Logs a warning for each body the new one overlaps deeper than contacts look; see
+  // overlaps_at_creation().
   Id add_body(const TetMesh& mesh, const BodySettings& settings, const Vec3& translation, const Vec3& velocity);
+  // The bodies the last add_body found its body overlapping (overlaps.cpp), and what it logged.
+  const std::vector<BodyOverlap>& overlaps_at_creation() const { return last_overlaps_; }
+  std::string overlap_message(Id created, const BodyOverlap& overlap) const;
+  // Whether contacts between two bodies are skipped: created overlapping, their bounds not yet parted.
+  bool contacts_skipped(Id a, Id b) const;
   void remove_body(Id id);
   Body& body(Id id) { return bodies_.get(id, "body"); }
   const Body& body(Id id) const { return bodies_.get(id, "body"); }
@@ -161,6 +179,9 @@ class World {
   void follow_devices();
   void collide(StepContext& ctx);
   bool bounds_overlap(const SurfaceView& a, const SurfaceView& b) const;
+  // Bodies placed overlapping (overlaps.cpp).
+  std::vector<BodyOverlap> find_overlaps(Body& created);
+  void forget_parted_overlaps();
   void apply_loads(Body& b) const;
   void assemble_elements(const StepContext& ctx, Body& b) const;
   void add_contact_stiffness(const StepContext& ctx, Body& b) const;
@@ -213,6 +234,8 @@ class World {
   Vec3List saved_reactions_;
   int64_t bodies_created_ = 0;
   bool warned_exact_rows_ = false;
+  std::vector<BodyOverlap> last_overlaps_;          // of the last add_body
+  std::vector<std::pair<Id, Id>> overlapping_;      // pairs whose contacts are skipped until their bounds part
   std::unique_ptr<ThreadPool> pool_;                // threads > 1 only; the step's parallel loops
   // Chosen once from the settings; keeps per-body factors (some factored in the background on
   // the bodies' patterns), so it goes before the bodies do.

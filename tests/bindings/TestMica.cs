@@ -348,6 +348,45 @@ static class TestMica
         }
     }
 
+    // System.Numerics overloads (MicaNumerics): Vector3 and Quaternion, libmica's (w, x, y, z) mapped.
+    static void NumericsOverloads()
+    {
+        using (var world = new World(Mica.WorldDef()))
+        {
+            world.SetGravity(new System.Numerics.Vector3(0, 0, -5));
+            var body = world.CreateBox(new[] { 0.0, 0, 0 }, new[] { 0.1, 0.1, 0.1 }, new[] { 2, 2, 2 }, 5, Mica.BodyDef());
+            var before = body.GetPositions();
+            world.Step(0.01);
+            var after = body.GetPositions();
+            Expect(after[2] < before[2] && Math.Abs(after[1] - before[1]) < 1e-12, "gravity (0, 0, -5) from a Vector3");
+
+            var tool = world.CreateTool(Mica.ToolDef());
+            var turn = System.Numerics.Quaternion.CreateFromAxisAngle(System.Numerics.Vector3.UnitY, (float)(Math.PI / 2));
+            tool.SetPose(new System.Numerics.Vector3(1, 2, 3), turn);
+            double[] p = new double[3], q = new double[4];
+            tool.GetPose(p, q);
+            Expect(p[0] == 1 && p[1] == 2 && p[2] == 3, "position from a Vector3");
+            Expect(Math.Abs(q[0] - turn.W) < 1e-7 && Math.Abs(q[2] - turn.Y) < 1e-7 && q[1] == 0 && q[3] == 0,
+                   "orientation from a Quaternion as (w, x, y, z): " + string.Join(", ", q));
+            System.Numerics.Vector3 position;
+            System.Numerics.Quaternion orientation;
+            tool.GetPose(out position, out orientation);
+            Expect(position == new System.Numerics.Vector3(1, 2, 3), "position back as a Vector3");
+            Expect(Math.Abs(orientation.W - turn.W) < 1e-6 && Math.Abs(orientation.Y - turn.Y) < 1e-6, "orientation back");
+            var force = tool.GetForce();
+            Expect(tool.GetForceVector() == new System.Numerics.Vector3((float)force[0], (float)force[1], (float)force[2]), "force");
+
+            var nodes = body.SelectNodesByPlane(System.Numerics.Vector3.Zero, System.Numerics.Vector3.UnitZ, 1e-9, true);
+            Expect(nodes.Length == 9, "the nodes of z = 0: " + nodes.Length);
+            var lpc = body.Grab(new System.Numerics.Vector3(0.1f, 0.1f, 0.1f), 0.01);
+            lpc.SetHandlePose(new System.Numerics.Vector3(0.1f, 0.1f, 0.12f), System.Numerics.Quaternion.Identity);
+            world.Step(0.01);
+            var reaction = lpc.GetReaction();
+            var r = lpc.GetReactionVector();
+            Expect(r.Z == (float)reaction[2] && reaction[2] != 0, "the reaction as a Vector3: " + reaction[2]);
+        }
+    }
+
     sealed class Stylus : DeviceBackend
     {
         public int Reads, Writes, Opened, Closed;
@@ -407,6 +446,7 @@ static class TestMica
         Test("sphere indent matches C to 1e-9", SphereIndent);
         Test("a device backend in C#", DeviceBackendInCSharp);
         Test("a mesh file and raw ids, from another assembly", LoaderAndRawIds);
+        Test("System.Numerics Vector3 and Quaternion overloads", NumericsOverloads);
         Console.WriteLine("{0} passed, {1} failed, {2} skipped", passed, failed, skipped);
         return failed == 0 ? 0 : 1;
     }

@@ -16,7 +16,9 @@ runtime=$MICA_SOURCE_DIR/bindings/csharp/com.libmica.mica/Runtime
 # user's code referencing it, which sees only what the binding makes public.
 dll=$MICA_TEST_WORK_DIR/LibMica.dll
 exe=$MICA_TEST_WORK_DIR/TestMica.exe
-mcs -nologo -warnaserror+ -unsafe -langversion:7.2 -target:library -out:"$dll" "$runtime"/*.cs
-mcs -nologo -warnaserror+ -unsafe -langversion:7.2 -r:"$dll" -out:"$exe" "$1"
+# System.Numerics.Vectors (Vector3, Quaternion: Runtime/MicaNumerics.cs) is part of Unity's .NET
+# profiles; on Debian it is the package libmono-system-numerics-vectors4.0-cil.
+mcs -nologo -warnaserror+ -unsafe -langversion:7.2 -r:System.Numerics -r:System.Numerics.Vectors -target:library -out:"$dll" "$runtime"/*.cs
+mcs -nologo -warnaserror+ -unsafe -langversion:7.2 -r:System.Numerics -r:System.Numerics.Vectors -r:"$dll" -out:"$exe" "$1"
 # [DllImport("mica")] resolves to libmica.so on the library path; mono finds LibMica.dll beside the exe.
 LD_LIBRARY_PATH=$MICA_LIBRARY_DIR${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH} exec mono --debug "$exe"

@@ -146,11 +146,12 @@ static const char kTwoTetMsh[] =
   } while (0)
 
 /* The fixture world with the given solver; NULL on failure. */
-static inline fixture* new_fixture(int32_t solver) {
+static inline fixture* new_fixture(int32_t solver, int32_t sweep) {
   fixture* fx = calloc(1, sizeof *fx);
   if (!fx) return NULL;
   mica_world_def wd = mica_world_def_default();
   wd.solver = solver;
+  wd.mica_sweep = sweep;
   wd.log = record_log;
   wd.log_user = fx;
   if (mica_world_create(&wd, &fx->world) != MICA_OK) return NULL;
@@ -182,7 +183,7 @@ static inline fixture* new_fixture(int32_t solver) {
 }
 
 static inline int setup(void** state) {
-  fixture* fx = new_fixture(MICA_SOLVER_DIRECT);
+  fixture* fx = new_fixture(MICA_SOLVER_DIRECT, MICA_SWEEP_FACTORED);
   *state = fx;
   return fx ? 0 : -1;
 }

@@ -145,7 +145,9 @@ static void test_defaults(void** state) {
   assert_int_equal(wd.struct_size, sizeof(mica_world_def));
   assert_int_equal(wd.header_version, MICA_VERSION_NUMBER);
   assert_true(wd.gravity[0] == 0 && wd.gravity[1] == -9.81 && wd.gravity[2] == 0);
-  assert_int_equal(wd.solver, MICA_SOLVER_DIRECT);
+  /* Since 0.5 the default world is the haptic one: MICA with the factored sweep. */
+  assert_int_equal(wd.solver, MICA_SOLVER_MICA);
+  assert_int_equal(wd.mica_sweep, MICA_SWEEP_FACTORED);
   assert_int_equal(wd.max_iterations, 200);
   assert_true(wd.tolerance == 1e-8);
   assert_int_equal(wd.plan_all_stages, 0);
@@ -176,6 +178,8 @@ static void test_defaults(void** state) {
   assert_int_equal(fw.struct_size, sizeof fw);
   assert_int_equal(fw.header_version, MICA_VERSION_NUMBER);
   assert_true(fw.gravity[1] == -9.81 && fw.tolerance == 1e-8 && fw.max_iterations == 200);
+  assert_int_equal(fw.solver, MICA_SOLVER_MICA);
+  assert_int_equal(fw.mica_sweep, MICA_SWEEP_FACTORED);
   assert_null(fw.log);
   mica_body_def fb;
   memset(&fb, 0xff, sizeof fb);

@@ -357,8 +357,8 @@ static void test_failed_calls_leave_no_trace(void** state) {
  * velocity after a 1 s step about 16e308 / 3 m/s, beyond DBL_MAX. Every solver must report
  * MICA_ERR_NUMERICAL and undo the step completely, the statistics included (the header: "on
  * an error the world is left exactly as it was"); none may return MICA_OK. */
-static void check_numerical_failure(int32_t solver) {
-  fixture* fx = new_fixture(solver);
+static void check_numerical_failure(int32_t solver, int32_t sweep) {
+  fixture* fx = new_fixture(solver, sweep);
   assert_non_null(fx);
   REQUIRE_OK_W(fx->world, mica_lpc_remove(fx->world, fx->lpc));
   int32_t nodes[64];
@@ -404,15 +404,19 @@ static void check_numerical_failure(int32_t solver) {
 
 static void test_numerical_failure_direct(void** state) {
   (void)state;
-  check_numerical_failure(MICA_SOLVER_DIRECT);
+  check_numerical_failure(MICA_SOLVER_DIRECT, MICA_SWEEP_FACTORED);
 }
 static void test_numerical_failure_pcg(void** state) {
   (void)state;
-  check_numerical_failure(MICA_SOLVER_PCG);
+  check_numerical_failure(MICA_SOLVER_PCG, MICA_SWEEP_FACTORED);
 }
 static void test_numerical_failure_mica(void** state) {
   (void)state;
-  check_numerical_failure(MICA_SOLVER_MICA);
+  check_numerical_failure(MICA_SOLVER_MICA, MICA_SWEEP_GAUSS_SEIDEL);
+}
+static void test_numerical_failure_mica_factored(void** state) {
+  (void)state;
+  check_numerical_failure(MICA_SOLVER_MICA, MICA_SWEEP_FACTORED);
 }
 
 int main(void) {
@@ -424,6 +428,7 @@ int main(void) {
       cmocka_unit_test(test_numerical_failure_direct),
       cmocka_unit_test(test_numerical_failure_pcg),
       cmocka_unit_test(test_numerical_failure_mica),
+      cmocka_unit_test(test_numerical_failure_mica_factored),
   };
   return cmocka_run_group_tests(tests, group_setup, group_teardown);
 }

@@ -109,6 +109,65 @@ static void test_world_from_an_older_header(void** state) {
   assert_null(world);
 }
 
+/* A stiff cantilever (E = 1e7 Pa, 10 x 2 x 2 cells, x = 0 clamped) sagging for three 10 ms
+ * steps in a world made from `def`: the last step's statistics and the positions. */
+typedef struct {
+  mica_world_stats stats;
+  double x[3 * 11 * 3 * 3];
+} sag_result;
+
+static void sag(const mica_world_def* def, sag_result* r) {
+  memset(r, 0, sizeof *r);
+  mica_world* world = NULL;
+  assert_int_equal(mica_world_create(def, &world), MICA_OK);
+  mica_body_def bd = mica_body_def_default();
+  bd.youngs_modulus = 1e7;
+  const double lo[3] = {0, 0, 0}, hi[3] = {0.1, 0.02, 0.02}, point[3] = {0, 0, 0}, normal[3] = {1, 0, 0};
+  const int32_t cells[3] = {10, 2, 2};
+  mica_body_id body;
+  assert_int_equal(mica_body_create_box(world, &bd, lo, hi, cells, 5, &body), MICA_OK);
+  int32_t clamped[9], count = 0;
+  assert_int_equal(mica_body_select_nodes_by_plane(world, body, point, normal, 1e-9, 1, clamped, 9, &count), MICA_OK);
+  const mica_lpc_def fixed = mica_lpc_def_default();
+  mica_lpc_id lpc;
+  assert_int_equal(mica_add_lpc(world, body, clamped, count, &fixed, &lpc), MICA_OK);
+  for (int k = 0; k < 3; ++k) assert_true(mica_step(world, 0.01) >= 0);
+  r->stats.struct_size = sizeof r->stats;
+  assert_int_equal(mica_world_get_stats(world, &r->stats), MICA_OK);
+  int32_t n = 0;
+  assert_int_equal(mica_body_get_positions(world, body, r->x, 11 * 3 * 3, &n), MICA_OK);
+  assert_int_equal(n, 11 * 3 * 3);
+  mica_world_destroy(world);
+}
+
+/* A 0.2 caller's def gets this library's defaults: its init fills the solver (MICA since 0.5), and
+ * the field its header lacks (mica_sweep, since 0.3) is the default, the factored sweep. The world
+ * steps exactly like one made with MICA and the factored sweep set explicitly, and not like the
+ * Gauss-Seidel sweep (the 0.4 default), which stops at the 200-iteration cap on this stiff beam. */
+static void test_older_header_gets_the_library_defaults(void** state) {
+  (void)state;
+  world_buffer old;
+  memset(&old, 0xcd, sizeof old);
+  assert_int_equal(mica_world_def_init(&old.d, FIRST_WORLD, 200), MICA_OK);
+  assert_int_equal(old.d.solver, MICA_SOLVER_MICA);
+  mica_world_def factored = mica_world_def_default(), gauss_seidel = factored;
+  factored.solver = gauss_seidel.solver = MICA_SOLVER_MICA;
+  factored.mica_sweep = MICA_SWEEP_FACTORED;
+  gauss_seidel.mica_sweep = MICA_SWEEP_GAUSS_SEIDEL;
+  static sag_result a, b, c;
+  sag(&old.d, &a);
+  sag(&factored, &b);
+  sag(&gauss_seidel, &c);
+  print_message("0.2 def: %d iterations (converged %d); factored: %d (%d); Gauss-Seidel: %d (%d)\n",
+                a.stats.solver_iterations, a.stats.converged, b.stats.solver_iterations, b.stats.converged,
+                c.stats.solver_iterations, c.stats.converged);
+  assert_int_equal(a.stats.solver_iterations, b.stats.solver_iterations);
+  assert_int_equal(a.stats.converged, 1);
+  assert_memory_equal(a.x, b.x, sizeof a.x);
+  assert_int_equal(c.stats.converged, 0);
+  assert_true(c.stats.solver_iterations != a.stats.solver_iterations);
+}
+
 /* 0.3's reserved3 became threads in 0.4: a 0.3 def's value there is not a thread count. */
 static void test_world_0_3_reserved_slot(void** state) {
   (void)state;
@@ -167,6 +226,7 @@ int main(void) {
       cmocka_unit_test(test_init_accepts_every_released_size),
       cmocka_unit_test(test_world_from_an_older_header),
       cmocka_unit_test(test_world_0_3_reserved_slot),
+      cmocka_unit_test(test_older_header_gets_the_library_defaults),
       cmocka_unit_test(test_header_versions),
       cmocka_unit_test(test_create_names_a_refused_size),
   };

@@ -60,6 +60,7 @@ static mica_world* make_world(int32_t solver) {
   mica_world_def wd = mica_world_def_default();
   wd.gravity[1] = 0;
   wd.solver = solver;
+  wd.mica_sweep = MICA_SWEEP_GAUSS_SEIDEL; /* MICA: the paper's sweep */
   wd.max_iterations = 2000;
   wd.tolerance = 1e-8;
   mica_world* w = NULL;

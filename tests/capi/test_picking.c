@@ -22,6 +22,7 @@ static scene make_scene(void) {
   mica_world_def wd = mica_world_def_default();
   wd.gravity[1] = 0;
   wd.solver = MICA_SOLVER_MICA;
+  wd.mica_sweep = MICA_SWEEP_GAUSS_SEIDEL; /* the paper's sweep */
   wd.tolerance = 1e-10;
   wd.max_iterations = 100000;
   assert_int_equal(mica_world_create(&wd, &s.world), MICA_OK);

@@ -18,6 +18,7 @@ static double press(mica_tool_def td, double depth, int32_t* contacts) {
   mica_world_def wd = mica_world_def_default();
   wd.gravity[1] = 0;
   wd.solver = MICA_SOLVER_MICA;
+  wd.mica_sweep = MICA_SWEEP_GAUSS_SEIDEL; /* the paper's sweep */
   wd.tolerance = 1e-10;
   wd.max_iterations = 100000;
   mica_world* w = NULL;

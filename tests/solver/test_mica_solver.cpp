@@ -71,6 +71,7 @@ void build(Scene& s, const SceneSpec& spec) {
 WorldSettings settings(SolverKind solver, double tol) {
   WorldSettings ws;
   ws.solver = solver;
+  ws.mica_sweep = MicaSweep::GaussSeidel;  // MICA: the paper's sweep unless a test says otherwise
   ws.tolerance = tol;
   ws.max_iterations = 100000;
   ws.gravity = Vec3::Zero();

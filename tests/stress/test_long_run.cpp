@@ -55,6 +55,7 @@ static void test_virtual_hand_long_run(void**) {
   WorldSettings ws;
   ws.gravity = Vec3::Zero();
   ws.solver = c.solver;
+  ws.mica_sweep = c.sweep;
   ws.tolerance = c.tol;
   ws.max_iterations = c.max_iter;
   World w(ws);

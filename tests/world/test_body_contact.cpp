@@ -11,6 +11,7 @@ namespace {
 WorldSettings settings(SolverKind solver) {
   WorldSettings ws;
   ws.solver = solver;
+  ws.mica_sweep = MicaSweep::GaussSeidel;  // MICA: the paper's sweep
   ws.tolerance = 1e-10;
   ws.max_iterations = 100000;
   ws.gravity = Vec3(0, -9.81, 0);

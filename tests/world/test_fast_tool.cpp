@@ -11,6 +11,7 @@ namespace {
 WorldSettings settings() {
   WorldSettings ws;
   ws.solver = SolverKind::Mica;
+  ws.mica_sweep = MicaSweep::GaussSeidel;  // the paper's sweep
   ws.tolerance = 1e-8;
   ws.max_iterations = 20000;
   ws.gravity = Vec3::Zero();

@@ -32,6 +32,7 @@ void build(Scene& s, bool corotational) {
 
 WorldSettings settings(bool plan_all) {
   WorldSettings ws;
+  ws.solver = SolverKind::Direct;  // the exact solver: one factorization per new system
   ws.gravity = Vec3::Zero();
   ws.plan_all_stages = plan_all;
   return ws;
@@ -122,6 +123,7 @@ static void test_removed_tool_leaves_nothing_behind(void**) {
     WorldSettings ws;
     ws.gravity = Vec3::Zero();
     ws.solver = solver;
+    ws.mica_sweep = MicaSweep::GaussSeidel;  // MICA: the paper's sweep
     ws.tolerance = 1e-12;
     ws.max_iterations = 100000;
     World w(ws);

@@ -32,6 +32,7 @@ Release twist_and_release(SolverKind solver, int32_t relinearise_max) {
   WorldSettings ws;
   ws.gravity = Vec3::Zero();
   ws.solver = solver;
+  ws.mica_sweep = MicaSweep::GaussSeidel;  // MICA: the paper's sweep
   ws.tolerance = solver == SolverKind::Mica ? 1e-7 : 1e-8;
   ws.max_iterations = 2000;
   ws.relinearise_max = relinearise_max;
@@ -92,6 +93,7 @@ void build_cantilever(Cantilever& c, bool corotational = true) {
 
 WorldSettings cantilever_settings(int32_t relinearise_max, double tolerance) {
   WorldSettings ws;
+  ws.solver = SolverKind::Direct;  // the exact reference
   ws.gravity = Vec3::Zero();
   ws.tolerance = 1e-10;
   ws.relinearise_max = relinearise_max;

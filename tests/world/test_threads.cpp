@@ -29,6 +29,7 @@ struct Scene {
 WorldSettings settings(const SceneSpec& spec, int32_t threads) {
   WorldSettings ws;
   ws.solver = spec.solver;
+  ws.mica_sweep = MicaSweep::GaussSeidel;  // MICA: the colour-ordered Gauss-Seidel sweep is what threads change
   ws.tolerance = 1e-10;
   ws.max_iterations = 100000;
   ws.gravity = spec.gravity;

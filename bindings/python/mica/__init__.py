@@ -76,7 +76,11 @@ def _check(status, world_handle=None, function=""):
         message = native.mica_world_last_error(world_handle) or b""
         raise MicaError(status, message.decode(errors="replace"), function)
     if status > 0:
-        warnings.warn(MicaWarning(status), stacklevel=_caller_level())
+        message = ""
+        if status == native.MICA_WARN_BODIES_OVERLAP and world_handle is not None:
+            # The library keeps this warning's message (both bodies and the depth) as the world's.
+            message = (native.mica_world_last_error(world_handle) or b"").decode(errors="replace")
+        warnings.warn(MicaWarning(status, message), stacklevel=_caller_level())
     return status
 
 

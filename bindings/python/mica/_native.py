@@ -12,13 +12,14 @@ from ctypes import (CFUNCTYPE, POINTER, Structure, c_char, c_char_p, c_double, c
 
 # --- Constants (mica.h)
 MICA_VERSION_MAJOR = 0
-MICA_VERSION_MINOR = 4
+MICA_VERSION_MINOR = 5
 MICA_VERSION_PATCH = 0
 MICA_VERSION_NUMBER = MICA_VERSION_MAJOR * 10000 + MICA_VERSION_MINOR * 100 + MICA_VERSION_PATCH
 
 MICA_OK = 0
 MICA_WARN_NOT_CONVERGED = 1
 MICA_WARN_DEVICE = 2
+MICA_WARN_BODIES_OVERLAP = 3
 MICA_ERR_NULL_ARGUMENT = -1
 MICA_ERR_INVALID_ARGUMENT = -2
 MICA_ERR_OUT_OF_RANGE = -3
@@ -197,6 +198,8 @@ class mica_world_stats(Structure):
         ("solver_residual", c_double),
         ("ms_last_step", c_double),
         ("stages", mica_stage_stats * MICA_STAGE_COUNT),
+        ("contacts", c_int32),
+        ("body_contacts", c_int32),
     ]
 
 

@@ -16,13 +16,14 @@ namespace LibMica
 
         // --- Constants (mica.h)
         public const int MICA_VERSION_MAJOR = 0;
-        public const int MICA_VERSION_MINOR = 4;
+        public const int MICA_VERSION_MINOR = 5;
         public const int MICA_VERSION_PATCH = 0;
         public const int MICA_VERSION_NUMBER = MICA_VERSION_MAJOR * 10000 + MICA_VERSION_MINOR * 100 + MICA_VERSION_PATCH;
 
         public const int MICA_OK = 0;
         public const int MICA_WARN_NOT_CONVERGED = 1;
         public const int MICA_WARN_DEVICE = 2;
+        public const int MICA_WARN_BODIES_OVERLAP = 3;
         public const int MICA_ERR_NULL_ARGUMENT = -1;
         public const int MICA_ERR_INVALID_ARGUMENT = -2;
         public const int MICA_ERR_OUT_OF_RANGE = -3;
@@ -214,6 +215,8 @@ namespace LibMica
             // mica_stage_stats stages[MICA_STAGE_COUNT]: fixed buffers hold primitives only, so
             // the bytes are kept here and Stage(i) reads them.
             public fixed byte stages[MICA_STAGE_COUNT * 32];
+            public int contacts;
+            public int body_contacts;
 
             public mica_stage_stats Stage(int stage)
             {

@@ -1,0 +1,68 @@
+// SPDX-License-Identifier: Apache-2.0
+// A soft cube fixed at its base and a sphere you move with a Transform (drag it in the Scene view,
+// or parent it to a tracked stylus): the cube deforms and the force the tissue puts on the sphere
+// is logged and drawn. Put this on an empty GameObject, assign `Probe` (any Transform) and press
+// Play. Needs libmica.so in Assets/Plugins/x86_64/ (Linux x86-64; see the package's README).
+// Units: libmica is SI (m, N); 1 Unity unit is taken as 1 m. Unity's frame is left-handed: z is
+// flipped on the way in and out so the cube's base stays at y = 0.
+using LibMica;
+using UnityEngine;
+
+public sealed class PressCube : MonoBehaviour
+{
+    public Transform Probe;              // the sphere's centre follows it
+    public float ProbeRadius = 0.02f;    // m
+    public float YoungsModulus = 1e4f;   // Pa
+    public int CellsPerSide = 8;
+
+    World world;
+    Body cube;
+    LibMica.Tool sphere;
+    double[] positions;
+
+    void Start()
+    {
+        var def = Mica.WorldDef();   // the haptic default: MICA with the factored sweep
+        def.time_budget_ms = 10;     // a step never takes longer than a frame's share
+        world = new World(def, (level, text) => Debug.Log("libmica: " + text));
+        var body = Mica.BodyDef();
+        body.youngs_modulus = YoungsModulus;
+        body.rayleigh_alpha = 2;
+        var n = CellsPerSide;
+        cube = world.CreateBox(new[] { -0.05, 0, -0.05 }, new[] { 0.05, 0.1, 0.05 }, new[] { n, n, n }, 5, body);
+        cube.AddLpc(cube.SelectNodesByPlane(System.Numerics.Vector3.Zero, System.Numerics.Vector3.UnitY, 1e-9, true),
+                    Mica.LpcDef());
+        var tool = Mica.ToolDef();
+        tool.radius = ProbeRadius;
+        sphere = world.CreateTool(tool);
+    }
+
+    void FixedUpdate()
+    {
+        if (world == null) return;
+        if (Probe != null)
+        {
+            var p = Probe.position;
+            sphere.SetPose(new System.Numerics.Vector3(p.x, p.y, -p.z));
+        }
+        world.Step(Time.fixedDeltaTime);
+        positions = cube.GetPositions(positions);
+        var f = sphere.GetForceVector();
+        if (f.Length() > 0) Debug.Log(string.Format("force on the probe: {0:F3} N", f.Length()));
+    }
+
+    void OnDrawGizmos()
+    {
+        if (positions == null) return;
+        Gizmos.color = Color.red;
+        for (int i = 0; i < positions.Length / 3; ++i)
+            Gizmos.DrawCube(new Vector3((float)positions[3 * i], (float)positions[3 * i + 1], -(float)positions[3 * i + 2]),
+                            Vector3.one * 0.002f);
+    }
+
+    void OnDestroy()
+    {
+        if (world != null) world.Dispose();
+        world = null;
+    }
+}
