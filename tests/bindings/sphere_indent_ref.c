@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /* The reference for the binding tests: the scene of examples_c/sphere_indent.c (same parameters
- * but MICA's sweep, same operations in the same order), printing the tool force of every step at
+ * and solver, the same operations in the same order), printing the tool force of every step at
  * full precision.
  * Each binding replays the scene and compares its forces with this output.
  *
@@ -35,9 +35,8 @@ int main(int argc, char** argv) {
     return 1;
   }
   /* The scene of examples_c/sphere_indent.c, built by the same code (scenes/press_scene.c), with
-   * MICA's Gauss-Seidel sweep (mica_world_def's default, which the bindings replay). */
-  press_scene_def def = press_scene_sphere_indent_def();
-  def.sweep = MICA_SWEEP_GAUSS_SEIDEL;
+   * MICA's factored sweep (mica_world_def's default, which the bindings replay). */
+  const press_scene_def def = press_scene_sphere_indent_def();
   const double dt = def.dt, start_gap = def.gap, max_depth = def.depth;
   press_scene scene;
   if (press_scene_create(&def, &scene) != MICA_OK) {
