@@ -206,11 +206,17 @@ SolveReport FactoredMicaSolver::solve(const SolveContext& ctx, std::vector<Solve
   }
   lambda.resize(nr, 0.0);
   start_compliance(bodies, rows, lambda);
-  if (settings.active_set && nr > 0) return solve_active_set(ctx, bodies, rows, lambda);
-  bool may_refactor = false;  // only co-rotational bodies: a linear body's factor is its A
-  for (const FactoredBody& f : factored) may_refactor = may_refactor || (f.node_rotation && settings.refactor_after > 0);
-
   SolveReport report;
+  if (settings.active_set && nr > 0) {
+    report = solve_active_set(ctx, bodies, rows, lambda);
+    if (report.converged || report.out_of_time) return report;
+    // Not settled in its rounds: the alternating loop below goes on from its impulses and
+    // velocities, with what is left of the iteration cap.
+  }
+  bool may_refactor = false;  // only co-rotational bodies: a linear body's factor is its A
+  for (const FactoredBody& f : factored)
+    may_refactor = may_refactor || (f.node_rotation && settings.refactor_after > report.iterations);
+
   report.converged = false;
   report.momentum_residual = std::numeric_limits<double>::quiet_NaN();
   double l_scale = 0;

@@ -24,6 +24,10 @@ namespace mica {
 
 namespace {
 
+// Rounds of the active-set loop before it hands over to the alternating loop (a set that keeps
+// changing: contacts flickering at the threshold of pressing or sticking).
+constexpr int32_t kMaxRounds = 25;
+
 double dot(const std::vector<Vec3List>& a, const std::vector<Vec3List>& b) {
   double s = 0;
   for (size_t k = 0; k < a.size(); ++k) s += flat(a[k]).dot(flat(b[k]));
@@ -247,6 +251,7 @@ SolveReport FactoredMicaSolver::solve_active_set(const SolveContext& ctx, std::v
   double l_scale = 0;
   for (double l : lambda_next_) l_scale += l * l;
   int32_t outer = 0;
+  bool have_pair = false;  // lambda_prev_ and w_prev_ are a solved round of this solve and factor
   while (report.iterations < settings.max_iterations) {
     if (deadline && outer > 0 && Clock::now() >= *deadline) {
       report.out_of_time = true;
@@ -261,6 +266,7 @@ SolveReport FactoredMicaSolver::solve_active_set(const SolveContext& ctx, std::v
       start_compliance(bodies, rows, lambda_next_);
       W0_ = W_;
       may_refactor = false;
+      have_pair = false;
     }
     ++outer;
     lambda = lambda_next_;
@@ -276,10 +282,27 @@ SolveReport FactoredMicaSolver::solve_active_set(const SolveContext& ctx, std::v
       if (may_refactor) continue;  // stopped where refactoring pays: refactor, go on
       break;
     }
-    // The solved pair measures the true compliance along the impulses' change (secant update, as
-    // in solve()); then the small problem around the solved impulses corrects the active set.
+    // Solved: the impulses balance A with the equalities held. Done when they and the row
+    // velocities are complementary (the natural residual, as in solve()) and the momentum balances.
+    // The impulses of redundant rows are not unique, so the test is on (lambda, w), not on how far
+    // the small problem would move lambda.
     row_velocities(bodies, rows);
-    if (outer > 1) {
+    double l2 = 0;
+    for (double l : lambda) l2 += l * l;
+    l_scale = std::max(l_scale, l2);
+    report.impulse_change = complementarity_error(rows, lambda) / std::sqrt(std::max(l_scale, 1e-300));
+    if (report.impulse_change <= settings.tolerance) {
+      rows.project(lambda);  // a sliding pair kept its impulse while lambda_n was solved: back onto the disk
+      scatter_contact_impulses(rows, lambda, bodies);
+      report.momentum_residual = momentum_residual(bodies);
+      report.residual = std::max({report.velocity_change, report.impulse_change, report.momentum_residual});
+      report.converged = report.momentum_residual <= settings.tolerance;
+      if (report.converged) return report;
+    }
+    if (outer >= kMaxRounds) break;  // the set keeps changing: the alternating loop takes over (solve())
+    // The solved pair measures the true compliance along the impulses' change (secant update, as
+    // in solve()); then the small problem around the solved impulses predicts the next set.
+    if (have_pair) {
       const Eigen::VectorXd s_ = Eigen::Map<const Eigen::VectorXd>(lambda.data(), Eigen::Index(nr)) -
                                  Eigen::Map<const Eigen::VectorXd>(lambda_prev_.data(), Eigen::Index(nr));
       const Eigen::VectorXd y = Eigen::Map<const Eigen::VectorXd>(w_.data(), Eigen::Index(nr)) -
@@ -293,23 +316,8 @@ SolveReport FactoredMicaSolver::solve_active_set(const SolveContext& ctx, std::v
     }
     w_prev_ = w_;
     lambda_prev_ = lambda;
+    have_pair = true;
     solve_small_lcp(rows, settings.tolerance, lambda, deadline);
-    double dl2 = 0, l2 = 0;
-    for (size_t r = 0; r < nr; ++r) {
-      dl2 += (lambda_next_[r] - lambda[r]) * (lambda_next_[r] - lambda[r]);
-      l2 += lambda_next_[r] * lambda_next_[r];
-    }
-    l_scale = std::max(l_scale, 1e-300);
-    report.impulse_change = dl2 > 0 ? std::sqrt(dl2 / std::max(l2, l_scale)) : 0.0;
-    if (report.impulse_change <= settings.tolerance &&
-        complementarity_error(rows, lambda) <= settings.tolerance * std::sqrt(std::max(l2, l_scale))) {
-      rows.project(lambda);  // a sliding pair kept its impulse while lambda_n was solved: back onto the disk
-      scatter_contact_impulses(rows, lambda, bodies);
-      report.momentum_residual = momentum_residual(bodies);
-      report.residual = std::max({report.velocity_change, report.impulse_change, report.momentum_residual});
-      report.converged = report.momentum_residual <= settings.tolerance;
-      if (report.converged) return report;
-    }
   }
   rows.project(lambda);
   scatter_contact_impulses(rows, lambda, bodies);
