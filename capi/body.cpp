@@ -78,6 +78,18 @@ mica_status select_nodes(const mica::Body& b, int32_t use_rest, int32_t* out, in
   return copy_out(found.data(), int32_t(found.size()), 1, out, capacity, out_count);
 }
 
+// 3 * node_count values of a body as node vectors; the count is checked before anything is read
+// (the core checks that every value is finite).
+mica::Vec3List node_values(const mica::Body& b, const double* xyz, int32_t node_count) {
+  require(xyz, "xyz");
+  if (node_count != b.fem.node_count())
+    refuse(MICA_ERR_INVALID_ARGUMENT, "node_count is " + std::to_string(node_count) + ", " + b.name + " has " +
+                                          std::to_string(b.fem.node_count()) + " nodes");
+  mica::Vec3List values(static_cast<size_t>(node_count));
+  for (size_t i = 0; i < values.size(); ++i) values[i] = {xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]};
+  return values;
+}
+
 }  // namespace
 
 extern "C" {
@@ -242,6 +254,24 @@ MICA_API mica_status mica_body_get_energy(const mica_world* world, mica_body_id 
       for (size_t i = 0; i < b.x.size(); ++i) u -= b.fem.node_mass[i] * world->world.settings().gravity.dot(b.x[i]);
       *potential = u;
     }
+    return MICA_OK;
+  });
+}
+
+MICA_API mica_status mica_body_set_positions(mica_world* world, mica_body_id body, const double* xyz,
+                                             int32_t node_count) {
+  return guarded(world, "mica_body_set_positions", [&] {
+    require(world, "world");
+    world->world.set_positions(body, node_values(world->world.body(body), xyz, node_count));
+    return MICA_OK;
+  });
+}
+
+MICA_API mica_status mica_body_set_velocities(mica_world* world, mica_body_id body, const double* xyz,
+                                              int32_t node_count) {
+  return guarded(world, "mica_body_set_velocities", [&] {
+    require(world, "world");
+    world->world.set_velocities(body, node_values(world->world.body(body), xyz, node_count));
     return MICA_OK;
   });
 }

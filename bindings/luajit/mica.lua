@@ -252,6 +252,38 @@ function World:positions(body)
   return ptr[0], n[0]
 end
 
+-- Sets every node's positions (m) or velocities (m/s): a table (or double array) of 3 values a node.
+function World:set_positions(body, values)
+  assert(#values % 3 == 0, "positions: 3 values a node")
+  self:check(C.mica_body_set_positions(self.ptr, body, ffi.new("double[?]", #values, values), #values / 3))
+end
+function World:set_velocities(body, values)
+  assert(#values % 3 == 0, "velocities: 3 values a node")
+  self:check(C.mica_body_set_velocities(self.ptr, body, ffi.new("double[?]", #values, values), #values / 3))
+end
+
+-- The world's dynamic state as a Lua string (mica_world_save_state), and back.
+function World:save_state()
+  local size = ffi.new("size_t[1]")
+  self:check(C.mica_world_state_size(self.ptr, size))
+  local buffer = ffi.new("uint8_t[?]", size[0])
+  self:check(C.mica_world_save_state(self.ptr, buffer, size[0]))
+  return ffi.string(buffer, size[0])
+end
+function World:restore_state(state)
+  self:check(C.mica_world_restore_state(self.ptr, state, #state))
+end
+
+-- The contacts of the last step: a mica_contact[?] array (0-based) and its count.
+function World:contacts()
+  local n = ffi.new("int32_t[1]")
+  self:check(C.mica_world_get_contacts(self.ptr, nil, 0, n))
+  local out = ffi.new("mica_contact[?]", math.max(n[0], 1))
+  out[0].struct_size = ffi.sizeof("mica_contact")
+  if n[0] > 0 then self:check(C.mica_world_get_contacts(self.ptr, out, n[0], n)) end
+  return out, n[0]
+end
+
 -- A device whose callbacks are Lua functions: `callbacks` has read_state(state) and
 -- write_force(force, torque), optionally open(), close(), info(out); each returns nothing
 -- (success) or a mica_status. An error inside one becomes MICA_ERR_DEVICE.

@@ -321,6 +321,86 @@ static class TestMica
         }
     }
 
+    // Setting node state, saving and restoring, and the contacts readout.
+    static void StateAndContacts()
+    {
+        var def = Mica.WorldDef();
+        using (var world = new World(def))
+        {
+            var bdef = Mica.BodyDef();
+            bdef.youngs_modulus = 2e4;
+            var body = world.CreateBox(new double[] { 0, 0, 0 }, new double[] { 0.1, 0.1, 0.1 }, new[] { 2, 2, 2 }, 5, bdef);
+            var bottom = body.SelectNodesByPlane(new double[] { 0, 0, 0 }, new double[] { 0, 1, 0 }, 1e-9, true);
+            var ldef = Mica.LpcDef();
+            ulong lpc;
+            Mica.Check(MicaNative.mica_add_lpc(world.Handle, body.Id, bottom, bottom.Length, ref ldef, out lpc), world.Handle);
+            var tdef = Mica.ToolDef();
+            unsafe { tdef.radius = 0.02; tdef.position[0] = 0.05; tdef.position[1] = 0.1205; tdef.position[2] = 0.05; }
+            var tool = world.CreateTool(tdef);
+            // Set and read back.
+            var x = body.GetPositions();
+            var moved = (double[])x.Clone();
+            for (int i = 0; i < moved.Length; ++i) moved[i] += 1e-4;
+            body.SetPositions(moved);
+            Expect(body.GetPositions().SequenceEqual(moved), "positions read back");
+            body.SetPositions(x);
+            body.SetVelocities(new double[x.Length]);
+            try
+            {
+                body.SetVelocities(new double[3]);
+                Expect(false, "a wrong node count throws");
+            }
+            catch (MicaException e)
+            {
+                Expect(e.Status == MicaNative.MICA_ERR_INVALID_ARGUMENT, "MICA_ERR_INVALID_ARGUMENT");
+            }
+            // Save, run, restore, run again: the same bits.
+            Func<int, List<double>> run = first =>
+            {
+                var record = new List<double>();
+                for (int k = first; k < first + 10; ++k)
+                {
+                    tool.SetPose(new double[] { 0.05, 0.1205 - 0.0003 * Math.Min(k, 15), 0.05 }, new double[] { 1, 0, 0, 0 });
+                    world.Step(0.01);
+                    record.AddRange(body.GetPositions());
+                    record.AddRange(tool.GetForce());
+                }
+                return record;
+            };
+            run(0);
+            var state = world.SaveState();
+            var a = run(10);
+            world.RestoreState(state);
+            var b = run(10);
+            Expect(a.Select(BitConverter.DoubleToInt64Bits).SequenceEqual(b.Select(BitConverter.DoubleToInt64Bits)),
+                   "the restored run repeats the first bit for bit");
+            // The contacts add up to the tool force.
+            var force = tool.GetForce();
+            var contacts = world.GetContacts();
+            Expect(contacts.Length > 0 && force[1] > 0, "the tool is pressing");
+            double sum = 0;
+            unsafe
+            {
+                foreach (var c in contacts)
+                {
+                    var k = c;
+                    sum += k.normal[1] * k.normal_impulse + k.tangent_impulse[1];
+                }
+            }
+            Expect(Math.Abs(sum / 0.01 + force[1]) <= 1e-12 * Math.Abs(force[1]) * contacts.Length,
+                   "the contacts sum to the tool force");
+            try
+            {
+                world.RestoreState(state.Take(state.Length - 1).ToArray());
+                Expect(false, "a truncated state throws");
+            }
+            catch (MicaException e)
+            {
+                Expect(e.Status == MicaNative.MICA_ERR_PARSE, "MICA_ERR_PARSE");
+            }
+        }
+    }
+
     // User code in its own assembly: a mesh from a file, and an id from the raw layer wrapped.
     static void LoaderAndRawIds()
     {
@@ -442,6 +522,7 @@ static class TestMica
         Test("drift: struct sizes, field offsets, sizes and types", DriftStructs);
         Test("drift: callbacks and constants", DriftCallbacksAndConstants);
         Test("defaults, views and stats", DefaultsAndViews);
+        Test("node state, saved state and contacts", StateAndContacts);
         Test("errors, the log callback and the SafeHandle", Errors);
         Test("sphere indent matches C to 1e-9", SphereIndent);
         Test("a device backend in C#", DeviceBackendInCSharp);

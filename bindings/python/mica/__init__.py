@@ -335,6 +335,32 @@ class World:
         self._check(native.mica_world_get_stats(self.handle, byref(s)), "mica_world_get_stats")
         return s
 
+    def save_state(self) -> bytes:
+        """The world's dynamic state (mica_world_save_state), for restore_state()."""
+        size = ctypes.c_size_t()
+        self._check(native.mica_world_state_size(self.handle, byref(size)), "mica_world_state_size")
+        buffer = ctypes.create_string_buffer(size.value)
+        self._check(native.mica_world_save_state(self.handle, buffer, size.value), "mica_world_save_state")
+        return buffer.raw
+
+    def restore_state(self, state: bytes) -> None:
+        """Puts back a state from save_state() (a world of the same shape); raises MicaError
+        with the world unchanged otherwise."""
+        state = bytes(state)
+        self._view_epoch += 1
+        self._check(native.mica_world_restore_state(self.handle, state, len(state)), "mica_world_restore_state")
+
+    def contacts(self) -> list:
+        """The contacts of the last step, a list of mica_contact."""
+        n = c_int32()
+        self._check(native.mica_world_get_contacts(self.handle, None, 0, byref(n)), "mica_world_get_contacts")
+        if n.value == 0:
+            return []
+        out = (native.mica_contact * n.value)()
+        out[0].struct_size = sizeof(native.mica_contact)
+        self._check(native.mica_world_get_contacts(self.handle, out, n.value, byref(n)), "mica_world_get_contacts")
+        return list(out)
+
     def write_vtk(self, path: PathLike) -> None:
         self._check(native.mica_world_write_vtk(self.handle, str(path).encode()), "mica_world_write_vtk")
 
@@ -495,6 +521,18 @@ class Body(_Object):
         self.world._check(native.mica_body_set_node_forces(
             self.world.handle, self.id, nodes.ctypes.data_as(POINTER(c_int32)),
             forces.ctypes.data_as(POINTER(c_double)), len(nodes)), "mica_body_set_node_forces")
+
+    def _set_nodes(self, fn, values, name):
+        values = np.ascontiguousarray(values, dtype=np.float64).reshape(-1, 3)
+        self.world._check(fn(self.world.handle, self.id, values.ctypes.data_as(POINTER(c_double)), len(values)), name)
+
+    def set_positions(self, positions: ArrayLike) -> None:
+        """Sets every node's position (m), (n, 3); drops what was derived from the old ones."""
+        self._set_nodes(native.mica_body_set_positions, positions, "mica_body_set_positions")
+
+    def set_velocities(self, velocities: ArrayLike) -> None:
+        """Sets every node's velocity (m/s), (n, 3)."""
+        self._set_nodes(native.mica_body_set_velocities, velocities, "mica_body_set_velocities")
 
     def energy(self) -> Tuple[float, float, float]:
         """(kinetic, elastic, potential) in J."""

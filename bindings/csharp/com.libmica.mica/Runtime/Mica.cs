@@ -231,6 +231,36 @@ namespace LibMica
             return s;
         }
 
+        /// <summary>The world's dynamic state (mica_world_save_state), for RestoreState.</summary>
+        public byte[] SaveState()
+        {
+            ulong size;
+            Check(MicaNative.mica_world_state_size(Handle, out size));
+            var buffer = new byte[size];
+            Check(MicaNative.mica_world_save_state(Handle, buffer, size));
+            return buffer;
+        }
+
+        /// <summary>Puts back a state from SaveState (a world of the same shape); throws with the
+        /// world unchanged otherwise.</summary>
+        public void RestoreState(byte[] state)
+        {
+            if (state == null) throw new ArgumentNullException("state");
+            Check(MicaNative.mica_world_restore_state(Handle, state, (ulong)state.Length));
+        }
+
+        /// <summary>The contacts of the last step.</summary>
+        public MicaNative.mica_contact[] GetContacts()
+        {
+            int n;
+            Check(MicaNative.mica_world_get_contacts(Handle, null, 0, out n));
+            var contacts = new MicaNative.mica_contact[n];
+            if (n == 0) return contacts;
+            unsafe { contacts[0].struct_size = (uint)sizeof(MicaNative.mica_contact); }
+            Check(MicaNative.mica_world_get_contacts(Handle, contacts, n, out n));
+            return contacts;
+        }
+
         public Body CreateBox(double[] lo, double[] hi, int[] cells, int tetsPerCell, MicaNative.mica_body_def def)
         {
             ulong id;
@@ -306,6 +336,20 @@ namespace LibMica
             if (into == null || into.Length != 3 * n) into = new double[3 * n];
             World.Check(MicaNative.mica_body_get_positions(World.Handle, Id, into, n, out n));
             return into;
+        }
+
+        /// <summary>Sets every node's position (m), 3 values a node.</summary>
+        public void SetPositions(double[] xyz)
+        {
+            if (xyz == null) throw new ArgumentNullException("xyz");
+            World.Check(MicaNative.mica_body_set_positions(World.Handle, Id, xyz, xyz.Length / 3));
+        }
+
+        /// <summary>Sets every node's velocity (m/s), 3 values a node.</summary>
+        public void SetVelocities(double[] xyz)
+        {
+            if (xyz == null) throw new ArgumentNullException("xyz");
+            World.Check(MicaNative.mica_body_set_velocities(World.Handle, Id, xyz, xyz.Length / 3));
         }
 
         /// <summary>Zero-copy view of the positions, owned by the world: valid until the next
