@@ -125,6 +125,10 @@ class World {
   Body& body(Id id) { return bodies_.get(id, "body"); }
   const Body& body(Id id) const { return bodies_.get(id, "body"); }
   void set_node_forces(Id body, const std::vector<int32_t>& nodes, const Vec3List& forces);
+  // One material per tet: rebuilds the body's model (stiffness, mass, so damping and gravity) and
+  // drops the solver's factors of it; positions and velocities stay. Throws, changing nothing,
+  // for a wrong count or a material out of its domain (the message names the tet).
+  void set_body_materials(Id body, const std::vector<Material>& materials);
   // Numeric factorizations the solver has made of this body's systems so far.
   int64_t factorizations(Id body) const;
 
