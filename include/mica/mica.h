@@ -576,7 +576,8 @@ MICA_API mica_status mica_body_get_tet_regions(const mica_world* world, mica_bod
  *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` is NULL); MICA_ERR_STALE_ID (`body` is
  *          null, of another kind or destroyed); MICA_ERR_INVALID_ARGUMENT (`tet_count` is not the
  *          body's tet count, or a value out of its domain: the message names the tet and the
- *          property). On any error nothing changes. */
+ *          property); MICA_ERR_BAD_MESH (a value so large that a tet's stiffness or mass
+ *          overflows double precision); MICA_ERR_OUT_OF_MEMORY. On any error nothing changes. */
 MICA_API mica_status mica_body_set_materials(mica_world* world, mica_body_id body,
                                              const double* youngs_modulus,
                                              const double* poisson_ratio, const double* density,
