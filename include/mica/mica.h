@@ -555,6 +555,112 @@ MICA_API mica_status mica_body_set_positions(mica_world* world, mica_body_id bod
  *          static). On an error the world is unchanged. */
 MICA_API mica_status mica_body_set_velocities(mica_world* world, mica_body_id body, const double* xyz,
                                               int32_t node_count);
+/* Since 0.6: tissue regions (a material per tet), the mesh and its fields. */
+
+/** The tets, 4 node indices each (0-based, positive rest volume as at creation); as
+ *  mica_body_get_positions(). The world's thread (the one thread using the world at a time).
+ *  @param world the world (not changed).
+ *  @param body the body.
+ *  @param out the caller's buffer, or NULL to ask for the count only. @param capacity the buffer's
+ *         size in tets (not in values). @param out_count receives the tet count (may be NULL when
+ *         `out` is not).
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` or a required pointer is NULL);
+ *          MICA_ERR_STALE_ID (`body` is null, of another kind or destroyed);
+ *          MICA_ERR_INVALID_ARGUMENT (`capacity` < 0); MICA_ERR_BUFFER_TOO_SMALL (`capacity` below
+ *          the count: nothing copied, `*out_count` = the count needed). */
+MICA_API mica_status mica_body_get_tets(const mica_world* world, mica_body_id body,
+                                        int32_t* out, int32_t capacity, int32_t* out_count);
+
+/** The region of each tet, 1 value per tet in the order of mica_body_get_tets(): for a Gmsh .msh
+ *  file the tet's physical tag (2.2: the element's first tag; 4.1: the first physical tag of its
+ *  volume in $Entities), for a TetGen .ele the first tet attribute (tetgen -A) when every tet's
+ *  is an integer, else 0; 0 for a tet without one and for bodies made from arrays or boxes. Map
+ *  regions to materials with mica_body_set_materials(). Buffer protocol as
+ *  mica_body_get_positions(). The world's thread (the one thread using the world at a time).
+ *  @param world the world (not changed).
+ *  @param body the body.
+ *  @param out the caller's buffer, or NULL to ask for the count only. @param capacity the buffer's
+ *         size in tets. @param out_count receives the tet count (may be NULL when `out` is not).
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` or a required pointer is NULL);
+ *          MICA_ERR_STALE_ID (`body` is null, of another kind or destroyed);
+ *          MICA_ERR_INVALID_ARGUMENT (`capacity` < 0); MICA_ERR_BUFFER_TOO_SMALL (`capacity` below
+ *          the count: nothing copied, `*out_count` = the count needed). */
+MICA_API mica_status mica_body_get_tet_regions(const mica_world* world, mica_body_id body,
+                                               int32_t* out, int32_t capacity,
+                                               int32_t* out_count);
+
+/** Sets the material of every tet (a stiff nodule in soft tissue): Young's modulus, Poisson
+ *  ratio and density per tet, in the order of mica_body_get_tets(). The body's model is rebuilt:
+ *  element stiffness, mass (so gravity and node masses) and Rayleigh damping (alpha M + beta K,
+ *  with the body's alpha and beta) follow each tet's material, and the solver's factors of the
+ *  body are dropped (the next step factors anew). Positions, velocities, loads and constraints
+ *  stay. Cost: like creating the body; call it after creation, not per step. The world's thread
+ *  (the one thread using the world at a time).
+ *  @param world the world.
+ *  @param body the body.
+ *  @param youngs_modulus `tet_count` values, Pa, each finite and > 0; NULL keeps every tet's.
+ *  @param poisson_ratio `tet_count` values, each in [0, 0.5); NULL keeps every tet's.
+ *  @param density `tet_count` values, kg/m^3, each finite and > 0; NULL keeps every tet's.
+ *  @param tet_count the body's tet count (mica_body_get_counts()).
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` is NULL); MICA_ERR_STALE_ID (`body` is
+ *          null, of another kind or destroyed); MICA_ERR_INVALID_ARGUMENT (`tet_count` is not the
+ *          body's tet count, or a value out of its domain: the message names the tet and the
+ *          property); MICA_ERR_BAD_MESH (a value so large that a tet's stiffness or mass
+ *          overflows double precision); MICA_ERR_OUT_OF_MEMORY. On any error nothing changes. */
+MICA_API mica_status mica_body_set_materials(mica_world* world, mica_body_id body,
+                                             const double* youngs_modulus,
+                                             const double* poisson_ratio, const double* density,
+                                             int32_t tet_count);
+
+/** Mass of each node (kg), 1 value per node: the row sums of the body's mass matrix, the mass
+ *  gravity pulls on. For linear tets each tet gives rho V / 4 to each of its nodes with either
+ *  MICA_MASS_CONSISTENT or MICA_MASS_LUMPED, so the sum is the body's mass (density times
+ *  volume, per tet). Buffer protocol as mica_body_get_positions(). The world's thread (the one
+ *  thread using the world at a time).
+ *  @param world the world (not changed).
+ *  @param body the body.
+ *  @param out the caller's buffer, or NULL to ask for the count only. @param capacity the buffer's
+ *         size in nodes. @param out_count receives the node count (may be NULL when `out` is not).
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` or a required pointer is NULL);
+ *          MICA_ERR_STALE_ID (`body` is null, of another kind or destroyed);
+ *          MICA_ERR_INVALID_ARGUMENT (`capacity` < 0); MICA_ERR_BUFFER_TOO_SMALL (`capacity` below
+ *          the count: nothing copied, `*out_count` = the count needed). */
+MICA_API mica_status mica_body_get_node_masses(const mica_world* world, mica_body_id body,
+                                               double* out, int32_t capacity, int32_t* out_count);
+
+/** Strain of each tet at the current positions (dimensionless), 6 values per tet: xx, yy, zz,
+ *  yz, xz, xy, with tensor shear components (half the engineering shear). It is the strain the
+ *  model uses: co-rotational bodies eps = sym(R^T F) - I, with F the tet's deformation gradient
+ *  and R its rotation, expressed in the tet's rest axes (a rigid rotation of the body gives 0);
+ *  MICA_MODEL_LINEAR bodies the small strain sym(F) - I. Constant over each (linear) tet.
+ *  Buffer protocol as mica_body_get_positions(). The world's thread (the one thread using the
+ *  world at a time).
+ *  @param world the world (not changed).
+ *  @param body the body.
+ *  @param out the caller's buffer, or NULL to ask for the count only. @param capacity the buffer's
+ *         size in tets (not in values). @param out_count receives the tet count (may be NULL when
+ *         `out` is not).
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` or a required pointer is NULL);
+ *          MICA_ERR_STALE_ID (`body` is null, of another kind or destroyed);
+ *          MICA_ERR_INVALID_ARGUMENT (`capacity` < 0); MICA_ERR_BUFFER_TOO_SMALL (`capacity` below
+ *          the count: nothing copied, `*out_count` = the count needed); MICA_ERR_OUT_OF_MEMORY. */
+MICA_API mica_status mica_body_get_strains(const mica_world* world, mica_body_id body,
+                                           double* out, int32_t capacity, int32_t* out_count);
+
+/** Von Mises stress of each tet at the current positions (Pa), 1 value per tet:
+ *  sqrt(3/2 s:s), s the deviatoric part of the stress 2 mu eps + lambda tr(eps) I of the tet's
+ *  own material and its strain as mica_body_get_strains() gives it. Buffer protocol as
+ *  mica_body_get_positions(). The world's thread (the one thread using the world at a time).
+ *  @param world the world (not changed).
+ *  @param body the body.
+ *  @param out the caller's buffer, or NULL to ask for the count only. @param capacity the buffer's
+ *         size in tets. @param out_count receives the tet count (may be NULL when `out` is not).
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` or a required pointer is NULL);
+ *          MICA_ERR_STALE_ID (`body` is null, of another kind or destroyed);
+ *          MICA_ERR_INVALID_ARGUMENT (`capacity` < 0); MICA_ERR_BUFFER_TOO_SMALL (`capacity` below
+ *          the count: nothing copied, `*out_count` = the count needed); MICA_ERR_OUT_OF_MEMORY. */
+MICA_API mica_status mica_body_get_von_mises(const mica_world* world, mica_body_id body,
+                                             double* out, int32_t capacity, int32_t* out_count);
 /** @} */
 
 /** @name Linear projection constraints (LPC)
@@ -956,8 +1062,10 @@ MICA_API const char* mica_stage_name(int32_t stage);
 
 /** @name Output
  *  @{ */
-/** Writes one body (current positions, velocities and displacements) as a VTK legacy unstructured
- *  grid that ParaView opens. The world's thread (the one thread using the world at a time).
+/** Writes one body (current positions, velocities and displacements per node; since 0.6 also the
+ *  von Mises stress "von_mises" (Pa, as mica_body_get_von_mises()) and "region" (as
+ *  mica_body_get_tet_regions()) per tet, as CELL_DATA) as a VTK legacy unstructured grid that
+ *  ParaView opens. The world's thread (the one thread using the world at a time).
  *  @param world the world (not changed).
  *  @param body the body.
  *  @param path the file to write (replaced if it exists).
@@ -966,7 +1074,8 @@ MICA_API const char* mica_stage_name(int32_t stage);
  *          cannot be written). */
 MICA_API mica_status mica_body_write_vtk(const mica_world* world, mica_body_id body,
                                          const char* path);
-/** Writes every body of the world into one VTK file (cell scalar "piece" = body order). The world's
+/** Writes every body of the world into one VTK file (cell scalar "piece" = body order; the fields
+ *  of mica_body_write_vtk()). The world's
  *  thread (the one thread using the world at a time).
  *  @param world the world (not changed).
  *  @param path the file to write (replaced if it exists).

@@ -131,6 +131,10 @@ class World {
   // the world unchanged. Positions drop what was derived from the old ones (see there).
   void set_positions(Id body, const Vec3List& x);
   void set_velocities(Id body, const Vec3List& v);
+  // One material per tet: rebuilds the body's model (stiffness, mass, so damping and gravity) and
+  // drops the solver's factors of it; positions and velocities stay. Throws, changing nothing,
+  // for a wrong count or a material out of its domain (the message names the tet).
+  void set_body_materials(Id body, const std::vector<Material>& materials);
   // Numeric factorizations the solver has made of this body's systems so far.
   int64_t factorizations(Id body) const;
 

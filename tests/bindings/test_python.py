@@ -330,6 +330,39 @@ class Behaviour(unittest.TestCase):
                 world.restore_state(state[:-1])
             self.assertEqual(caught.exception.status, mica.MICA_ERR_PARSE)
 
+    def test_regions_materials_and_fields(self):
+        # A box held on a uniform stretch eps along x, nu = 0: strain (eps, 0...) and von Mises
+        # E eps in every tet; node masses sum to density x volume; doubling E doubles the stress.
+        eps, E, rho = 1e-3, 2e4, 1100
+        with mica.World(gravity=(0, 0, 0)) as world:
+            body = world.create_box((0, 0, 0), (0.1, 0.05, 0.05), (2, 1, 1), 5, youngs_modulus=E,
+                                    poisson_ratio=0, density=rho)
+            nodes, tets, _ = body.counts()
+            self.assertEqual(body.tets().shape, (tets, 4))
+            self.assertTrue(np.all(body.tet_regions() == 0))
+            self.assertAlmostEqual(body.node_masses().sum(), rho * 0.1 * 0.05 * 0.05, delta=1e-15)
+            rest = body.rest_positions()
+            lpc = body.add_lpc(np.arange(nodes))
+            lpc.set_targets(rest * (1 + eps, 1, 1))
+            world.step(0.01)
+            strains = body.strains()
+            self.assertEqual(strains.shape, (tets, 6))
+            np.testing.assert_allclose(strains, np.tile([eps, 0, 0, 0, 0, 0], (tets, 1)), atol=1e-12)
+            np.testing.assert_allclose(body.von_mises(), E * eps, rtol=1e-9)
+            body.set_materials(youngs_modulus=np.full(tets, 2 * E))
+            np.testing.assert_allclose(body.von_mises(), 2 * E * eps, rtol=1e-9)
+            with self.assertRaises(ValueError):
+                body.set_materials(density=[rho])
+            bad = np.full(tets, rho)
+            bad[3] = -1
+            with self.assertRaises(mica.MicaError) as e:
+                body.set_materials(density=bad)
+            self.assertEqual(e.exception.status, mica.MICA_ERR_INVALID_ARGUMENT)
+            self.assertIn("tet 3", e.exception.message)
+            data = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "data")
+            cube = world.create_body_from_file(os.path.join(data, "two_regions_v41.msh"), translation=(2, 0, 0))
+            self.assertEqual(list(cube.tet_regions()), [7, 7, 7, 9, 9, 0])
+
     def test_library_found_next_to_the_build_tree(self):
         # The package copied into <build>/bindings/python finds <build>/libmica without help.
         pkg = os.path.join(os.environ["MICA_BINDINGS_BUILD_DIR"], "python")

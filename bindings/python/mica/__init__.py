@@ -541,6 +541,45 @@ class Body(_Object):
                           "mica_body_get_energy")
         return k.value, e.value, p.value
 
+    def tets(self) -> np.ndarray:
+        """The tets (t, 4), 0-based node indices."""
+        return self._get(native.mica_body_get_tets, 4, np.int32, "mica_body_get_tets")
+
+    def tet_regions(self) -> np.ndarray:
+        """Region of each tet (t,): the Gmsh physical tag or TetGen region attribute, else 0."""
+        return self._get(native.mica_body_get_tet_regions, 1, np.int32, "mica_body_get_tet_regions").ravel()
+
+    def set_materials(self, youngs_modulus: Optional[ArrayLike] = None, poisson_ratio: Optional[ArrayLike] = None,
+                      density: Optional[ArrayLike] = None) -> None:
+        """Per tet: Young's modulus (Pa), Poisson ratio, density (kg/m^3); None keeps that property.
+        Rebuilds the body's stiffness, mass and damping."""
+        tets = self.counts()[1]
+        arrays = []
+        for name, values in (("youngs_modulus", youngs_modulus), ("poisson_ratio", poisson_ratio),
+                             ("density", density)):
+            if values is None:
+                arrays.append(None)
+                continue
+            a = np.ascontiguousarray(values, dtype=np.float64).ravel()
+            if len(a) != tets:
+                raise ValueError(f"{name}: one value per tet ({tets}), got {len(a)}")
+            arrays.append(a)
+        pointers = [None if a is None else a.ctypes.data_as(POINTER(c_double)) for a in arrays]
+        self.world._check(native.mica_body_set_materials(self.world.handle, self.id, *pointers, tets),
+                          "mica_body_set_materials")
+
+    def node_masses(self) -> np.ndarray:
+        """Mass of each node (n,), kg: the row sums of the mass matrix."""
+        return self._get(native.mica_body_get_node_masses, 1, np.float64, "mica_body_get_node_masses").ravel()
+
+    def strains(self) -> np.ndarray:
+        """Strain of each tet (t, 6): xx, yy, zz, yz, xz, xy (tensor shears), co-rotated."""
+        return self._get(native.mica_body_get_strains, 6, np.float64, "mica_body_get_strains")
+
+    def von_mises(self) -> np.ndarray:
+        """Von Mises stress of each tet (t,), Pa."""
+        return self._get(native.mica_body_get_von_mises, 1, np.float64, "mica_body_get_von_mises").ravel()
+
     def add_lpc(self, nodes: ArrayLike, definition: Optional[native.mica_lpc_def] = None, **fields: Any) -> Lpc:
         """A projection constraint on `nodes` (kind=MICA_LPC_FIXED by default)."""
         d = _fill(definition if definition is not None else lpc_def(), fields)

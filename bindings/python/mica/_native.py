@@ -353,6 +353,13 @@ PROTOTYPES = {
     "mica_body_get_energy": (mica_status, [mica_world_p, mica_body_id, _p(_d), _p(_d), _p(_d)]),
     "mica_body_set_positions": (mica_status, [mica_world_p, mica_body_id, _p(_d), _i]),
     "mica_body_set_velocities": (mica_status, [mica_world_p, mica_body_id, _p(_d), _i]),
+    # since 0.6: tissue regions, the mesh and its fields
+    "mica_body_get_tets": (mica_status, [mica_world_p, mica_body_id, _p(_i), _i, _p(_i)]),
+    "mica_body_get_tet_regions": (mica_status, [mica_world_p, mica_body_id, _p(_i), _i, _p(_i)]),
+    "mica_body_set_materials": (mica_status, [mica_world_p, mica_body_id, _p(_d), _p(_d), _p(_d), _i]),
+    "mica_body_get_node_masses": (mica_status, [mica_world_p, mica_body_id, _p(_d), _i, _p(_i)]),
+    "mica_body_get_strains": (mica_status, [mica_world_p, mica_body_id, _p(_d), _i, _p(_i)]),
+    "mica_body_get_von_mises": (mica_status, [mica_world_p, mica_body_id, _p(_d), _i, _p(_i)]),
     # projection constraints
     "mica_lpc_def_init": (mica_status, [_p(mica_lpc_def), _u]),
     "mica_add_lpc": (mica_status, [mica_world_p, mica_body_id, _p(_i), _i, _p(mica_lpc_def), _p(mica_lpc_id)]),

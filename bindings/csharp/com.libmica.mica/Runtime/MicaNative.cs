@@ -415,6 +415,31 @@ namespace LibMica
         public static extern int mica_body_get_energy(WorldHandle world, ulong body, out double kinetic, out double elastic,
                                                       out double potential);
 
+        // Since 0.6: tissue regions, the mesh and its fields.
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern int mica_body_get_tets(WorldHandle world, ulong body, int[] @out, int capacity,
+                                                    out int out_count);
+
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern int mica_body_get_tet_regions(WorldHandle world, ulong body, int[] @out, int capacity,
+                                                           out int out_count);
+
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern int mica_body_set_materials(WorldHandle world, ulong body, double[] youngs_modulus,
+                                                         double[] poisson_ratio, double[] density, int tet_count);
+
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern int mica_body_get_node_masses(WorldHandle world, ulong body, double[] @out, int capacity,
+                                                           out int out_count);
+
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern int mica_body_get_strains(WorldHandle world, ulong body, double[] @out, int capacity,
+                                                       out int out_count);
+
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern int mica_body_get_von_mises(WorldHandle world, ulong body, double[] @out, int capacity,
+                                                         out int out_count);
+
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
         public static extern int mica_body_set_positions(WorldHandle world, ulong body, double[] xyz, int node_count);
 
