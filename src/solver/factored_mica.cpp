@@ -178,6 +178,16 @@ double FactoredMicaSolver::complementarity_error(const ContactRows& rows, const 
   return std::sqrt(e2);
 }
 
+void FactoredMicaSolver::row_velocities(const std::vector<SolverBody>& bodies, const ContactRows& rows) {
+  w_.assign(rows.size(), 0.0);
+  for (size_t r = 0; r < rows.size(); ++r) {
+    double c = rows.bias[r];
+    for (int32_t t = rows.start[r]; t < rows.start[r + 1]; ++t)
+      c += rows.terms[t].coef * rows.direction[r].dot((*bodies[rows.terms[t].body].v)[rows.terms[t].node]);
+    w_[r] = c;
+  }
+}
+
 SolveReport FactoredMicaSolver::solve(const SolveContext& ctx, std::vector<SolverBody>& bodies,
                                       const ContactRows& rows, std::vector<double>& lambda) {
   using Clock = SolveContext::Clock;
@@ -196,6 +206,7 @@ SolveReport FactoredMicaSolver::solve(const SolveContext& ctx, std::vector<Solve
   }
   lambda.resize(nr, 0.0);
   start_compliance(bodies, rows, lambda);
+  if (settings.active_set && nr > 0) return solve_active_set(ctx, bodies, rows, lambda);
   bool may_refactor = false;  // only co-rotational bodies: a linear body's factor is its A
   for (const FactoredBody& f : factored) may_refactor = may_refactor || (f.node_rotation && settings.refactor_after > 0);
 
@@ -257,13 +268,7 @@ SolveReport FactoredMicaSolver::solve(const SolveContext& ctx, std::vector<Solve
       break;
     }
     // Anticipate the row velocities and solve the small complementarity problem on W.
-    w_.assign(nr, 0.0);
-    for (size_t r = 0; r < nr; ++r) {
-      double c = rows.bias[r];
-      for (int32_t t = rows.start[r]; t < rows.start[r + 1]; ++t)
-        c += rows.terms[t].coef * rows.direction[r].dot((*bodies[rows.terms[t].body].v)[rows.terms[t].node]);
-      w_[r] = c;
-    }
+    row_velocities(bodies, rows);
     // Two solved velocity fields a step s of the impulses apart measure the true compliance along
     // it, y = W_true s = w - w_prev. A BFGS update takes that into W and keeps it symmetric
     // positive definite (while s.y > 0, as for the true W), so the rotations the warped factor

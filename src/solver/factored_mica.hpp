@@ -11,6 +11,7 @@
 //    velocities then follow the impulse change through the same columns.
 // With P = A the loop would end after one correction; the rotations' mismatch costs a few more.
 #pragma once
+#include <Eigen/QR>
 #include <chrono>
 #include <optional>
 #include <vector>
@@ -72,6 +73,29 @@ class FactoredMicaSolver : public CachingVelocitySolver<FactoredBodyCache> {
                        const std::optional<std::chrono::steady_clock::time_point>& deadline);
   // Of the current lambda against the current row velocities w_ (N s).
   double complementarity_error(const ContactRows& rows, const std::vector<double>& lambda);
+  // w_ = G v + bias of the bodies' current velocities.
+  void row_velocities(const std::vector<SolverBody>& bodies, const ContactRows& rows);
+
+  // The active-set loop (factored_mica_active_set.cpp, SolverSettings::active_set).
+  SolveReport solve_active_set(const SolveContext& ctx, std::vector<SolverBody>& bodies, const ContactRows& rows,
+                               std::vector<double>& lambda);
+  // eq_: the rows held as equalities for these impulses (pressing normal rows, sticking tangent
+  // pairs), and W_E = G_E P^-1 G_E^T factored; impulses at round-off level set to 0.
+  void choose_equalities(const ContactRows& rows, std::vector<double>& lambda);
+  // A v = b + G^T lambda with G_E v + bias_E = 0, by projected PCG; lambda_E out, the rest fixed.
+  SolveReport constrained_solve(std::vector<SolverBody>& bodies, const ContactRows& rows, std::vector<double>& lambda,
+                                double tolerance, int32_t cap,
+                                const std::optional<SolveContext::Clock::time_point>& deadline);
+  // x = W_E^-1 rhs (the least-squares solution where rows are redundant).
+  void solve_equalities(const Eigen::VectorXd& rhs, Eigen::VectorXd& x) const;
+  // out += P^-1 G_which^T x (through the cached columns).
+  void add_response(const std::vector<SolverBody>& bodies, const ContactRows& rows, const std::vector<int32_t>& which,
+                    const Eigen::VectorXd& x, std::vector<Vec3List>& out);
+  // out -= S G_E^T x.
+  void subtract_row_forces(const std::vector<SolverBody>& bodies, const ContactRows& rows, const Eigen::VectorXd& x,
+                           std::vector<Vec3List>& out) const;
+  // out = G_E y (no bias).
+  void rows_times(const ContactRows& rows, const std::vector<Vec3List>& y, Eigen::VectorXd& out) const;
 
   SolverSettings settings_;
   std::vector<FactoredBody> factored_;
@@ -88,6 +112,14 @@ class FactoredMicaSolver : public CachingVelocitySolver<FactoredBodyCache> {
   std::vector<double> warped_diag_;  // W_rr before the secant updates
   std::vector<Vec3List> rhs_;
   Eigen::VectorXd y_;
+  // The active-set loop's.
+  Eigen::MatrixXd W0_;  // G P^-1 G^T of the factor, without the secant updates (the projections need it exact)
+  Eigen::MatrixXd W_eq_;
+  Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> W_eq_solver_;
+  std::vector<int32_t> eq_;
+  Eigen::VectorXd mu_, mu_neg_, mu_total_, row_scratch_;
+  std::vector<double> fixed_, lambda_prev_;
+  std::vector<Vec3List> cy_, cr_, cz_, cp_, cq_, ct_, cf_;  // per body: y, r, z, p, A p, scratch, rhs
 };
 
 }  // namespace mica

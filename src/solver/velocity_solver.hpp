@@ -45,6 +45,10 @@ struct SolverSettings {
   // current system and goes on with it (about what a factorization costs on a body of some
   // thousand nodes; 0: never).
   int32_t refactor_after = 100;
+  // Factored sweep: hold the contact rows predicted active as equalities inside one projected
+  // conjugate-gradient solve per round (factored_mica_active_set.cpp) instead of alternating
+  // impulse updates and velocity solves.
+  bool active_set = true;
 };
 
 // What one solve may use of its step.

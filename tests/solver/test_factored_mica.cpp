@@ -2,7 +2,8 @@
 // The factored MICA solver against the exact one on the same problem, through the solver
 // contract: velocities and impulses agree to the tolerance, with and without friction, from a
 // cold and a warm start, with the factor of the current system and with one warped from an
-// earlier one; a body's factor is made once per system key and dropped with the body.
+// earlier one; a body's factor is made once per system key and dropped with the body. Each case
+// runs both loops: the alternating one and the active-set one (SolverSettings::active_set).
 #include "solver/exact_contact_solver.hpp"  // before cmocka (test_util.hpp)
 #include "solver/factored_mica.hpp"
 #include "solver/solver_problem.hpp"
@@ -12,8 +13,11 @@ using namespace mica_test;
 
 namespace {
 
-SolverSettings tight() {
+const bool kLoops[] = {false, true};  // SolverSettings::active_set
+
+SolverSettings tight(bool active_set) {
   SolverSettings s;
+  s.active_set = active_set;
   s.tolerance = 1e-10;
   s.max_iterations = 100000;
   s.refactor_after = 0;
@@ -33,42 +37,45 @@ void compare(SolverProblem& mica, double mu, double tol, const char* what) {
 }  // namespace
 
 static void test_matches_exact(void**) {
-  for (double mu : {0.0, 0.5}) {
-    SolverProblem p(mu);
-    FactoredMicaSolver solver(tight());
-    const SolveReport r = p.solve(solver);
-    assert_true(r.converged);
-    assert_le(r.momentum_residual, 1e-10);
-    check_solution(p, 1e-8);
-    compare(p, mu, 1e-7, "cold start");
-    assert_int_equal(solver.row_diagonal().size(), p.rows.size());
-  }
+  for (bool active_set : kLoops)
+    for (double mu : {0.0, 0.5}) {
+      SolverProblem p(mu);
+      FactoredMicaSolver solver(tight(active_set));
+      const SolveReport r = p.solve(solver);
+      print_message("active set %d: %d iterations\n", int(active_set), r.iterations);
+      assert_true(r.converged);
+      assert_le(r.momentum_residual, 1e-10);
+      check_solution(p, 1e-8);
+      compare(p, mu, 1e-7, "cold start");
+      assert_int_equal(solver.row_diagonal().size(), p.rows.size());
+    }
 }
 
 // The second solve starts from the first one's impulses (and velocities): fewer iterations, the
 // same answer.
 static void test_warm_start(void**) {
-  SolverProblem p(0.3);
-  FactoredMicaSolver solver(tight());
-  const SolveReport cold = p.solve(solver);
-  const std::vector<double> lambda = p.lambda;
-  p.v.assign(p.v.size(), Vec3(0, 0.05, 0));
-  const SolveReport warm = p.solve(solver);
-  print_message("iterations: cold %d, warm %d\n", cold.iterations, warm.iterations);
-  assert_true(warm.iterations <= cold.iterations);
-  compare(p, 0.3, 1e-7, "warm start");
+  for (bool active_set : kLoops) {
+    SolverProblem p(0.3);
+    FactoredMicaSolver solver(tight(active_set));
+    const SolveReport cold = p.solve(solver);
+    p.v.assign(p.v.size(), Vec3(0, 0.05, 0));
+    const SolveReport warm = p.solve(solver);
+    print_message("active set %d: iterations cold %d, warm %d\n", int(active_set), cold.iterations, warm.iterations);
+    assert_true(warm.iterations <= cold.iterations);
+    compare(p, 0.3, 1e-7, "warm start");
+  }
 }
 
 // The factor of an earlier system (the body sheared less), warped by the node rotations since:
 // more iterations, the same answer; the factor is not made again for the same key.
-static void test_lagged_factor_converges_to_exact(void**) {
+static void check_lagged_factor(bool active_set) {
   SolverProblem earlier(0.0), p(0.0);
   // The earlier system: the rest shape (R = I).
   compute_rotations(earlier.fem, earlier.fem.rest, earlier.R);
   set_scaled_mass(earlier.fem, 1.0, earlier.A);
   assemble_elastic(earlier.fem, earlier.fem.rest, &earlier.R, SolverProblem::kH * SolverProblem::kH, &earlier.A,
                    earlier.f_int);
-  FactoredMicaSolver solver(tight());
+  FactoredMicaSolver solver(tight(active_set));
   earlier.solve(solver);
   assert_int_equal(solver.factorizations(1), 1);
   const SolveReport r = p.solve(solver);  // key 1 again: the same body, a turned system
@@ -76,7 +83,7 @@ static void test_lagged_factor_converges_to_exact(void**) {
   assert_true(r.converged);
   compare(p, 0.0, 1e-7, "lagged factor");
   // Refactoring once a solve has used 2 iterations: a second factorization, the same answer.
-  SolverSettings s = tight();
+  SolverSettings s = tight(active_set);
   s.refactor_after = 2;
   FactoredMicaSolver eager(s);
   earlier.solve(eager);
@@ -88,10 +95,38 @@ static void test_lagged_factor_converges_to_exact(void**) {
   assert_int_equal(eager.factorizations(1), 0);
 }
 
+static void test_lagged_factor_converges_to_exact(void**) {
+  for (bool active_set : kLoops) check_lagged_factor(active_set);
+}
+
+// A deadline already past: each loop stops after one conjugate-gradient iteration of its first
+// round on the turned system (the factor of the rest shape: more than one is needed), says it ran
+// out of time and did not converge, and returns finite velocities and impulses.
+static void test_deadline_stops_the_solve(void**) {
+  for (bool active_set : kLoops) {
+    SolverProblem earlier(0.0), p(0.0);
+    compute_rotations(earlier.fem, earlier.fem.rest, earlier.R);
+    set_scaled_mass(earlier.fem, 1.0, earlier.A);
+    assemble_elastic(earlier.fem, earlier.fem.rest, &earlier.R, SolverProblem::kH * SolverProblem::kH, &earlier.A,
+                     earlier.f_int);
+    FactoredMicaSolver solver(tight(active_set));
+    earlier.solve(solver);
+    SolveContext late;
+    late.deadline = SolveContext::Clock::now() - std::chrono::seconds(1);
+    const SolveReport r = p.solve(solver, late);
+    print_message("active set %d: %d iterations, out of time %d\n", int(active_set), r.iterations, int(r.out_of_time));
+    assert_true(r.out_of_time);
+    assert_false(r.converged);
+    assert_int_equal(r.iterations, 1);
+    for (const Vec3& v : p.v) assert_true(v.allFinite());
+    for (double l : p.lambda) assert_true(std::isfinite(l));
+  }
+}
+
 // A system key or constraint version that changes makes the factor again at once.
 static void test_new_key_factors_again(void**) {
   SolverProblem p;
-  FactoredMicaSolver solver(tight());
+  FactoredMicaSolver solver(tight(true));
   std::vector<SolverBody> bodies{p.body(3)};
   solver.solve({}, bodies, p.rows, p.lambda);
   bodies[0].constraint_version = 1;
@@ -107,6 +142,7 @@ int main(void) {
       cmocka_unit_test(test_warm_start),
       cmocka_unit_test(test_lagged_factor_converges_to_exact),
       cmocka_unit_test(test_new_key_factors_again),
+      cmocka_unit_test(test_deadline_stops_the_solve),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -436,6 +436,7 @@ static void test_time_budget_stops_the_solve(void**) {
     const SolverKind solver = config == 2 ? SolverKind::Pcg : SolverKind::Mica;
     WorldSettings ws = settings(solver, 1e-14);
     ws.mica_sweep = config == 1 ? MicaSweep::Factored : MicaSweep::GaussSeidel;
+    ws.active_set = false;  // the alternating loop: a second round after the budget (the active-set loop's: test_factored_mica)
     ws.max_iterations = 1000000000;
     ws.time_budget_ms = 1;
     World world(ws);

@@ -1,0 +1,321 @@
+// SPDX-License-Identifier: Apache-2.0
+// The factored MICA loop with the contact rows predicted active held as equalities inside the
+// velocity solve (SolverSettings::active_set). Each round:
+//  1. a small complementarity problem on W (the factor's compliance, secant-updated) predicts the
+//     impulses, and with them which rows press (normal rows with lambda > 0, tangent pairs that
+//     stick) and the impulses of the rest (sliding tangent pairs, kept fixed for the round);
+//  2. one projected conjugate-gradient solve of the whole step, A v = b + G^T lambda with
+//     G_E v + bias_E = 0 on the pressing rows E, gives velocities and lambda_E that balance A, not
+//     its factor (Gould, Hribar and Nocedal 2001, the constraint preconditioner
+//     [P C^T; C 0] with P the warped factor: a step of it costs one solve pair);
+//  3. the same stopping test as the loop of factored_mica.cpp.
+// A round costs one solve to tolerance; the plain loop needs ~10 rounds of inexact solves per
+// step where the factor's compliance misses A's (rotations turned since it was made), this one
+// ~2-3 (the active set and sliding directions settle), so far fewer solve pairs per step.
+#include <Eigen/QR>
+#include <algorithm>
+#include <cmath>
+
+#include "core/error.hpp"
+#include "solver/factored_mica.hpp"
+#include "solver/mica_solver.hpp"
+
+namespace mica {
+
+namespace {
+
+double dot(const std::vector<Vec3List>& a, const std::vector<Vec3List>& b) {
+  double s = 0;
+  for (size_t k = 0; k < a.size(); ++k) s += flat(a[k]).dot(flat(b[k]));
+  return s;
+}
+
+void project_free(const Projection& projection, Vec3List& y) {
+  for (int32_t i : projection.nodes) y[i] = projection.S[i] * y[i];
+}
+
+}  // namespace
+
+void FactoredMicaSolver::choose_equalities(const ContactRows& rows, std::vector<double>& lambda) {
+  // Impulses below 1e-12 of the largest are the small solver's round-off: not pressing.
+  double largest = 0;
+  for (size_t r = 0; r < rows.size(); ++r)
+    if (rows.normal_of[r] < 0) largest = std::max(largest, lambda[r]);
+  const double pressing = 1e-12 * largest;
+  eq_.clear();
+  for (size_t r = 0; r < rows.size(); ++r) {
+    const int32_t n = rows.normal_of[r];
+    if (n < 0) {
+      if (lambda[r] <= pressing) lambda[r] = 0;
+      else if (diag_[r] > 0) eq_.push_back(int32_t(r));
+      continue;
+    }
+    if (lambda[n] == 0) lambda[r] = 0;  // the normal row comes first: already cleared
+    if (lambda[n] == 0 || diag_[r] == 0 || diag_[n] == 0) continue;
+    const size_t first = rows.first_tangent(r) ? r : r - 1;  // the pair sticks or slides together
+    const double t = std::hypot(lambda[first], lambda[first + 1]);
+    if (t < (1 - 1e-6) * rows.mu[r] * lambda[n]) eq_.push_back(int32_t(r));  // inside the disk: sticks
+  }
+  const Eigen::Index ne = Eigen::Index(eq_.size());
+  W_eq_.resize(ne, ne);
+  for (Eigen::Index a = 0; a < ne; ++a)
+    for (Eigen::Index b = 0; b < ne; ++b) W_eq_(a, b) = W0_(eq_[a], eq_[b]);
+  // Rank-revealing: rows pressing on nodes that cannot all move independently are redundant.
+  if (ne > 0) {
+    W_eq_solver_.setThreshold(1e-10);
+    W_eq_solver_.compute(W_eq_);
+  }
+}
+
+void FactoredMicaSolver::solve_equalities(const Eigen::VectorXd& rhs, Eigen::VectorXd& x) const {
+  if (eq_.empty()) x.resize(0);
+  else x = W_eq_solver_.solve(rhs);
+}
+
+void FactoredMicaSolver::add_response(const std::vector<SolverBody>& bodies, const ContactRows& rows,
+                                      const std::vector<int32_t>& which, const Eigen::VectorXd& x,
+                                      std::vector<Vec3List>& out) {
+  for (size_t bi = 0; bi < bodies.size(); ++bi) {
+    y_.setZero(3 * Eigen::Index(bodies[bi].node_count()));
+    bool any = false;
+    for (size_t a = 0; a < which.size(); ++a) {
+      if (x(Eigen::Index(a)) == 0) continue;
+      const int32_t r = which[a];
+      for (int32_t t = rows.start[r]; t < rows.start[r + 1]; ++t)
+        if (rows.terms[t].body == int32_t(bi)) {
+          y_.noalias() += *term_columns_[t] * (term_force_[t] * x(Eigen::Index(a)));
+          any = true;
+        }
+    }
+    if (!any) continue;
+    const FactoredBody& f = factored_[bi];
+    Vec3List& o = out[bi];
+    for (int32_t i = 0; i < bodies[bi].node_count(); ++i) {
+      const Vec3 d = f.factor->turn(f.node_rotation, i) * y_.segment<3>(3 * i);
+      o[i] += bodies[bi].projection->active() && bodies[bi].projection->is_constrained[i]
+                  ? Vec3(bodies[bi].projection->S[i] * d)
+                  : d;
+    }
+  }
+}
+
+void FactoredMicaSolver::subtract_row_forces(const std::vector<SolverBody>& bodies, const ContactRows& rows,
+                                             const Eigen::VectorXd& x, std::vector<Vec3List>& out) const {
+  for (size_t a = 0; a < eq_.size(); ++a) {
+    const int32_t r = eq_[a];
+    for (int32_t t = rows.start[r]; t < rows.start[r + 1]; ++t) {
+      const Projection& p = *bodies[rows.terms[t].body].projection;
+      const int32_t i = rows.terms[t].node;
+      const Vec3 g = rows.terms[t].coef * x(Eigen::Index(a)) * rows.direction[r];
+      out[rows.terms[t].body][i] -= p.active() && p.is_constrained[i] ? Vec3(p.S[i] * g) : g;
+    }
+  }
+}
+
+void FactoredMicaSolver::rows_times(const ContactRows& rows, const std::vector<Vec3List>& y, Eigen::VectorXd& out) const {
+  out.resize(Eigen::Index(eq_.size()));
+  for (size_t a = 0; a < eq_.size(); ++a) {
+    const int32_t r = eq_[a];
+    double c = 0;
+    for (int32_t t = rows.start[r]; t < rows.start[r + 1]; ++t)
+      c += rows.terms[t].coef * rows.direction[r].dot(y[rows.terms[t].body][rows.terms[t].node]);
+    out(Eigen::Index(a)) = c;
+  }
+}
+
+SolveReport FactoredMicaSolver::constrained_solve(std::vector<SolverBody>& bodies, const ContactRows& rows,
+                                                  std::vector<double>& lambda, double tolerance, int32_t cap,
+                                                  const std::optional<SolveContext::Clock::time_point>& deadline) {
+  using Clock = SolveContext::Clock;
+  const size_t nb = bodies.size();
+  for (std::vector<Vec3List>* v : {&cy_, &cr_, &cz_, &cp_, &cq_, &ct_, &cf_}) v->resize(nb);
+  // The fixed impulses: every row but the equalities.
+  fixed_ = lambda;
+  for (int32_t r : eq_) fixed_[r] = 0;
+  scatter_contact_impulses(rows, fixed_, bodies);
+  for (size_t bi = 0; bi < nb; ++bi) {
+    const SolverBody& body = bodies[bi];
+    const size_t n = size_t(body.node_count());
+    for (std::vector<Vec3List>* v : {&cy_, &cr_, &cz_, &cp_, &cq_, &ct_, &cf_}) (*v)[bi].resize(n);
+    rhs_[bi] = *body.b;
+    for (size_t i = 0; i < n; ++i) rhs_[bi][i] += (*body.contact_impulse)[i];
+    body.projected().right_hand_side(rhs_[bi], cf_[bi], ct_[bi]);  // S (b + G_F^T lambda_F - A z)
+    cy_[bi] = *body.v;
+    project_free(*body.projection, cy_[bi]);  // the unknown y = S (v - z)
+  }
+  // Onto the equalities: G_E (y + z) + bias_E = 0, through P^-1 G_E^T and W_E = G_E P^-1 G_E^T.
+  Eigen::VectorXd& gap = row_scratch_;
+  rows_times(rows, cy_, gap);
+  for (size_t a = 0; a < eq_.size(); ++a) {
+    const int32_t r = eq_[a];
+    double c = rows.bias[r];
+    for (int32_t t = rows.start[r]; t < rows.start[r + 1]; ++t) {
+      const SolverBody& body = bodies[rows.terms[t].body];
+      const int32_t i = rows.terms[t].node;
+      if (body.projection->active() && body.projection->is_constrained[i])
+        c += rows.terms[t].coef * rows.direction[r].dot(body.projection->z[i]);
+    }
+    gap(Eigen::Index(a)) = -(gap(Eigen::Index(a)) + c);
+  }
+  solve_equalities(gap, mu_);
+  add_response(bodies, rows, eq_, mu_, cy_);
+
+  SolveReport report;
+  double f2 = 0;
+  for (size_t bi = 0; bi < nb; ++bi) {
+    const ProjectedSystem sys = bodies[bi].projected();
+    sys.apply(cy_[bi], cq_[bi], ct_[bi]);
+    for (size_t i = 0; i < cy_[bi].size(); ++i) cr_[bi][i] = cf_[bi][i] - cq_[bi][i];
+    f2 += flat(cf_[bi]).squaredNorm();
+  }
+  double rz = 0;
+  mu_total_.setZero(Eigen::Index(eq_.size()));
+  for (;;) {
+    // z = P^-1 r projected onto G_E z = 0; mu: the impulses on E the residual asks for.
+    for (size_t bi = 0; bi < nb; ++bi) {
+      warp_[bi].apply(cr_[bi], cz_[bi]);
+      project_free(*bodies[bi].projection, cz_[bi]);
+    }
+    rows_times(rows, cz_, row_scratch_);
+    solve_equalities(row_scratch_, mu_);
+    mu_neg_ = -mu_;
+    add_response(bodies, rows, eq_, mu_neg_, cz_);
+    // The equalities take their share of the residual, r -= S G_E^T mu, at every step (the
+    // residual update of Gould, Hribar and Nocedal: without it round-off in the projection stalls
+    // the residual of a solve far from its factor's system); what is left must be small.
+    mu_total_ += mu_;
+    subtract_row_forces(bodies, rows, mu_, cr_);
+    for (size_t bi = 0; bi < nb; ++bi) ct_[bi].assign(ct_[bi].size(), Vec3::Zero());
+    subtract_row_forces(bodies, rows, mu_total_, ct_);
+    const double g2 = dot(cr_, cr_), scale2 = std::max({f2, dot(ct_, ct_), 1e-300});  // the equalities' load included
+    report.residual = std::sqrt(g2 / scale2);
+    if (!std::isfinite(g2)) fail(Errc::Numerical, "the constrained velocity solve diverged (loads or state overflow)");
+    report.converged = g2 <= tolerance * tolerance * scale2;
+    if (report.converged || report.iterations >= cap) break;
+    if (deadline && report.iterations > 0 && Clock::now() >= *deadline) {
+      report.out_of_time = true;
+      break;
+    }
+    const double rz_new = dot(cr_, cz_);
+    if (report.iterations == 0) {
+      cp_ = cz_;
+    } else {
+      const double beta = rz_new / rz;
+      for (size_t bi = 0; bi < nb; ++bi)
+        for (size_t i = 0; i < cp_[bi].size(); ++i) cp_[bi][i] = cz_[bi][i] + beta * cp_[bi][i];
+    }
+    rz = rz_new;
+    for (size_t bi = 0; bi < nb; ++bi) bodies[bi].projected().apply(cp_[bi], cq_[bi], ct_[bi]);
+    const double pq = dot(cp_, cq_);
+    if (!(pq > 0)) break;  // breakdown: not positive definite on the equalities' null space
+    const double alpha = rz / pq;
+    for (size_t bi = 0; bi < nb; ++bi)
+      for (size_t i = 0; i < cy_[bi].size(); ++i) {
+        cy_[bi][i] += alpha * cp_[bi][i];
+        cr_[bi][i] -= alpha * cq_[bi][i];
+      }
+    ++report.iterations;
+  }
+  for (size_t bi = 0; bi < nb; ++bi) {
+    Vec3List& v = *bodies[bi].v;
+    v = cy_[bi];
+    const Projection& p = *bodies[bi].projection;
+    for (int32_t i : p.nodes) v[i] += p.z[i];
+  }
+  // The residual the equalities took, f - A y = S G_E^T mu_total = -S G_E^T lambda_E.
+  for (size_t a = 0; a < eq_.size(); ++a) lambda[eq_[a]] = -mu_total_(Eigen::Index(a));
+  return report;
+}
+
+SolveReport FactoredMicaSolver::solve_active_set(const SolveContext& ctx, std::vector<SolverBody>& bodies,
+                                                 const ContactRows& rows, std::vector<double>& lambda) {
+  using Clock = SolveContext::Clock;
+  const SolverSettings& settings = settings_;
+  const std::optional<Clock::time_point>& deadline = ctx.deadline;
+  const size_t nb = bodies.size(), nr = rows.size();
+  W0_ = W_;
+  bool may_refactor = false;
+  for (const FactoredBody& f : factored_) may_refactor = may_refactor || (f.node_rotation && settings.refactor_after > 0);
+
+  SolveReport report;
+  report.converged = false;
+  report.momentum_residual = std::numeric_limits<double>::quiet_NaN();
+  const double tolerance = 0.3 * settings.tolerance;  // each solve a little below the outer test
+  // The first prediction: the warm start's row velocities (the last step's solution).
+  row_velocities(bodies, rows);
+  solve_small_lcp(rows, settings.tolerance, lambda, deadline);
+  double l_scale = 0;
+  for (double l : lambda_next_) l_scale += l * l;
+  int32_t outer = 0;
+  while (report.iterations < settings.max_iterations) {
+    if (deadline && outer > 0 && Clock::now() >= *deadline) {
+      report.out_of_time = true;
+      break;
+    }
+    if (may_refactor && report.iterations >= settings.refactor_after) {  // as in solve(): once
+      for (size_t bi = 0; bi < nb; ++bi)
+        if (factored_[bi].node_rotation)
+          factored_[bi].factor->refactor_now(bodies[bi].pattern(), *bodies[bi].A, *bodies[bi].projection,
+                                             factored_[bi].node_rotation);
+      for (size_t bi = 0; bi < nb; ++bi) warp_[bi].bind(factored_[bi].factor, factored_[bi].node_rotation);
+      start_compliance(bodies, rows, lambda_next_);
+      W0_ = W_;
+      may_refactor = false;
+    }
+    ++outer;
+    lambda = lambda_next_;
+    choose_equalities(rows, lambda);
+    const int32_t cap = may_refactor ? std::max(1, settings.refactor_after - report.iterations)
+                                     : settings.max_iterations - report.iterations;
+    const SolveReport s = constrained_solve(bodies, rows, lambda, tolerance, std::max(cap, 1), deadline);
+    report.iterations += std::max(1, s.iterations);
+    report.velocity_change = s.residual;
+    report.out_of_time = s.out_of_time;
+    if (s.out_of_time) break;
+    if (!s.converged) {
+      if (may_refactor) continue;  // stopped where refactoring pays: refactor, go on
+      break;
+    }
+    // The solved pair measures the true compliance along the impulses' change (secant update, as
+    // in solve()); then the small problem around the solved impulses corrects the active set.
+    row_velocities(bodies, rows);
+    if (outer > 1) {
+      const Eigen::VectorXd s_ = Eigen::Map<const Eigen::VectorXd>(lambda.data(), Eigen::Index(nr)) -
+                                 Eigen::Map<const Eigen::VectorXd>(lambda_prev_.data(), Eigen::Index(nr));
+      const Eigen::VectorXd y = Eigen::Map<const Eigen::VectorXd>(w_.data(), Eigen::Index(nr)) -
+                                Eigen::Map<const Eigen::VectorXd>(w_prev_.data(), Eigen::Index(nr));
+      const Eigen::VectorXd Ws = W_ * s_;
+      const double sWs = s_.dot(Ws), sy = s_.dot(y);
+      if (sWs > 0 && sy > 1e-3 * sWs) {
+        W_ += y * y.transpose() / sy - Ws * Ws.transpose() / sWs;
+        for (size_t q = 0; q < nr; ++q) diag_[q] = diag_[q] > 0 ? W_(q, q) : 0.0;
+      }
+    }
+    w_prev_ = w_;
+    lambda_prev_ = lambda;
+    solve_small_lcp(rows, settings.tolerance, lambda, deadline);
+    double dl2 = 0, l2 = 0;
+    for (size_t r = 0; r < nr; ++r) {
+      dl2 += (lambda_next_[r] - lambda[r]) * (lambda_next_[r] - lambda[r]);
+      l2 += lambda_next_[r] * lambda_next_[r];
+    }
+    l_scale = std::max(l_scale, 1e-300);
+    report.impulse_change = dl2 > 0 ? std::sqrt(dl2 / std::max(l2, l_scale)) : 0.0;
+    if (report.impulse_change <= settings.tolerance &&
+        complementarity_error(rows, lambda) <= settings.tolerance * std::sqrt(std::max(l2, l_scale))) {
+      rows.project(lambda);  // a sliding pair kept its impulse while lambda_n was solved: back onto the disk
+      scatter_contact_impulses(rows, lambda, bodies);
+      report.momentum_residual = momentum_residual(bodies);
+      report.residual = std::max({report.velocity_change, report.impulse_change, report.momentum_residual});
+      report.converged = report.momentum_residual <= settings.tolerance;
+      if (report.converged) return report;
+    }
+  }
+  rows.project(lambda);
+  scatter_contact_impulses(rows, lambda, bodies);
+  report.momentum_residual = momentum_residual(bodies);
+  report.residual = std::max({report.velocity_change, report.impulse_change, report.momentum_residual});
+  return report;
+}
+
+}  // namespace mica
