@@ -116,7 +116,7 @@ int main(int argc, char** argv) {
       }
       ms[k] = now_ms() - t0;
       mica_step(r.world, 0.01);
-      mica_world_stats st = {sizeof st};
+      mica_world_stats st = {.struct_size = sizeof st};
       mica_world_get_stats(s.world, &st);
       iterations += st.solver_iterations;
       mica_body_get_velocities(s.world, s.body, v, s.nodes, NULL);

@@ -113,7 +113,7 @@ int main(int argc, char** argv) {
     }
   }
   fclose(csv);
-  mica_world_stats stats = {sizeof stats};
+  mica_world_stats stats = {.struct_size = sizeof stats};
   CHECK(mica_world_get_stats(world, &stats));
   printf("final tip deflection %.5f m = %.3f x Euler-Bernoulli; %.3f ms per step (last)\n", w, w / w_beam,
          stats.ms_last_step);

@@ -104,7 +104,7 @@ static int run(double E, int steps, int cells_per_side, int cap, FILE* csv, int*
     CHECK(mica_tool_set_pose(world, sphere, pos, identity));
     const mica_status s = mica_step(world, dt);
     CHECK(s);
-    mica_world_stats stats = {sizeof stats};
+    mica_world_stats stats = {.struct_size = sizeof stats};
     CHECK(mica_world_get_stats(world, &stats));
     double force[3];
     int32_t contacts = 0;

@@ -62,7 +62,7 @@ static void* servo_thread(void* arg) {
   while (atomic_load(&L->running)) {
     double force[3];
     if (mica_device_poll(L->world, L->device, NULL, force) < 0) L->failures++;
-    mica_device_stats st = {sizeof st};
+    mica_device_stats st = {.struct_size = sizeof st};
     mica_device_get_stats(L->world, L->device, &st);
     if (L->samples < MAX_SAMPLES) {
       L->t[L->samples] = now_s() - start;
@@ -140,7 +140,7 @@ int main(int argc, char** argv) {
     dd.trajectory = press;
     CHECK(mica_device_create(world, &dd, &L.device));
   }
-  mica_device_info info = {sizeof info};
+  mica_device_info info = {.struct_size = sizeof info};
   CHECK(mica_device_get_info(world, L.device, &info));
   printf("device: %s, max force %.2f N\n", info.name, info.max_force);
 
@@ -169,7 +169,7 @@ int main(int argc, char** argv) {
   atomic_store(&L.running, 0);
   pthread_join(servo, NULL);
   const double elapsed = now_s() - start;
-  mica_device_stats st = {sizeof st};
+  mica_device_stats st = {.struct_size = sizeof st};
   CHECK(mica_device_get_stats(world, L.device, &st));
   printf("simulation %.1f Hz (worst step %.1f ms), servo %.0f Hz, %ld device failures, %lld limited polls\n",
          steps / elapsed, worst_step_ms, L.samples / elapsed, L.failures, (long long)st.clamped);
