@@ -248,11 +248,8 @@ class World {
   decltype(debt_) saved_debt_;
   struct SavedTool {  // save_undo(): what a failed step puts back
     Tool* tool;
-    Vec3 position;
-    Eigen::Quaterniond orientation;
-    Vec3 velocity, angular_velocity, force, torque;
-    Mat3 stiffness;
-    int32_t contact_count;
+    ToolState state;
+    ToolScratch scratch;
   };
   std::vector<SavedTool> saved_tools_;
   Vec3List saved_reactions_;
