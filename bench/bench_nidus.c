@@ -85,7 +85,7 @@ static long status_kb(const char* key) {
   } while (0)
 
 typedef struct {
-  double median, p95, mean, iterations, mem_create_b_per_tet, mem_step_b_per_tet, force;
+  double median, p95, max, mean, iterations, mem_create_b_per_tet, mem_step_b_per_tet, force;
   double reversals; /* fraction of contact nodes' velocity changes that reverse from step to step */
   int32_t nodes, tets, capped, contacts;
 } figures;
@@ -145,6 +145,7 @@ static int press(mica_world* world, mica_body_id body, mica_tool_id tool, const 
   out->mean = sum / steps;
   out->median = quantile(ms, steps, 0.5);
   out->p95 = quantile(ms, steps, 0.95);
+  out->max = quantile(ms, steps, 1.0);
   out->iterations = (double)iterations / steps;
   out->reversals = changes ? (double)reversals / (double)changes : 0;
   free(ms);
@@ -236,6 +237,7 @@ static int nidus(const char* path, const mica_world_def* wd, int steps, int warm
   printf("total s (timed steps) %.2f\n", 1e-3 * fig.mean * steps);
   printf("median ms/step        %.3f\n", fig.median);
   printf("p95 ms/step           %.3f\n", fig.p95);
+  printf("max ms/step           %.3f\n", fig.max);
   printf("mean ms/step          %.3f\n", fig.mean);
   printf("iterations/step       %.1f (mean over timed steps; %d stopped at the cap)\n", fig.iterations, fig.capped);
   printf("tool force            %.4f N, %d contacts at the end\n", fig.force, fig.contacts);
