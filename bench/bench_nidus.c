@@ -48,7 +48,9 @@
 #include <mica/mica.h>
 
 #include "bench_common.h"
+#include "box_scene.h"
 #include "cli.h"
+#include "node_selection.h"
 #include "press_scene.h"
 
 static double quantile(double* v, int n, double q) {
@@ -83,7 +85,7 @@ static long status_kb(const char* key) {
   } while (0)
 
 typedef struct {
-  double median, p95, mean, iterations, mem_create_b_per_tet, mem_step_b_per_tet, force;
+  double median, p95, max, mean, iterations, mem_create_b_per_tet, mem_step_b_per_tet, force;
   double reversals; /* fraction of contact nodes' velocity changes that reverse from step to step */
   int32_t nodes, tets, capped, contacts;
 } figures;
@@ -143,6 +145,7 @@ static int press(mica_world* world, mica_body_id body, mica_tool_id tool, const 
   out->mean = sum / steps;
   out->median = quantile(ms, steps, 0.5);
   out->p95 = quantile(ms, steps, 0.95);
+  out->max = quantile(ms, steps, 1.0);
   out->iterations = (double)iterations / steps;
   out->reversals = changes ? (double)reversals / (double)changes : 0;
   free(ms);
@@ -203,13 +206,8 @@ static int nidus(const char* path, const mica_world_def* wd, int steps, int warm
   /* Held by its lowest fifth. */
   const double cut[3] = {0, lo[1] + 0.2 * (hi[1] - lo[1]), 0}, up[3] = {0, 1, 0};
   int32_t n = 0;
-  CHECK(mica_body_select_nodes_by_plane(world, body, cut, up, 0, 1, NULL, 0, &n));
-  int32_t* held = malloc(sizeof(int32_t) * (size_t)n);
-  CHECK(mica_body_select_nodes_by_plane(world, body, cut, up, 0, 1, held, n, &n));
-  mica_lpc_def fixed = mica_lpc_def_default();
   mica_lpc_id base;
-  CHECK(mica_add_lpc(world, body, held, n, &fixed, &base));
-  free(held);
+  CHECK(scene_fix_plane(world, body, cut, up, 0, &n, &base));
   const double R = 0.002, y0 = c[1] + R + 0.0005;
   mica_tool_def td = mica_tool_def_default();
   td.radius = R;
@@ -239,6 +237,7 @@ static int nidus(const char* path, const mica_world_def* wd, int steps, int warm
   printf("total s (timed steps) %.2f\n", 1e-3 * fig.mean * steps);
   printf("median ms/step        %.3f\n", fig.median);
   printf("p95 ms/step           %.3f\n", fig.p95);
+  printf("max ms/step           %.3f\n", fig.max);
   printf("mean ms/step          %.3f\n", fig.mean);
   printf("iterations/step       %.1f (mean over timed steps; %d stopped at the cap)\n", fig.iterations, fig.capped);
   printf("tool force            %.4f N, %d contacts at the end\n", fig.force, fig.contacts);
@@ -277,39 +276,30 @@ static int scaling(const char* csv_path, int max_tets, int32_t sweep) {
     wd.max_iterations = 100000;
     wd.mica_sweep = sweep;
     if (mica_world_create(&wd, &world) != MICA_OK) return 1;
-    mica_body_def bd = mica_body_def_default();
-    bd.youngs_modulus = 2e4;
-    bd.rayleigh_alpha = 2;
-    const double lo[3] = {0, 0, 0}, hi[3] = {0.1, 0.1, 0.1};
-    const int32_t cells[3] = {n, n, n};
+    /* The cube [0, 0.1]^3 of scenes/box_scene.h, its base fixed, the sphere 1 mm above its top. */
+    box_scene_def def = box_scene_def_default();
+    def.body.youngs_modulus = 2e4;
+    def.body.rayleigh_alpha = 2;
+    def.cells[0] = def.cells[1] = def.cells[2] = n;
+    def.tool_margin = 0.002;
+    const double c[3] = {0.05, 0, 0.05}, y0 = 0.1 + 0.02 + 0.001;
+    def.tool_position[0] = c[0];
+    def.tool_position[1] = y0;
+    def.tool_position[2] = c[2];
     figures fig;
     memset(&fig, 0, sizeof fig);
     const long rss0 = status_kb("VmRSS:");
-    mica_body_id body;
-    CHECK(mica_body_create_box(world, &bd, lo, hi, cells, 6, &body));
-    CHECK(mica_body_get_counts(world, body, &fig.nodes, &fig.tets, NULL));
-    int32_t count = 0;
-    const double o[3] = {0, 0, 0}, up[3] = {0, 1, 0};
-    CHECK(mica_body_select_nodes_by_plane(world, body, o, up, 1e-9, 1, NULL, 0, &count));
-    int32_t* sel = malloc(sizeof(int32_t) * (size_t)count);
-    CHECK(mica_body_select_nodes_by_plane(world, body, o, up, 1e-9, 1, sel, count, &count));
-    mica_lpc_def fixed = mica_lpc_def_default();
-    mica_lpc_id base;
-    CHECK(mica_add_lpc(world, body, sel, count, &fixed, &base));
-    free(sel);
-    mica_tool_def td = mica_tool_def_default();
-    td.radius = 0.02;
-    td.margin = 0.002;
-    const double c[3] = {0.05, 0, 0.05}, y0 = 0.1 + 0.02 + 0.001;
-    td.position[0] = c[0];
-    td.position[1] = y0;
-    td.position[2] = c[2];
-    mica_tool_id tool;
-    CHECK(mica_tool_create(world, &td, &tool));
+    box_scene scene;
+    CHECK(box_scene_create(world, &def, &scene));
+    const mica_body_id body = scene.body;
+    const mica_tool_id tool = scene.tool;
+    fig.nodes = scene.nodes;
+    fig.tets = scene.tets;
     CHECK(mica_step(world, 0.01) < 0 ? -1 : MICA_OK);
     const long rss1 = status_kb("VmRSS:");
     const int steps = fig.tets > 40000 ? 10 : 20;
-    if (press(world, body, tool, c, y0, 0.007, 0.1, 0.003, td.radius + td.margin, 0.01, 9, steps, &fig)) return 1;
+    if (press(world, body, tool, c, y0, 0.007, 0.1, 0.003, def.tool_radius + def.tool_margin, 0.01, 9, steps, &fig))
+      return 1;
     fig.mem_step_b_per_tet = 1024.0 * (double)(rss1 - rss0) / fig.tets;
     fprintf(csv, "%d,%d,%d,%.4f,%.4f,%.1f,%.5f,%.0f,%.5g\n", n, fig.nodes, fig.tets, fig.median, fig.p95,
             fig.iterations, fig.iterations > 0 ? fig.median / fig.iterations : NAN, fig.mem_step_b_per_tet, fig.force);

@@ -17,6 +17,7 @@
 #include "cli.h"
 
 #include "bench_common.h"
+#include "box_scene.h"
 
 static double now_s(void) {
   struct timespec ts;
@@ -67,26 +68,15 @@ int main(int argc, char** argv) {
   wd.max_iterations = 500;
   mica_world* world;
   if (mica_world_create(&wd, &world) != MICA_OK) return 1;
-  mica_body_def bd = mica_body_def_default();
-  bd.youngs_modulus = 1e4;
-  const double lo[3] = {-0.05, -0.1, -0.05}, hi[3] = {0.05, 0, 0.05};
-  const int32_t c[3] = {cells, cells, cells};
-  mica_body_id body;
-  if (mica_body_create_box(world, &bd, lo, hi, c, 6, &body) != MICA_OK) return 1;
-  int32_t n = 0, tets = 0;
-  mica_body_get_counts(world, body, &n, &tets, NULL);
-  int32_t* base = malloc(sizeof(int32_t) * (size_t)n);
-  int32_t nb = 0;
-  const double o[3] = {0, -0.1, 0}, up[3] = {0, 1, 0};
-  mica_body_select_nodes_by_plane(world, body, o, up, 1e-9, 1, base, n, &nb);
-  mica_lpc_def fixed = mica_lpc_def_default();
-  mica_lpc_id lpc;
-  mica_add_lpc(world, body, base, nb, &fixed, &lpc);
-  free(base);
-  mica_tool_def td = mica_tool_def_default();
-  td.radius = 0.02;
-  mica_tool_id tool;
-  mica_tool_create(world, &td, &tool);
+  /* The soft block of scenes/box_scene.h, its base fixed, the sphere at the origin. */
+  box_scene_def def = box_scene_block_def();
+  def.body.youngs_modulus = 1e4;
+  def.cells[0] = def.cells[1] = def.cells[2] = cells;
+  def.tool_position[1] = 0;
+  box_scene scene;
+  if (box_scene_create(world, &def, &scene) != MICA_OK) return 1;
+  const int32_t tets = scene.tets;
+  const mica_tool_id tool = scene.tool;
   mica_device_def dd = mica_device_def_default();
   dd.backend = MICA_DEVICE_SIMULATED;
   dd.trajectory = press;

@@ -19,6 +19,7 @@
 #include "cli.h"
 
 #include "bench_common.h"
+#include "box_scene.h"
 
 #define STEPS 40
 
@@ -36,33 +37,23 @@ static int make_scene(scene* s, int32_t solver, double tol, int32_t cells) {
   wd.tolerance = tol > 0 ? tol : 1e-8; /* unused by DIRECT */
   wd.max_iterations = 1000000;
   if (mica_world_create(&wd, &s->world) != MICA_OK) return 0;
-  mica_body_def bd = mica_body_def_default();
-  bd.youngs_modulus = 2e4;
-  bd.rayleigh_alpha = 2;
-  const double lo[3] = {0, 0, 0}, hi[3] = {0.1, 0.1, 0.1};
-  const int32_t c[3] = {cells, cells, cells};
-  if (mica_body_create_box(s->world, &bd, lo, hi, c, 6, &s->body) != MICA_OK) return 0;
-  mica_body_get_counts(s->world, s->body, &s->nodes, NULL, NULL);
-  int32_t* sel = malloc(sizeof(int32_t) * (size_t)s->nodes);
-  int32_t n = 0;
-  const double o[3] = {0, 0, 0}, up[3] = {0, 1, 0};
-  mica_body_select_nodes_by_plane(s->world, s->body, o, up, 1e-9, 1, sel, s->nodes, &n);
-  mica_lpc_def fixed = mica_lpc_def_default();
-  mica_lpc_id base, drag;
-  mica_add_lpc(s->world, s->body, sel, n, &fixed, &base);
-  const double side[3] = {0.1, 0, 0}, out[3] = {-1, 0, 0};
-  mica_body_select_nodes_by_plane(s->world, s->body, side, out, 1e-9, 1, sel, s->nodes, &n);
-  mica_lpc_def pull = mica_lpc_def_default();
-  pull.velocity[2] = 0.05;
-  mica_add_lpc(s->world, s->body, sel, n, &pull, &drag);
-  free(sel);
-  mica_tool_def td = mica_tool_def_default();
-  td.radius = 0.03;
-  td.margin = 0.002;
-  td.position[0] = 0.05;
-  td.position[1] = 0.13;
-  td.position[2] = 0.05;
-  return mica_tool_create(s->world, &td, &s->tool) == MICA_OK;
+  /* The cube [0, 0.1]^3 of scenes/box_scene.h, its base fixed, the face x = 0.1 dragged along z. */
+  box_scene_def def = box_scene_def_default();
+  def.body.youngs_modulus = 2e4;
+  def.body.rayleigh_alpha = 2;
+  def.cells[0] = def.cells[1] = def.cells[2] = cells;
+  def.drag_velocity[2] = 0.05;
+  def.tool_radius = 0.03;
+  def.tool_margin = 0.002;
+  def.tool_position[0] = 0.05;
+  def.tool_position[1] = 0.13;
+  def.tool_position[2] = 0.05;
+  box_scene bs;
+  if (box_scene_create(s->world, &def, &bs) != MICA_OK) return 0;
+  s->body = bs.body;
+  s->tool = bs.tool;
+  s->nodes = bs.nodes;
+  return 1;
 }
 
 static const char kUsage[] =
@@ -116,7 +107,7 @@ int main(int argc, char** argv) {
       }
       ms[k] = now_ms() - t0;
       mica_step(r.world, 0.01);
-      mica_world_stats st = {sizeof st};
+      mica_world_stats st = {.struct_size = sizeof st};
       mica_world_get_stats(s.world, &st);
       iterations += st.solver_iterations;
       mica_body_get_velocities(s.world, s.body, v, s.nodes, NULL);

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
-// Bodies: creation from arrays, files and the box generator; read-back; loads; selection.
+// Bodies: creation from arrays, files and the box generator; read-back; loads; selection;
+// tissue regions (materials per tet) and the mesh and its fields (tets, masses, strain, stress).
 #include "capi_internal.hpp"
+#include "fem/element_fields.hpp"
 #include "mesh/mesh_io.hpp"
 
 using namespace mica_capi;
@@ -76,6 +78,18 @@ mica_status select_nodes(const mica::Body& b, int32_t use_rest, int32_t* out, in
   for (size_t i = 0; i < p.size(); ++i)
     if (inside(p[i])) found.push_back(int32_t(i));
   return copy_out(found.data(), int32_t(found.size()), 1, out, capacity, out_count);
+}
+
+// 3 * node_count values of a body as node vectors; the count is checked before anything is read
+// (the core checks that every value is finite).
+mica::Vec3List node_values(const mica::Body& b, const double* xyz, int32_t node_count) {
+  require(xyz, "xyz");
+  if (node_count != b.fem.node_count())
+    refuse(MICA_ERR_INVALID_ARGUMENT, "node_count is " + std::to_string(node_count) + ", " + b.name + " has " +
+                                          std::to_string(b.fem.node_count()) + " nodes");
+  mica::Vec3List values(static_cast<size_t>(node_count));
+  for (size_t i = 0; i < values.size(); ++i) values[i] = {xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]};
+  return values;
 }
 
 }  // namespace
@@ -243,6 +257,103 @@ MICA_API mica_status mica_body_get_energy(const mica_world* world, mica_body_id 
       *potential = u;
     }
     return MICA_OK;
+  });
+}
+
+MICA_API mica_status mica_body_set_positions(mica_world* world, mica_body_id body, const double* xyz,
+                                             int32_t node_count) {
+  return guarded(world, "mica_body_set_positions", [&] {
+    require(world, "world");
+    world->world.set_positions(body, node_values(world->world.body(body), xyz, node_count));
+    return MICA_OK;
+  });
+}
+
+MICA_API mica_status mica_body_set_velocities(mica_world* world, mica_body_id body, const double* xyz,
+                                              int32_t node_count) {
+  return guarded(world, "mica_body_set_velocities", [&] {
+    require(world, "world");
+    world->world.set_velocities(body, node_values(world->world.body(body), xyz, node_count));
+    return MICA_OK;
+  });
+}
+
+MICA_API mica_status mica_body_get_tets(const mica_world* world, mica_body_id body, int32_t* out, int32_t capacity,
+                                        int32_t* out_count) {
+  return guarded(world, "mica_body_get_tets", [&] {
+    require(world, "world");
+    const mica::Body& b = world->world.body(body);
+    return copy_out(b.tets[0].data(), int32_t(b.tets.size()), 4, out, capacity, out_count);
+  });
+}
+
+MICA_API mica_status mica_body_get_tet_regions(const mica_world* world, mica_body_id body, int32_t* out,
+                                               int32_t capacity, int32_t* out_count) {
+  return guarded(world, "mica_body_get_tet_regions", [&] {
+    require(world, "world");
+    const mica::Body& b = world->world.body(body);
+    return copy_out(b.regions.data(), int32_t(b.regions.size()), 1, out, capacity, out_count);
+  });
+}
+
+MICA_API mica_status mica_body_set_materials(mica_world* world, mica_body_id body, const double* youngs_modulus,
+                                             const double* poisson_ratio, const double* density, int32_t tet_count) {
+  return guarded(world, "mica_body_set_materials", [&] {
+    require(world, "world");
+    const mica::Body& b = world->world.body(body);
+    const int32_t tets = int32_t(b.tets.size());
+    if (tet_count != tets)
+      refuse(MICA_ERR_INVALID_ARGUMENT, "tet_count is " + std::to_string(tet_count) + ", the body has " +
+                                            std::to_string(tets) + " tets (one material per tet)");
+    std::vector<mica::Material> materials = b.fem.materials;  // a NULL array keeps that property
+    for (int32_t e = 0; e < tets; ++e) {
+      if (youngs_modulus) materials[e].youngs_modulus = youngs_modulus[e];
+      if (poisson_ratio) materials[e].poisson_ratio = poisson_ratio[e];
+      if (density) materials[e].density = density[e];
+    }
+    world->world.set_body_materials(body, materials);
+    return MICA_OK;
+  });
+}
+
+MICA_API mica_status mica_body_get_node_masses(const mica_world* world, mica_body_id body, double* out,
+                                               int32_t capacity, int32_t* out_count) {
+  return guarded(world, "mica_body_get_node_masses", [&] {
+    require(world, "world");
+    const mica::Body& b = world->world.body(body);
+    return copy_out(b.fem.node_mass.data(), b.fem.node_count(), 1, out, capacity, out_count);
+  });
+}
+
+MICA_API mica_status mica_body_get_strains(const mica_world* world, mica_body_id body, double* out, int32_t capacity,
+                                           int32_t* out_count) {
+  return guarded(world, "mica_body_get_strains", [&] {
+    require(world, "world");
+    const mica::Body& b = world->world.body(body);
+    const int32_t tets = int32_t(b.tets.size());
+    if (!out || capacity < tets) return copy_out<double>(nullptr, tets, 6, out, capacity, out_count);
+    std::vector<mica::Mat3> strain;
+    mica::element_strains(b.fem, b.x, b.settings.corotational, strain);
+    std::vector<double> voigt(size_t(6) * size_t(tets));
+    for (int32_t e = 0; e < tets; ++e) {  // xx yy zz yz xz xy, tensor (not engineering) shears
+      const mica::Mat3& s = strain[e];
+      const double v[6] = {s(0, 0), s(1, 1), s(2, 2), s(1, 2), s(0, 2), s(0, 1)};
+      std::copy(v, v + 6, voigt.begin() + 6 * int64_t(e));
+    }
+    return copy_out(voigt.data(), tets, 6, out, capacity, out_count);
+  });
+}
+
+MICA_API mica_status mica_body_get_von_mises(const mica_world* world, mica_body_id body, double* out,
+                                             int32_t capacity, int32_t* out_count) {
+  return guarded(world, "mica_body_get_von_mises", [&] {
+    require(world, "world");
+    const mica::Body& b = world->world.body(body);
+    const int32_t tets = int32_t(b.tets.size());
+    if (!out || capacity < tets) return copy_out<double>(nullptr, tets, 1, out, capacity, out_count);
+    std::vector<double> stress;
+    mica::element_von_mises(b.fem, b.x, b.settings.corotational, stress);
+    return copy_out(stress.data(), tets, 1, out, capacity, out_count);
   });
 }
 

@@ -1,8 +1,10 @@
 // SPDX-License-Identifier: Apache-2.0
 // World lifetime, settings, stepping, statistics and output.
+#include <deque>
 #include <fstream>
 
 #include "capi_internal.hpp"
+#include "fem/element_fields.hpp"
 #include "mesh/mesh_io.hpp"
 
 using namespace mica_capi;
@@ -72,15 +74,24 @@ mica::WorldSettings translate(const mica_world_def& d) {
   return s;
 }
 
-std::vector<mica::VtkPiece> vtk_pieces(const mica::Body& b, std::vector<mica::Vec3List>& storage) {
-  mica::Vec3List displacement(b.x.size());
+// The fields a body's piece points to (a deque: adding one keeps the others where they are).
+struct VtkStorage {
+  std::deque<mica::Vec3List> vectors;
+  std::deque<std::vector<double>> scalars;
+};
+
+mica::VtkPiece vtk_piece(const mica::Body& b, VtkStorage& storage) {
+  mica::Vec3List& displacement = storage.vectors.emplace_back(b.x.size());
   for (size_t i = 0; i < b.x.size(); ++i) displacement[i] = b.x[i] - b.fem.rest[i];
-  storage.push_back(std::move(displacement));
+  std::vector<double>& von_mises = storage.scalars.emplace_back();
+  mica::element_von_mises(b.fem, b.x, b.settings.corotational, von_mises);
+  const std::vector<double>& region = storage.scalars.emplace_back(b.regions.begin(), b.regions.end());
   mica::VtkPiece piece;
   piece.positions = &b.x;
   piece.tets = &b.tets;
-  piece.point_vectors = {{"velocity", &b.v}, {"displacement", &storage.back()}};
-  return {piece};
+  piece.point_vectors = {{"velocity", &b.v}, {"displacement", &displacement}};
+  piece.cell_scalars = {{"von_mises", &von_mises}, {"region", &region}};
+  return piece;
 }
 
 }  // namespace
@@ -177,9 +188,8 @@ MICA_API mica_status mica_body_write_vtk(const mica_world* world, mica_body_id b
   return guarded(world, "mica_body_write_vtk", [&] {
     require(world, "world");
     require(path, "path");
-    std::vector<mica::Vec3List> storage;
-    storage.reserve(1);
-    mica::write_vtk_file(path, vtk_pieces(world->world.body(body), storage), "libmica body");
+    VtkStorage storage;
+    mica::write_vtk_file(path, {vtk_piece(world->world.body(body), storage)}, "libmica body");
     return MICA_OK;
   });
 }
@@ -188,14 +198,9 @@ MICA_API mica_status mica_world_write_vtk(const mica_world* world, const char* p
   return guarded(world, "mica_world_write_vtk", [&] {
     require(world, "world");
     require(path, "path");
-    std::vector<mica::Vec3List> storage;
+    VtkStorage storage;
     std::vector<mica::VtkPiece> pieces;
-    size_t count = 0;
-    world->world.for_each_body([&](mica::Id, const mica::Body&) { ++count; });
-    storage.reserve(count);  // pieces point into storage: it must not reallocate
-    world->world.for_each_body([&](mica::Id, const mica::Body& b) {
-      for (auto& p : vtk_pieces(b, storage)) pieces.push_back(p);
-    });
+    world->world.for_each_body([&](mica::Id, const mica::Body& b) { pieces.push_back(vtk_piece(b, storage)); });
     mica::write_vtk_file(path, pieces, "libmica world");
     return MICA_OK;
   });

@@ -14,6 +14,7 @@
 #include <mica/mica.h>
 
 #include "cli.h"
+#include "node_selection.h"
 
 #define CHECK(call)                                                                       \
   do {                                                                                    \
@@ -61,21 +62,17 @@ int main(int argc, char** argv) {
 
   /* Clamp the face x = 0. */
   const double origin[3] = {0, 0, 0}, normal[3] = {1, 0, 0};
-  int32_t count = 0;
-  CHECK(mica_body_select_nodes_by_plane(world, beam, origin, normal, 1e-9, 1, NULL, 0, &count));
-  int32_t* clamped = malloc(sizeof(int32_t) * (size_t)count);
-  CHECK(mica_body_select_nodes_by_plane(world, beam, origin, normal, 1e-9, 1, clamped, count, &count));
-  mica_lpc_def fixed = mica_lpc_def_default();
   mica_lpc_id clamp;
-  CHECK(mica_add_lpc(world, beam, clamped, count, &fixed, &clamp));
-  free(clamped);
+  CHECK(scene_fix_plane(world, beam, origin, normal, 1e-9, NULL, &clamp)); /* scenes/node_selection.h */
 
   /* The tip: nodes on the face x = L. */
   const double tip_point[3] = {L, 0, 0}, tip_normal[3] = {-1, 0, 0};
   int32_t tip_count = 0;
-  CHECK(mica_body_select_nodes_by_plane(world, beam, tip_point, tip_normal, 1e-9, 1, NULL, 0, &tip_count));
-  int32_t* tip = malloc(sizeof(int32_t) * (size_t)tip_count);
-  CHECK(mica_body_select_nodes_by_plane(world, beam, tip_point, tip_normal, 1e-9, 1, tip, tip_count, &tip_count));
+  int32_t* tip = scene_select_plane(world, beam, tip_point, tip_normal, 1e-9, &tip_count);
+  if (!tip || tip_count == 0) {
+    fprintf(stderr, "no node on the face x = L\n");
+    return 1;
+  }
 
   int32_t nodes = 0;
   CHECK(mica_body_get_counts(world, beam, &nodes, NULL, NULL));
@@ -113,7 +110,7 @@ int main(int argc, char** argv) {
     }
   }
   fclose(csv);
-  mica_world_stats stats = {sizeof stats};
+  mica_world_stats stats = {.struct_size = sizeof stats};
   CHECK(mica_world_get_stats(world, &stats));
   printf("final tip deflection %.5f m = %.3f x Euler-Bernoulli; %.3f ms per step (last)\n", w, w / w_beam,
          stats.ms_last_step);

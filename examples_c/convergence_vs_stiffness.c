@@ -28,6 +28,7 @@
 
 #include <mica/mica.h>
 
+#include "box_scene.h"
 #include "cli.h"
 
 #define CHECK(call)                                                                       \
@@ -62,40 +63,25 @@ static int run(double E, int steps, int cells_per_side, int cap, FILE* csv, int*
     return 1;
   }
 
-  mica_body_def bdef = mica_body_def_default();
-  bdef.youngs_modulus = E;
-  bdef.poisson_ratio = nu;
-  bdef.density = rho;
-  bdef.rayleigh_alpha = 2.0; /* mass damping only: A = (1 + h alpha) M + h^2 K */
-  const double lo[3] = {-L / 2, 0, -L / 2}, hi[3] = {L / 2, L, L / 2};
-  const int32_t cells[3] = {cells_per_side, cells_per_side, cells_per_side};
-  mica_body_id cube;
-  CHECK(mica_body_create_box(world, &bdef, lo, hi, cells, 5, &cube));
-
-  const double origin[3] = {0, 0, 0}, up[3] = {0, 1, 0};
-  int32_t count = 0;
-  CHECK(mica_body_select_nodes_by_plane(world, cube, origin, up, 1e-9, 1, NULL, 0, &count));
-  int32_t* bottom = malloc(sizeof(int32_t) * (size_t)count);
-  if (!bottom) {
-    mica_world_destroy(world);
-    return 1;
-  }
-  CHECK(mica_body_select_nodes_by_plane(world, cube, origin, up, 1e-9, 1, bottom, count, &count));
-  mica_lpc_def fixed = mica_lpc_def_default();
-  mica_lpc_id base;
-  const mica_status added = mica_add_lpc(world, cube, bottom, count, &fixed, &base);
-  free(bottom);
-  CHECK(added);
-
-  /* The sphere's lowest point starts on the top face. */
+  /* The scene (scenes/box_scene.h): the cube fixed at its bottom face, the sphere's lowest point
+   * on its top face. */
+  box_scene_def def = box_scene_def_default();
+  def.body.youngs_modulus = E;
+  def.body.poisson_ratio = nu;
+  def.body.density = rho;
+  def.body.rayleigh_alpha = 2.0; /* mass damping only: A = (1 + h alpha) M + h^2 K */
+  def.lo[0] = def.lo[2] = -L / 2;
+  def.hi[0] = def.hi[2] = L / 2;
+  def.hi[1] = L;
+  def.cells[0] = def.cells[1] = def.cells[2] = cells_per_side;
+  def.tets_per_cell = 5;
+  def.tool_radius = R;
+  def.tool_margin = 0.001;
+  def.tool_position[1] = L + R;
+  box_scene scene;
+  CHECK(box_scene_create(world, &def, &scene));
+  const mica_tool_id sphere = scene.tool;
   const double identity[4] = {1, 0, 0, 0};
-  mica_tool_def tdef = mica_tool_def_default();
-  tdef.shape = MICA_TOOL_SPHERE;
-  tdef.radius = R;
-  tdef.margin = 0.001;
-  tdef.position[1] = L + R;
-  mica_tool_id sphere;
-  CHECK(mica_tool_create(world, &tdef, &sphere));
 
   const double dx = L / cells_per_side, ratio = E * dt * dt / (rho * dx * dx);
   printf("E = %8.0e Pa   E h^2/(rho dx^2) = %9.3g\n", E, ratio);
@@ -104,7 +90,7 @@ static int run(double E, int steps, int cells_per_side, int cap, FILE* csv, int*
     CHECK(mica_tool_set_pose(world, sphere, pos, identity));
     const mica_status s = mica_step(world, dt);
     CHECK(s);
-    mica_world_stats stats = {sizeof stats};
+    mica_world_stats stats = {.struct_size = sizeof stats};
     CHECK(mica_world_get_stats(world, &stats));
     double force[3];
     int32_t contacts = 0;

@@ -16,6 +16,7 @@
 
 #include <mica/mica.h>
 
+#include "box_scene.h"
 #include "cli.h"
 #include <mica/mica_device.h>
 
@@ -62,7 +63,7 @@ static void* servo_thread(void* arg) {
   while (atomic_load(&L->running)) {
     double force[3];
     if (mica_device_poll(L->world, L->device, NULL, force) < 0) L->failures++;
-    mica_device_stats st = {sizeof st};
+    mica_device_stats st = {.struct_size = sizeof st};
     mica_device_get_stats(L->world, L->device, &st);
     if (L->samples < MAX_SAMPLES) {
       L->t[L->samples] = now_s() - start;
@@ -110,25 +111,15 @@ int main(int argc, char** argv) {
     fprintf(stderr, "%s\n", mica_world_last_error(NULL));
     return 1;
   }
-  mica_body_def bd = mica_body_def_default();
-  bd.youngs_modulus = 8e3;
-  bd.poisson_ratio = 0.4;
-  bd.rayleigh_alpha = 2;
-  const double lo[3] = {-0.05, -0.1, -0.05}, hi[3] = {0.05, 0, 0.05};
-  const int32_t cells[3] = {8, 8, 8};
-  mica_body_id body;
-  CHECK(mica_body_create_box(world, &bd, lo, hi, cells, 6, &body));
-  int32_t base[128], n = 0;
-  const double o[3] = {0, -0.1, 0}, up[3] = {0, 1, 0};
-  CHECK(mica_body_select_nodes_by_plane(world, body, o, up, 1e-9, 1, base, 128, &n));
-  mica_lpc_def fixed = mica_lpc_def_default();
-  mica_lpc_id lpc;
-  CHECK(mica_add_lpc(world, body, base, n, &fixed, &lpc));
-  mica_tool_def td = mica_tool_def_default();
-  td.radius = 0.02;
-  td.position[1] = 0.05;
-  mica_tool_id tool;
-  CHECK(mica_tool_create(world, &td, &tool));
+  /* The soft block (scenes/box_scene.h): 10 cm wide, its top face at y = 0, fixed at its bottom
+   * face, a 2 cm sphere above it. */
+  box_scene_def def = box_scene_block_def();
+  def.body.youngs_modulus = 8e3;
+  def.body.poisson_ratio = 0.4;
+  def.body.rayleigh_alpha = 2;
+  box_scene scene;
+  CHECK(box_scene_create(world, &def, &scene));
+  const mica_tool_id tool = scene.tool;
 
   /* The Touch if OpenHaptics is there, else the simulated stylus. */
   mica_device_def dd = mica_device_def_default();
@@ -140,7 +131,7 @@ int main(int argc, char** argv) {
     dd.trajectory = press;
     CHECK(mica_device_create(world, &dd, &L.device));
   }
-  mica_device_info info = {sizeof info};
+  mica_device_info info = {.struct_size = sizeof info};
   CHECK(mica_device_get_info(world, L.device, &info));
   printf("device: %s, max force %.2f N\n", info.name, info.max_force);
 
@@ -169,7 +160,7 @@ int main(int argc, char** argv) {
   atomic_store(&L.running, 0);
   pthread_join(servo, NULL);
   const double elapsed = now_s() - start;
-  mica_device_stats st = {sizeof st};
+  mica_device_stats st = {.struct_size = sizeof st};
   CHECK(mica_device_get_stats(world, L.device, &st));
   printf("simulation %.1f Hz (worst step %.1f ms), servo %.0f Hz, %ld device failures, %lld limited polls\n",
          steps / elapsed, worst_step_ms, L.samples / elapsed, L.failures, (long long)st.clamped);

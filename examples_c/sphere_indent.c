@@ -125,7 +125,7 @@ int main(int argc, char** argv) {
     const double pos[3] = {0, y, 0};
     double force[3] = {0, 0, 0};
     int32_t contacts = 0;
-    mica_world_stats stats = {sizeof stats};
+    mica_world_stats stats = {.struct_size = sizeof stats};
     if (k > 0) {
       CHECK(mica_tool_set_pose(world, sphere, pos, scene.orientation));
       const mica_status s = mica_step(world, dt);
@@ -164,7 +164,7 @@ int main(int argc, char** argv) {
   fclose(csv);
 
   const double hertz = 4.0 / 3.0 * E_star * sqrt(R) * pow(peak_depth, 1.5);
-  mica_world_stats stats = {sizeof stats};
+  mica_world_stats stats = {.struct_size = sizeof stats};
   CHECK(mica_world_get_stats(world, &stats));
   printf("peak force %.4f N at depth %.4f m; Hertz half-space estimate there "
          "4/3 E/(1-nu^2) sqrt(R) d^1.5 = %.4f N (ratio %.2f)\n",

@@ -2,6 +2,8 @@
 /* A tool pressed into a soft body and held: see press_scene.h. */
 #include "press_scene.h"
 
+#include "node_selection.h"
+
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -152,17 +154,10 @@ static mica_status nidus_top(press_scene* s, double lo[3], double hi[3]) {
 static mica_status fix_below(press_scene* s, double y, double tol) {
   const double point[3] = {0, y, 0}, up[3] = {0, 1, 0};
   int32_t n = 0;
-  TRY(mica_body_select_nodes_by_plane(s->world, s->body, point, up, tol, 1, NULL, 0, &n), "select the held nodes");
-  if (n <= 0) return fail(s, MICA_ERR_INVALID_ARGUMENT, "no node to hold below y = %g", y);
-  int32_t* sel = malloc(sizeof(int32_t) * (size_t)n);
-  if (!sel) return fail(s, MICA_ERR_OUT_OF_MEMORY, "out of memory");
-  mica_status st = mica_body_select_nodes_by_plane(s->world, s->body, point, up, tol, 1, sel, n, &n);
-  mica_lpc_def fixed = mica_lpc_def_default();
-  fixed.kind = MICA_LPC_FIXED;
   mica_lpc_id lpc;
-  if (st >= 0) st = mica_add_lpc(s->world, s->body, sel, n, &fixed, &lpc);
-  free(sel);
-  TRY(st, "mica_add_lpc");
+  const mica_status st = scene_fix_plane(s->world, s->body, point, up, tol, &n, &lpc);
+  if (n <= 0 && st != MICA_ERR_OUT_OF_MEMORY) return fail(s, MICA_ERR_INVALID_ARGUMENT, "no node to hold below y = %g", y);
+  TRY(st, "hold the nodes below the cut");
   return MICA_OK;
 }
 

@@ -31,25 +31,10 @@ echo "study: building in $build (log: $out/logs/build.log)"
 bin="$build/study-bin"
 mkdir -p "$bin"
 study_programs=(study_sweep study_anchors study_filter)
-if cmake --build "$build" --target help 2>/dev/null | grep study_sweep >/dev/null; then  # not -q: an early exit would fail the pipe
-  # bench/CMakeLists.txt has add_subdirectory(study): the targets exist.
-  cmake --build "$build" -j 2 --target "${study_programs[@]}" >>"$out/logs/build.log" 2>&1
-  for p in "${study_programs[@]}"; do cp "$build/bench/study/$p" "$bin/$p"; done
-else
-  # Not hooked into CMake yet: compile the plain C programs against the built libmica.
-  cc=${CC:-cc}
-  defs=()
-  grep -q 'warm_start' "$root/include/mica/mica.h" && defs+=(-DMICA_STUDY_HAVE_WARM_START)
-  for p in "${study_programs[@]}"; do
-    src="$root/bench/study/$p.c"
-    if [[ ! -x "$bin/$p" || "$src" -nt "$bin/$p" || "$root/bench/study/study_common.h" -nt "$bin/$p" ||
-          "$build/libmica.so" -nt "$bin/$p" || "$root/include/mica/mica.h" -nt "$bin/$p" ]]; then
-      "$cc" -O2 -std=c99 -D_POSIX_C_SOURCE=200809L "${defs[@]}" -I"$root/include" "$src" -o "$bin/$p" \
-        -L"$build" -lmica -lm -lpthread -Wl,-rpath,"$build" >>"$out/logs/build.log" 2>&1 ||
-        { tail -20 "$out/logs/build.log"; exit 1; }
-    fi
-  done
-fi
+# bench/CMakeLists.txt builds them (add_subdirectory(study)), with the scene builders of scenes/.
+cmake --build "$build" -j 2 --target "${study_programs[@]}" >>"$out/logs/build.log" 2>&1 ||
+  { tail -20 "$out/logs/build.log"; exit 1; }
+for p in "${study_programs[@]}"; do cp "$build/bench/study/$p" "$bin/$p"; done
 nidus_bin="$build/bench/bench_nidus"
 contact_bin="$build/bench/bench_contact"
 pin=""

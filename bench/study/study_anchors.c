@@ -35,6 +35,7 @@
 
 #include <mica/mica.h>
 
+#include "node_selection.h"
 #include "study_common.h"
 #include "cli.h"
 
@@ -134,18 +135,18 @@ static level_result hertz_level(int cells, FILE* curve) {
   const double o[3] = {0, 0, 0}, nxp[3] = {1, 0, 0}, nzp[3] = {0, 0, 1}, bottom[3] = {0, -HERTZ_W, 0},
                up[3] = {0, 1, 0};
   int32_t n = 0;
-  int32_t* sel = study_select_plane(w, body, o, nxp, 1e-9, &n);
+  int32_t* sel = scene_select_plane(w, body, o, nxp, 1e-9, &n);
   mica_lpc_def plane = mica_lpc_def_default();
   plane.kind = MICA_LPC_PLANE;
   plane.direction[0][0] = 1;
   mica_add_lpc(w, body, sel, n, &plane, &lx);
   free(sel);
-  sel = study_select_plane(w, body, o, nzp, 1e-9, &n);
+  sel = scene_select_plane(w, body, o, nzp, 1e-9, &n);
   plane.direction[0][0] = 0;
   plane.direction[0][2] = 1;
   mica_add_lpc(w, body, sel, n, &plane, &lz);
   free(sel);
-  study_fix_plane(w, body, bottom, up, 1e-9, &base);
+  scene_fix_plane(w, body, bottom, up, 1e-9, NULL, &base);
   mica_tool_def td = mica_tool_def_default();
   td.radius = HERTZ_R;
   td.margin = 1e-4;
@@ -217,9 +218,9 @@ static level_result beam_level(int n, int model) {
   mica_body_get_counts(w, body, &r.nodes, &r.tets, NULL);
   mica_lpc_id clamp;
   const double o[3] = {0, 0, 0}, nx[3] = {1, 0, 0}, tip_p[3] = {L, 0, 0}, tip_n[3] = {-1, 0, 0};
-  study_fix_plane(w, body, o, nx, 1e-9, &clamp);
+  scene_fix_plane(w, body, o, nx, 1e-9, NULL, &clamp);
   int32_t ntip = 0;
-  int32_t* tip = study_select_plane(w, body, tip_p, tip_n, 1e-9, &ntip);
+  int32_t* tip = scene_select_plane(w, body, tip_p, tip_n, 1e-9, &ntip);
   double* x = malloc(sizeof(double) * 3 * (size_t)r.nodes);
   double* x0 = malloc(sizeof(double) * 3 * (size_t)r.nodes);
   mica_body_get_rest_positions(w, body, x0, r.nodes, NULL);

@@ -42,27 +42,6 @@ static inline void study_progress(double done, double total) {
   fflush(stderr);
 }
 
-/* Nodes of `body` with (p - point) . normal <= tol in rest positions; malloc'ed, count in *n. */
-static inline int32_t* study_select_plane(mica_world* w, mica_body_id body, const double point[3], const double normal[3],
-                                   double tol, int32_t* n) {
-  *n = 0;
-  mica_body_select_nodes_by_plane(w, body, point, normal, tol, 1, NULL, 0, n);
-  int32_t* sel = malloc(sizeof(int32_t) * (size_t)(*n > 0 ? *n : 1));
-  if (*n > 0) mica_body_select_nodes_by_plane(w, body, point, normal, tol, 1, sel, *n, n);
-  return sel;
-}
-
-/* Fixes every node of `body` on the side of the plane the normal points away from. */
-static inline mica_status study_fix_plane(mica_world* w, mica_body_id body, const double point[3], const double normal[3],
-                                   double tol, mica_lpc_id* out) {
-  int32_t n = 0;
-  int32_t* sel = study_select_plane(w, body, point, normal, tol, &n);
-  mica_lpc_def fixed = mica_lpc_def_default();
-  const mica_status s = n > 0 ? mica_add_lpc(w, body, sel, n, &fixed, out) : MICA_ERR_INVALID_ARGUMENT;
-  free(sel);
-  return s;
-}
-
 /* The distinct nodes of a body's surface triangles; malloc'ed, count in *n. */
 static inline int32_t* study_surface_nodes(mica_world* w, mica_body_id body, int32_t* n) {
   int32_t nodes = 0, tris = 0;

@@ -28,6 +28,7 @@
 #include <mica/mica.h>
 #include <mica/mica_device.h>
 
+#include "box_scene.h"
 #include "study_common.h"
 #include "cli.h"
 
@@ -58,28 +59,19 @@ static int run(int mode, int window, samples* s) {
   wd.max_iterations = 5000;
   mica_world* w = NULL;
   if (mica_world_create(&wd, &w) != MICA_OK) return 1;
-  mica_body_def bd = mica_body_def_default();
-  bd.youngs_modulus = 1e4;
-  bd.poisson_ratio = 0.4;
-  bd.rayleigh_alpha = 2;
-  const double lo[3] = {-0.05, -0.1, -0.05}, hi[3] = {0.05, 0, 0.05};
-  const int32_t cells[3] = {8, 8, 8};
-  mica_body_id body;
-  mica_lpc_id base;
-  const double o[3] = {0, -0.1, 0}, up[3] = {0, 1, 0};
-  mica_tool_def td = mica_tool_def_default();
-  td.radius = 0.02;
-  td.position[1] = 0.05;
-  mica_tool_id tool;
+  /* The soft block of scenes/box_scene.h (as examples_c/haptic_loop.c), E = 1e4 Pa. */
+  box_scene_def def = box_scene_block_def();
+  def.body.youngs_modulus = 1e4;
+  def.body.poisson_ratio = 0.4;
+  def.body.rayleigh_alpha = 2;
+  box_scene scene;
   mica_device_def dd = mica_device_def_default();
   mica_device_id dev;
-  if (mica_body_create_box(w, &bd, lo, hi, cells, 6, &body) != MICA_OK ||
-      study_fix_plane(w, body, o, up, 1e-9, &base) != MICA_OK || mica_tool_create(w, &td, &tool) != MICA_OK)
-    goto fail;
+  if (box_scene_create(w, &def, &scene) != MICA_OK) goto fail;
   dd.backend = MICA_DEVICE_SIMULATED;
   dd.simulated_kind = MICA_SIMULATED_TRAJECTORY;
   dd.trajectory = press;
-  dd.tool = tool;
+  dd.tool = scene.tool;
   dd.force_mode = mode;
   dd.filter_window = window;
   dd.max_force = 1000;
@@ -108,7 +100,7 @@ static int run(int mode, int window, samples* s) {
     }
     if (mica_step(w, STEP_S) < 0) goto fail;
     double f[3];
-    mica_tool_get_force(w, tool, f, NULL, NULL);
+    mica_tool_get_force(w, scene.tool, f, NULL, NULL);
     sim_force = f[1];
   }
   mica_device_destroy(w, dev);

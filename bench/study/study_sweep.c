@@ -46,6 +46,8 @@
 
 #include <mica/mica.h>
 
+#include "box_scene.h"
+#include "node_selection.h"
 #include "study_common.h"
 #include "cli.h"
 
@@ -150,56 +152,46 @@ static void run(const cfg* c, traj* rec, const traj* ref, const traj* model_ref,
     snprintf(res->error, sizeof res->error, "world: %s", mica_world_last_error(NULL));
     return;
   }
-  mica_body_def bd = mica_body_def_default();
-  bd.youngs_modulus = c->E;
-  bd.poisson_ratio = 0.3;
-  bd.density = 1000;
-  bd.rayleigh_alpha = c->scene == 0 ? 2.0 : 0.0;
-  bd.model = c->model;
-  bd.mass = c->mass;
-  const double lo[3] = {0, 0, 0}, hi[3] = {L_CUBE, L_CUBE, L_CUBE};
-  const int32_t cells[3] = {c->cells, c->cells, c->cells};
-  mica_body_id body;
-  mica_lpc_id base, drag = MICA_NULL_ID;
-  mica_tool_id tool = MICA_NULL_ID;
-  int32_t nodes = 0, tets = 0, nsurf = 0;
-  int32_t* surf = NULL;
-  const double o[3] = {0, 0, 0}, up[3] = {0, 1, 0};
-  if (mica_body_create_box(w, &bd, lo, hi, cells, 6, &body) != MICA_OK ||
-      study_fix_plane(w, body, o, up, 1e-9, &base) != MICA_OK) {
+  /* The cube of scenes/box_scene.h, its base fixed; the press adds the drag and the sphere. */
+  box_scene_def def = box_scene_def_default();
+  def.body.youngs_modulus = c->E;
+  def.body.poisson_ratio = 0.3;
+  def.body.density = 1000;
+  def.body.rayleigh_alpha = c->scene == 0 ? 2.0 : 0.0;
+  def.body.model = c->model;
+  def.body.mass = c->mass;
+  def.hi[0] = def.hi[1] = def.hi[2] = L_CUBE;
+  def.cells[0] = def.cells[1] = def.cells[2] = c->cells;
+  def.tool_radius = 0;
+  if (c->scene == 0) {
+    def.drag_velocity[2] = 0.02;
+    def.tool_radius = R_TOOL;
+    def.tool_margin = 0.002;
+    def.tool_position[0] = def.tool_position[2] = 0.5 * L_CUBE;
+    tool_y(0, &def.tool_position[1]);
+  }
+  box_scene scene;
+  if (box_scene_create(w, &def, &scene) != MICA_OK) {
     res->ok = 0;
     snprintf(res->error, sizeof res->error, "scene: %s", mica_world_last_error(w));
     mica_world_destroy(w);
     return;
   }
-  mica_body_get_counts(w, body, &nodes, &tets, NULL);
+  const mica_body_id body = scene.body;
+  const mica_lpc_id drag = scene.drag;
+  const mica_tool_id tool = scene.tool;
+  const int32_t nodes = scene.nodes;
+  int32_t nsurf = 0;
+  int32_t* surf = NULL;
   res->nodes = nodes;
-  res->tets = tets;
+  res->tets = scene.tets;
   if (c->scene == 0) {
-    int32_t n = 0;
-    const double side[3] = {L_CUBE, 0, 0}, out[3] = {-1, 0, 0};
-    int32_t* sel = study_select_plane(w, body, side, out, 1e-9, &n);
-    mica_lpc_def pull = mica_lpc_def_default();
-    pull.velocity[2] = 0.02;
-    mica_add_lpc(w, body, sel, n, &pull, &drag);
-    free(sel);
-    mica_tool_def td = mica_tool_def_default();
-    td.radius = R_TOOL;
-    td.margin = 0.002;
-    td.position[0] = td.position[2] = 0.5 * L_CUBE;
-    tool_y(0, &td.position[1]);
-    if (mica_tool_create(w, &td, &tool) != MICA_OK) {
-      res->ok = 0;
-      snprintf(res->error, sizeof res->error, "tool: %s", mica_world_last_error(w));
-      mica_world_destroy(w);
-      return;
-    }
     surf = study_surface_nodes(w, body, &nsurf);
   } else {
     /* Free vibration: push the top half sideways (node forces for the first 5 steps). */
     int32_t n = 0;
     const double mid[3] = {0, 0.5 * L_CUBE, 0}, down[3] = {0, -1, 0};
-    int32_t* sel = study_select_plane(w, body, mid, down, 1e-9, &n);
+    int32_t* sel = scene_select_plane(w, body, mid, down, 1e-9, &n);
     double* f = calloc(3 * (size_t)n, sizeof(double));
     for (int32_t i = 0; i < n; ++i) f[3 * i] = 20.0 / n;
     mica_body_set_node_forces(w, body, sel, f, n);
@@ -239,7 +231,7 @@ static void run(const cfg* c, traj* rec, const traj* ref, const traj* model_ref,
     } else if (k == 5) {
       int32_t n = 0;
       const double mid[3] = {0, 0.5 * L_CUBE, 0}, down[3] = {0, -1, 0};
-      int32_t* sel = study_select_plane(w, body, mid, down, 1e-9, &n);
+      int32_t* sel = scene_select_plane(w, body, mid, down, 1e-9, &n);
       double* f = calloc(3 * (size_t)n, sizeof(double));
       mica_body_set_node_forces(w, body, sel, f, n);
       free(f);

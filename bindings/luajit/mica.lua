@@ -197,6 +197,57 @@ function World:select_nodes_by_plane(body, point, normal, tolerance, use_rest)
   end)
 end
 
+-- Runs a buffer-protocol call for doubles (size query, then fill): returns a double array of
+-- `width` values per item and the item count.
+local function read_doubles(self, call, width)
+  local count = ffi.new("int32_t[1]")
+  self:check(call(nil, 0, count))
+  local out = ffi.new("double[?]", math.max(width * count[0], 1))
+  self:check(call(out, count[0], count))
+  return out, count[0]
+end
+
+-- Since 0.6: a body's tets (int32_t[4 * t], 0-based) and the region of each (int32_t[t]).
+function World:tets(body)
+  return read_indices(self, function(out, cap, count) return C.mica_body_get_tets(self.ptr, body, out, cap, count) end)
+end
+function World:tet_regions(body)
+  return read_indices(self, function(out, cap, count)
+    return C.mica_body_get_tet_regions(self.ptr, body, out, cap, count)
+  end)
+end
+
+-- Materials per tet: Lua tables (or nil to keep that property) of Young's modulus (Pa), Poisson
+-- ratio and density (kg/m^3), one value per tet. Rebuilds the body's stiffness, mass, damping.
+function World:set_materials(body, youngs_modulus, poisson_ratio, density)
+  local counts = ffi.new("int32_t[2]")
+  self:check(C.mica_body_get_counts(self.ptr, body, counts, counts + 1, nil))
+  local tets = counts[1]
+  local function array(values, name)
+    if values == nil then return nil end
+    assert(#values == tets, name .. ": one value per tet")
+    return ffi.new("double[?]", tets, values)
+  end
+  self:check(C.mica_body_set_materials(self.ptr, body, array(youngs_modulus, "youngs_modulus"),
+                                       array(poisson_ratio, "poisson_ratio"), array(density, "density"), tets))
+end
+
+-- Node masses (double[n], kg), strains (double[6 * t]: xx yy zz yz xz xy) and von Mises stress
+-- (double[t], Pa) per tet; each returns the array and its item count.
+function World:node_masses(body)
+  return read_doubles(self, function(out, cap, count)
+    return C.mica_body_get_node_masses(self.ptr, body, out, cap, count)
+  end, 1)
+end
+function World:strains(body)
+  return read_doubles(self, function(out, cap, count) return C.mica_body_get_strains(self.ptr, body, out, cap, count) end, 6)
+end
+function World:von_mises(body)
+  return read_doubles(self, function(out, cap, count)
+    return C.mica_body_get_von_mises(self.ptr, body, out, cap, count)
+  end, 1)
+end
+
 function World:add_lpc(body, nodes, count, fields)
   local id = ffi.new("mica_lpc_id[1]")
   self:check(C.mica_add_lpc(self.ptr, body, nodes, count, M.lpc_def(fields), id))
@@ -250,6 +301,38 @@ function World:positions(body)
   local ptr, n = ffi.new("const double*[1]"), ffi.new("int32_t[1]")
   self:check(C.mica_body_positions_view(self.ptr, body, ptr, n))
   return ptr[0], n[0]
+end
+
+-- Sets every node's positions (m) or velocities (m/s): a table (or double array) of 3 values a node.
+function World:set_positions(body, values)
+  assert(#values % 3 == 0, "positions: 3 values a node")
+  self:check(C.mica_body_set_positions(self.ptr, body, ffi.new("double[?]", #values, values), #values / 3))
+end
+function World:set_velocities(body, values)
+  assert(#values % 3 == 0, "velocities: 3 values a node")
+  self:check(C.mica_body_set_velocities(self.ptr, body, ffi.new("double[?]", #values, values), #values / 3))
+end
+
+-- The world's dynamic state as a Lua string (mica_world_save_state), and back.
+function World:save_state()
+  local size = ffi.new("size_t[1]")
+  self:check(C.mica_world_state_size(self.ptr, size))
+  local buffer = ffi.new("uint8_t[?]", size[0])
+  self:check(C.mica_world_save_state(self.ptr, buffer, size[0]))
+  return ffi.string(buffer, size[0])
+end
+function World:restore_state(state)
+  self:check(C.mica_world_restore_state(self.ptr, state, #state))
+end
+
+-- The contacts of the last step: a mica_contact[?] array (0-based) and its count.
+function World:contacts()
+  local n = ffi.new("int32_t[1]")
+  self:check(C.mica_world_get_contacts(self.ptr, nil, 0, n))
+  local out = ffi.new("mica_contact[?]", math.max(n[0], 1))
+  out[0].struct_size = ffi.sizeof("mica_contact")
+  if n[0] > 0 then self:check(C.mica_world_get_contacts(self.ptr, out, n[0], n)) end
+  return out, n[0]
 end
 
 -- A device whose callbacks are Lua functions: `callbacks` has read_state(state) and

@@ -57,7 +57,7 @@ extern "C" {
 /** Major version: incompatible ABI changes. */
 #define MICA_VERSION_MAJOR 0
 /** Minor version: compatible additions. */
-#define MICA_VERSION_MINOR 5
+#define MICA_VERSION_MINOR 6
 /** Patch version: fixes. */
 #define MICA_VERSION_PATCH 0
 /** major * 10000 + minor * 100 + patch */
@@ -525,6 +525,142 @@ MICA_API mica_status mica_body_select_nodes_by_plane(const mica_world* world, mi
  *          MICA_ERR_STALE_ID (`body` is null, of another kind or destroyed). */
 MICA_API mica_status mica_body_get_energy(const mica_world* world, mica_body_id body,
                                           double* kinetic, double* elastic, double* potential);
+
+/* Since 0.6: setting node state. */
+/** Sets the current positions (m) of every node of a body, 3 doubles per node (a checker's or a
+ *  host's own state; a body placed anew). What was derived from the old positions goes with them:
+ *  the rotations kept for the next step, the collision tree (refitted at once), and the warm-start
+ *  impulses of the body's contacts. Velocities are kept (mica_body_set_velocities() sets them).
+ *  A static body may be moved too: it stays where it is put. The world's thread (the one thread
+ *  using the world at a time).
+ *  @param world the world.
+ *  @param body the body.
+ *  @param xyz 3 * `node_count` coordinates, m, finite.
+ *  @param node_count the body's node count (mica_body_get_counts()).
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` or `xyz` is NULL); MICA_ERR_STALE_ID
+ *          (`body` is null, of another kind or destroyed); MICA_ERR_INVALID_ARGUMENT (`node_count`
+ *          is not the body's node count, a value is not finite: the message names the node). On an
+ *          error the world is unchanged. */
+MICA_API mica_status mica_body_set_positions(mica_world* world, mica_body_id body, const double* xyz,
+                                             int32_t node_count);
+/** Sets the current velocities (m/s) of every node of a dynamic body, 3 doubles per node; the next
+ *  step starts from them. The world's thread (the one thread using the world at a time).
+ *  @param world the world.
+ *  @param body the body.
+ *  @param xyz 3 * `node_count` values, m/s, finite.
+ *  @param node_count the body's node count.
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` or `xyz` is NULL); MICA_ERR_STALE_ID
+ *          (`body` is null, of another kind or destroyed); MICA_ERR_INVALID_ARGUMENT (`node_count`
+ *          is not the body's node count, a value is not finite); MICA_ERR_WRONG_STATE (the body is
+ *          static). On an error the world is unchanged. */
+MICA_API mica_status mica_body_set_velocities(mica_world* world, mica_body_id body, const double* xyz,
+                                              int32_t node_count);
+/* Since 0.6: tissue regions (a material per tet), the mesh and its fields. */
+
+/** The tets, 4 node indices each (0-based, positive rest volume as at creation); as
+ *  mica_body_get_positions(). The world's thread (the one thread using the world at a time).
+ *  @param world the world (not changed).
+ *  @param body the body.
+ *  @param out the caller's buffer, or NULL to ask for the count only. @param capacity the buffer's
+ *         size in tets (not in values). @param out_count receives the tet count (may be NULL when
+ *         `out` is not).
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` or a required pointer is NULL);
+ *          MICA_ERR_STALE_ID (`body` is null, of another kind or destroyed);
+ *          MICA_ERR_INVALID_ARGUMENT (`capacity` < 0); MICA_ERR_BUFFER_TOO_SMALL (`capacity` below
+ *          the count: nothing copied, `*out_count` = the count needed). */
+MICA_API mica_status mica_body_get_tets(const mica_world* world, mica_body_id body,
+                                        int32_t* out, int32_t capacity, int32_t* out_count);
+
+/** The region of each tet, 1 value per tet in the order of mica_body_get_tets(): for a Gmsh .msh
+ *  file the tet's physical tag (2.2: the element's first tag; 4.1: the first physical tag of its
+ *  volume in $Entities), for a TetGen .ele the first tet attribute (tetgen -A) when every tet's
+ *  is an integer, else 0; 0 for a tet without one and for bodies made from arrays or boxes. Map
+ *  regions to materials with mica_body_set_materials(). Buffer protocol as
+ *  mica_body_get_positions(). The world's thread (the one thread using the world at a time).
+ *  @param world the world (not changed).
+ *  @param body the body.
+ *  @param out the caller's buffer, or NULL to ask for the count only. @param capacity the buffer's
+ *         size in tets. @param out_count receives the tet count (may be NULL when `out` is not).
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` or a required pointer is NULL);
+ *          MICA_ERR_STALE_ID (`body` is null, of another kind or destroyed);
+ *          MICA_ERR_INVALID_ARGUMENT (`capacity` < 0); MICA_ERR_BUFFER_TOO_SMALL (`capacity` below
+ *          the count: nothing copied, `*out_count` = the count needed). */
+MICA_API mica_status mica_body_get_tet_regions(const mica_world* world, mica_body_id body,
+                                               int32_t* out, int32_t capacity,
+                                               int32_t* out_count);
+
+/** Sets the material of every tet (a stiff nodule in soft tissue): Young's modulus, Poisson
+ *  ratio and density per tet, in the order of mica_body_get_tets(). The body's model is rebuilt:
+ *  element stiffness, mass (so gravity and node masses) and Rayleigh damping (alpha M + beta K,
+ *  with the body's alpha and beta) follow each tet's material, and the solver's factors of the
+ *  body are dropped (the next step factors anew). Positions, velocities, loads and constraints
+ *  stay. Cost: like creating the body; call it after creation, not per step. The world's thread
+ *  (the one thread using the world at a time).
+ *  @param world the world.
+ *  @param body the body.
+ *  @param youngs_modulus `tet_count` values, Pa, each finite and > 0; NULL keeps every tet's.
+ *  @param poisson_ratio `tet_count` values, each in [0, 0.5); NULL keeps every tet's.
+ *  @param density `tet_count` values, kg/m^3, each finite and > 0; NULL keeps every tet's.
+ *  @param tet_count the body's tet count (mica_body_get_counts()).
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` is NULL); MICA_ERR_STALE_ID (`body` is
+ *          null, of another kind or destroyed); MICA_ERR_INVALID_ARGUMENT (`tet_count` is not the
+ *          body's tet count, or a value out of its domain: the message names the tet and the
+ *          property); MICA_ERR_BAD_MESH (a value so large that a tet's stiffness or mass
+ *          overflows double precision); MICA_ERR_OUT_OF_MEMORY. On any error nothing changes. */
+MICA_API mica_status mica_body_set_materials(mica_world* world, mica_body_id body,
+                                             const double* youngs_modulus,
+                                             const double* poisson_ratio, const double* density,
+                                             int32_t tet_count);
+
+/** Mass of each node (kg), 1 value per node: the row sums of the body's mass matrix, the mass
+ *  gravity pulls on. For linear tets each tet gives rho V / 4 to each of its nodes with either
+ *  MICA_MASS_CONSISTENT or MICA_MASS_LUMPED, so the sum is the body's mass (density times
+ *  volume, per tet). Buffer protocol as mica_body_get_positions(). The world's thread (the one
+ *  thread using the world at a time).
+ *  @param world the world (not changed).
+ *  @param body the body.
+ *  @param out the caller's buffer, or NULL to ask for the count only. @param capacity the buffer's
+ *         size in nodes. @param out_count receives the node count (may be NULL when `out` is not).
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` or a required pointer is NULL);
+ *          MICA_ERR_STALE_ID (`body` is null, of another kind or destroyed);
+ *          MICA_ERR_INVALID_ARGUMENT (`capacity` < 0); MICA_ERR_BUFFER_TOO_SMALL (`capacity` below
+ *          the count: nothing copied, `*out_count` = the count needed). */
+MICA_API mica_status mica_body_get_node_masses(const mica_world* world, mica_body_id body,
+                                               double* out, int32_t capacity, int32_t* out_count);
+
+/** Strain of each tet at the current positions (dimensionless), 6 values per tet: xx, yy, zz,
+ *  yz, xz, xy, with tensor shear components (half the engineering shear). It is the strain the
+ *  model uses: co-rotational bodies eps = sym(R^T F) - I, with F the tet's deformation gradient
+ *  and R its rotation, expressed in the tet's rest axes (a rigid rotation of the body gives 0);
+ *  MICA_MODEL_LINEAR bodies the small strain sym(F) - I. Constant over each (linear) tet.
+ *  Buffer protocol as mica_body_get_positions(). The world's thread (the one thread using the
+ *  world at a time).
+ *  @param world the world (not changed).
+ *  @param body the body.
+ *  @param out the caller's buffer, or NULL to ask for the count only. @param capacity the buffer's
+ *         size in tets (not in values). @param out_count receives the tet count (may be NULL when
+ *         `out` is not).
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` or a required pointer is NULL);
+ *          MICA_ERR_STALE_ID (`body` is null, of another kind or destroyed);
+ *          MICA_ERR_INVALID_ARGUMENT (`capacity` < 0); MICA_ERR_BUFFER_TOO_SMALL (`capacity` below
+ *          the count: nothing copied, `*out_count` = the count needed); MICA_ERR_OUT_OF_MEMORY. */
+MICA_API mica_status mica_body_get_strains(const mica_world* world, mica_body_id body,
+                                           double* out, int32_t capacity, int32_t* out_count);
+
+/** Von Mises stress of each tet at the current positions (Pa), 1 value per tet:
+ *  sqrt(3/2 s:s), s the deviatoric part of the stress 2 mu eps + lambda tr(eps) I of the tet's
+ *  own material and its strain as mica_body_get_strains() gives it. Buffer protocol as
+ *  mica_body_get_positions(). The world's thread (the one thread using the world at a time).
+ *  @param world the world (not changed).
+ *  @param body the body.
+ *  @param out the caller's buffer, or NULL to ask for the count only. @param capacity the buffer's
+ *         size in tets. @param out_count receives the tet count (may be NULL when `out` is not).
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` or a required pointer is NULL);
+ *          MICA_ERR_STALE_ID (`body` is null, of another kind or destroyed);
+ *          MICA_ERR_INVALID_ARGUMENT (`capacity` < 0); MICA_ERR_BUFFER_TOO_SMALL (`capacity` below
+ *          the count: nothing copied, `*out_count` = the count needed); MICA_ERR_OUT_OF_MEMORY. */
+MICA_API mica_status mica_body_get_von_mises(const mica_world* world, mica_body_id body,
+                                             double* out, int32_t capacity, int32_t* out_count);
 /** @} */
 
 /** @name Linear projection constraints (LPC)
@@ -775,6 +911,100 @@ MICA_API mica_status mica_tool_get_force(const mica_world* world, mica_tool_id t
 MICA_API mica_status mica_step(mica_world* world, double dt);
 /** @} */
 
+/** @name State and contacts (since 0.6)
+ *  Saving a world's dynamic state to restore it later (a session's checkpoint, two solvers from
+ *  one state, a bug report), and reading the contacts of the last step.
+ *  @{ */
+
+/** The size in bytes mica_world_save_state() needs now. The size changes as the world steps (the
+ *  contacts and warm-start impulses, the lagged factors the solver keeps): ask right before saving.
+ *  The world's thread (the one thread using the world at a time).
+ *  @param world the world (not changed).
+ *  @param out_bytes receives the size.
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` or `out_bytes` is NULL); MICA_ERR_WRONG_STATE
+ *          (a device's servo loop runs: stop it first); MICA_ERR_OUT_OF_MEMORY. */
+MICA_API mica_status mica_world_state_size(const mica_world* world, size_t* out_bytes);
+
+/** Saves the world's dynamic state into the caller's buffer: node positions and velocities, node
+ *  forces, the warm-start impulses and the last step's contacts, the solver's lagged factors (the
+ *  systems they were made from), tool poses, velocities and forces, constraint targets, velocities
+ *  and handle poses, each device's force filter (moving average) and rate limit, the step counter
+ *  and statistics. Restoring it into this world (or one built the same way) and stepping repeats
+ *  the original steps bit for bit, given the same host input. The buffer begins with a header
+ *  (magic "MICASTAT", format version, size, checksum) and the world's shape (bodies and their node
+ *  and tet counts, tools, constraints, devices, solver). It is for this libmica on this kind of
+ *  machine (native byte order), not an archive format. Meshes, materials and settings are not in
+ *  it: restore into a world made the same way. Devices must be stopped (their servo loop reads the
+ *  filter). The world's thread (the one thread using the world at a time).
+ *  @param world the world (not changed).
+ *  @param buffer the caller's buffer.
+ *  @param bytes its size in bytes.
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` or `buffer` is NULL); MICA_ERR_BUFFER_TOO_SMALL
+ *          (`bytes` below mica_world_state_size(): nothing written, the message gives the size);
+ *          MICA_ERR_WRONG_STATE (a device's servo loop runs); MICA_ERR_OUT_OF_MEMORY. */
+MICA_API mica_status mica_world_save_state(const mica_world* world, void* buffer, size_t bytes);
+
+/** Restores a state saved by mica_world_save_state(). The whole buffer is checked first; on any
+ *  error the world is unchanged. The contacts readout, tool forces and constraint reactions are
+ *  those of the step before the save. The world's thread (the one thread using the world at a
+ *  time).
+ *  @param world the world: of the same shape as the one saved (the same bodies with the same node
+ *         and tet counts in creation order, tools of the same shapes, constraints on the same
+ *         bodies with the same node counts, devices with the same filter windows, the same solver).
+ *  @param buffer the saved state.
+ *  @param bytes its size in bytes (the size it was saved with).
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` or `buffer` is NULL); MICA_ERR_PARSE (not a
+ *          saved state, another format version, truncated, a checksum mismatch, or inconsistent
+ *          contents: the message says which); MICA_ERR_INVALID_ARGUMENT (the state is of a world of
+ *          another shape: the message names the first difference); MICA_ERR_WRONG_STATE (a
+ *          device's servo loop runs); MICA_ERR_NUMERICAL (a saved factor no longer factors);
+ *          MICA_ERR_OUT_OF_MEMORY. */
+MICA_API mica_status mica_world_restore_state(mica_world* world, const void* buffer, size_t bytes);
+
+#define MICA_CONTACT_NODE 1     /**< the body's point is a node (weights[0] = 1) */
+#define MICA_CONTACT_EDGE 2     /**< a point of a surface edge: two nodes and their weights */
+#define MICA_CONTACT_TRIANGLE 3 /**< a point of a surface triangle: three nodes, barycentric weights */
+#define MICA_CONTACT_OTHER_TOOL 0 /**< the other side is a tool */
+#define MICA_CONTACT_OTHER_BODY 1 /**< the other side is a body (dynamic or static) */
+
+/** One contact of the last step. The body's point is pushed along +normal; the other side feels
+ *  the opposite. Impulses are over the step (N s): the force is impulse / dt. */
+typedef struct mica_contact {
+  uint32_t struct_size;    /**< set by the caller in out[0] (the array's stride): sizeof(mica_contact) */
+  int32_t kind;            /**< MICA_CONTACT_NODE, _EDGE or _TRIANGLE: the body's point */
+  mica_body_id body;       /**< the body */
+  int32_t nodes[3];        /**< the point's nodes (node_count = kind; unused ones -1) */
+  int32_t other_kind;      /**< MICA_CONTACT_OTHER_TOOL or MICA_CONTACT_OTHER_BODY */
+  double weights[3];       /**< the nodes' weights (barycentric, sum 1; unused ones 0) */
+  uint64_t other;          /**< the tool's id (mica_tool_id) or the other body's (mica_body_id) */
+  int32_t other_nodes[3];  /**< another dynamic body: its triangle's nodes; -1 for a tool or a static body */
+  int32_t reserved0;       /**< zero */
+  double other_weights[3]; /**< their barycentric weights; 0 when unused */
+  double point[3];         /**< m, the contact point where it was detected */
+  double normal[3];        /**< unit, separates the body from the other side (points towards the body) */
+  double gap;              /**< m, signed distance at the start of the step (negative: penetrating) */
+  double normal_impulse;   /**< N s, >= 0: the impulse on the body along `normal` */
+  double tangent_impulse[3]; /**< N s, the friction impulse on the body (perpendicular to `normal`; 0 without friction) */
+  double friction;         /**< the Coulomb coefficient of the contact */
+} mica_contact;
+
+/** The contacts of the last step. With out == NULL only *out_count is written (the size query).
+ *  The impulse on the body is normal * normal_impulse + tangent_impulse; summed over a tool's
+ *  contacts and divided by -dt it is mica_tool_get_force() (within round-off). The world's thread
+ *  (the one thread using the world at a time).
+ *  @param world the world (not changed).
+ *  @param out the caller's array, out[0].struct_size set to sizeof(mica_contact) (its stride), or
+ *         NULL to ask for the count only.
+ *  @param capacity the array's size in contacts.
+ *  @param out_count receives the count (may be NULL when `out` is not).
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` is NULL, or both `out` and `out_count`);
+ *          MICA_ERR_INVALID_ARGUMENT (`capacity` < 0); MICA_ERR_STRUCT_SIZE (out[0].struct_size
+ *          is not a size this library knows); MICA_ERR_BUFFER_TOO_SMALL (`capacity` below the count:
+ *          nothing copied, `*out_count` = the count needed). */
+MICA_API mica_status mica_world_get_contacts(const mica_world* world, mica_contact* out, int32_t capacity,
+                                             int32_t* out_count);
+/** @} */
+
 /** @name Statistics
  *  The step is a plan of stages derived from the scene; a stage whose effect is absent
  *  is not in the plan and never runs.
@@ -832,8 +1062,10 @@ MICA_API const char* mica_stage_name(int32_t stage);
 
 /** @name Output
  *  @{ */
-/** Writes one body (current positions, velocities and displacements) as a VTK legacy unstructured
- *  grid that ParaView opens. The world's thread (the one thread using the world at a time).
+/** Writes one body (current positions, velocities and displacements per node; since 0.6 also the
+ *  von Mises stress "von_mises" (Pa, as mica_body_get_von_mises()) and "region" (as
+ *  mica_body_get_tet_regions()) per tet, as CELL_DATA) as a VTK legacy unstructured grid that
+ *  ParaView opens. The world's thread (the one thread using the world at a time).
  *  @param world the world (not changed).
  *  @param body the body.
  *  @param path the file to write (replaced if it exists).
@@ -842,7 +1074,8 @@ MICA_API const char* mica_stage_name(int32_t stage);
  *          cannot be written). */
 MICA_API mica_status mica_body_write_vtk(const mica_world* world, mica_body_id body,
                                          const char* path);
-/** Writes every body of the world into one VTK file (cell scalar "piece" = body order). The world's
+/** Writes every body of the world into one VTK file (cell scalar "piece" = body order; the fields
+ *  of mica_body_write_vtk()). The world's
  *  thread (the one thread using the world at a time).
  *  @param world the world (not changed).
  *  @param path the file to write (replaced if it exists).

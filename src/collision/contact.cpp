@@ -125,6 +125,7 @@ void collide_tool(const Tool& tool, int32_t tool_index, uint64_t tool_key, const
   auto emit = [&](uint64_t pair, const BodyPoint& p, const Vec3& normal, const Vec3& point, double gap) -> Contact& {
     out.push_back(Contact{contact_key(tool_key, body.key, pair), tool_index, p, BodyPoint{}, normal, point, gap,
                           tool.friction, tool_point_velocity(tool, point)});
+    out.back().other = tool_key;
     return out.back();
   };
   // The nodes the tool went past (their start side and the nearest-point normal disagree), in
@@ -267,6 +268,7 @@ void collide_bodies(const SurfaceView& a, const SurfaceView& b, double margin_at
     Contact c{contact_key(a.key, b.key, uint64_t(node)), -1, node_point(a.index, node), BodyPoint{}, normal, p, gap,
               friction, Vec3::Zero()};
     if (b.index >= 0) c.b = triangle_point(b.index, (*b.triangles)[n.tri], n.point.weights);  // a static b is an obstacle
+    c.other = b.key;
     out.push_back(c);
   }
 }

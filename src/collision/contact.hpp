@@ -35,6 +35,7 @@ struct Contact {
   int32_t triangle = -1;
   int32_t core_corner = -1;
   int32_t core_edge = -1;
+  uint64_t other = 0;  // the tool's id, or the other body's id (a static obstacle's too)
 };
 
 inline BodyPoint node_point(int32_t body, int32_t node) {

@@ -11,21 +11,37 @@ namespace mica {
 
 double FemModel::total_mass() const { return std::accumulate(node_mass.begin(), node_mass.end(), 0.0); }
 
+namespace {
+// Throws InvalidArgument naming `where` for a material out of its domain.
+void validate_material(const Material& mat, const std::string& where) {
+  if (!(mat.youngs_modulus > 0) || !std::isfinite(mat.youngs_modulus))
+    fail(Errc::InvalidArgument, where + ": Young's modulus must be finite and > 0 Pa");
+  if (!(mat.poisson_ratio >= 0 && mat.poisson_ratio < 0.5))
+    fail(Errc::InvalidArgument, where + ": Poisson ratio must be in [0, 0.5)");
+  if (!(mat.density > 0) || !std::isfinite(mat.density))
+    fail(Errc::InvalidArgument, where + ": density must be finite and > 0 kg/m^3");
+}
+}  // namespace
+
 FemModel build_fem_model(const TetMesh& mesh, const Material& material, MassKind mass_kind,
                          const std::string& source) {
-  const Material& mat = material;
-  if (!(mat.youngs_modulus > 0) || !std::isfinite(mat.youngs_modulus))
-    fail(Errc::InvalidArgument, source + ": Young's modulus must be finite and > 0 Pa");
-  if (!(mat.poisson_ratio >= 0 && mat.poisson_ratio < 0.5))
-    fail(Errc::InvalidArgument, source + ": Poisson ratio must be in [0, 0.5)");
-  if (!(mat.density > 0) || !std::isfinite(mat.density))
-    fail(Errc::InvalidArgument, source + ": density must be finite and > 0 kg/m^3");
+  validate_material(material, source);
+  return build_fem_model(mesh, std::vector<Material>(mesh.tets.size(), material), mass_kind, source);
+}
+
+FemModel build_fem_model(const TetMesh& mesh, const std::vector<Material>& materials, MassKind mass_kind,
+                         const std::string& source) {
+  if (materials.size() != mesh.tets.size())
+    fail(Errc::InvalidArgument, source + ": " + std::to_string(materials.size()) + " materials for " +
+                                    std::to_string(mesh.tets.size()) + " tets (one per tet)");
+  for (size_t e = 0; e < materials.size(); ++e) validate_material(materials[e], source + ": tet " + std::to_string(e));
   validate_topology(mesh, source);
   FemModel m;
   m.quality = check_rest_quality(mesh, source);
   m.rest = mesh.nodes;
-  m.material = material;
-  m.lame = lame_parameters(material);
+  m.materials = materials;
+  m.lame.reserve(materials.size());
+  for (const Material& mat : materials) m.lame.push_back(lame_parameters(mat));
   m.mass_kind = mass_kind;
   m.elements.reserve(mesh.tets.size());
   for (size_t e = 0; e < mesh.tets.size(); ++e) {
@@ -33,8 +49,8 @@ FemModel build_fem_model(const TetMesh& mesh, const Material& material, MassKind
     // The quality check is scale-free; double precision is not: a tet of edge 1e-104 m has a
     // subnormal determinant (its inverse overflows) and one of 1e102 m overflows its mass.
     const TetElement& el = m.elements.back();
-    if (!el.dm_inv.allFinite() || !std::isfinite(material.density * el.volume) ||
-        !std::isfinite(material.youngs_modulus * el.volume))
+    if (!el.dm_inv.allFinite() || !std::isfinite(materials[e].density * el.volume) ||
+        !std::isfinite(materials[e].youngs_modulus * el.volume))
       fail(Errc::BadMesh, source + ": tet " + std::to_string(e) + " (volume " + std::to_string(el.volume) +
                               " m^3) is too small or too large to model in double precision");
   }
@@ -44,7 +60,7 @@ FemModel build_fem_model(const TetMesh& mesh, const Material& material, MassKind
   // Consistent: M_ab = rho V / 20 (1 + delta_ab); lumped: rho V / 4 on the diagonal.
   m.mass.assign(m.pattern.block_count(), 0.0);
   for (size_t e = 0; e < m.elements.size(); ++e) {
-    const double rv = mat.density * m.elements[e].volume;
+    const double rv = materials[e].density * m.elements[e].volume;
     for (int a = 0; a < 4; ++a)
       for (int b = 0; b < 4; ++b) {
         const int32_t slot = m.slots[e][4 * a + b];
@@ -88,9 +104,9 @@ void assemble_elastic(const FemModel& m, const Vec3List& x, const std::vector<Ma
   auto element = [&](int32_t e, Mat3* Ke) {  // Ke: 16 blocks of scratch
     const TetElement& el = m.elements[e];
     const Mat3& Re = R ? (*R)[e] : I;
-    add_elastic_forces(el, m.lame, Re, deformation_gradient(el, x), f_int);
+    add_elastic_forces(el, m.lame[e], Re, deformation_gradient(el, x), f_int);
     if (!K) return;
-    rotated_stiffness(el, m.lame, Re, k_scale, Ke);
+    rotated_stiffness(el, m.lame[e], Re, k_scale, Ke);
     for (int q = 0; q < 16; ++q) (*K)[m.slots[e][q]] += Ke[q];
   };
   if (!coloured) {
@@ -139,9 +155,10 @@ double mass_dot(const FemModel& m, const Vec3List& v, const Vec3List& w) {
 
 double elastic_energy(const FemModel& m, const Vec3List& x, bool corotational) {
   double energy = 0;
-  for (const TetElement& el : m.elements) {
+  for (size_t e = 0; e < m.elements.size(); ++e) {
+    const TetElement& el = m.elements[e];
     const Mat3 F = deformation_gradient(el, x);
-    energy += elastic_energy(el, m.lame, corotational ? proper_rotation(F) : Mat3::Identity(), F);
+    energy += elastic_energy(el, m.lame[e], corotational ? proper_rotation(F) : Mat3::Identity(), F);
   }
   return energy;
 }

@@ -20,8 +20,8 @@ enum class MassKind { Consistent, Lumped };
 struct FemModel {
   Vec3List rest;
   std::vector<TetElement> elements;
-  Material material;
-  Lame lame;
+  std::vector<Material> materials;             // per element (tissue regions)
+  std::vector<Lame> lame;                      // per element, from materials
   MassKind mass_kind;
   BlockPattern pattern;
   std::vector<std::array<int32_t, 16>> slots;  // per element, block index of (a, b)
@@ -33,9 +33,13 @@ struct FemModel {
   double total_mass() const;
 };
 
-// Validates the mesh (topology, rest quality) and precomputes the model. Throws Error naming
-// the offending element; `source` prefixes messages.
+// Validates the mesh (topology, rest quality) and the materials, and precomputes the model.
+// Throws Error naming the offending element; `source` prefixes messages.
 FemModel build_fem_model(const TetMesh& mesh, const Material& material, MassKind mass_kind,
+                         const std::string& source);
+// One material per tet (`materials.size()` == the tet count): stiffness, mass and so Rayleigh
+// damping (alpha M + beta K) are per element.
+FemModel build_fem_model(const TetMesh& mesh, const std::vector<Material>& materials, MassKind mass_kind,
                          const std::string& source);
 
 // Per-element rotations of the current positions x, on the threads of `pool` if there is one

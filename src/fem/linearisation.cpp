@@ -12,9 +12,9 @@ ScreenEnergies screen_energies(const FemModel& m, const Vec3List& x, const Vec3L
     const TetElement& el = m.elements[e];
     const Mat3 F1 = deformation_gradient(el, x_end);
     R_end[e] = proper_rotation(F1);
-    out.u_end += elastic_energy(el, m.lame, R_end[e], F1);
-    out.u_lin_end += elastic_energy(el, m.lame, R[e], F1);
-    if (with_start) out.u_lin_start += elastic_energy(el, m.lame, R[e], deformation_gradient(el, x));
+    out.u_end += elastic_energy(el, m.lame[e], R_end[e], F1);
+    out.u_lin_end += elastic_energy(el, m.lame[e], R[e], F1);
+    if (with_start) out.u_lin_start += elastic_energy(el, m.lame[e], R[e], deformation_gradient(el, x));
   }
   return out;
 }
@@ -33,15 +33,15 @@ LinearisationEnergies linearisation_energies(const FemModel& m, const Vec3List& 
     const Mat3& R = corot ? (*R_lin)[e] : I;
     const Mat3 F1 = deformation_gradient(el, x_end);
     if (corot) R_end[e] = proper_rotation(F1);
-    out.u_end += elastic_energy(el, m.lame, corot ? R_end[e] : I, F1);
-    out.u_lin_end += elastic_energy(el, m.lame, R, F1);
-    out.u_lin_start += elastic_energy(el, m.lame, R, deformation_gradient(el, x));
+    out.u_end += elastic_energy(el, m.lame[e], corot ? R_end[e] : I, F1);
+    out.u_lin_end += elastic_energy(el, m.lame[e], R, F1);
+    out.u_lin_start += elastic_energy(el, m.lame[e], R, deformation_gradient(el, x));
     // v^T (R Ke R^T) v is twice the strain energy of the displacement v in the frame R.
     const Mat3 Fv = deformation_gradient(el, v);
-    out.vKv += 2 * elastic_energy(el, m.lame, R, Fv + R);
+    out.vKv += 2 * elastic_energy(el, m.lame[e], R, Fv + R);
     if (with_start_stiffness) {
       const Mat3& Rs = corot ? (*R_start)[e] : I;
-      out.vKv_start += 2 * elastic_energy(el, m.lame, Rs, Fv + Rs);
+      out.vKv_start += 2 * elastic_energy(el, m.lame[e], Rs, Fv + Rs);
     }
     if (!twist) continue;
     const TwistModes& t = modes[e];
@@ -65,7 +65,7 @@ void add_twist_stiffness(const FemModel& m, const Vec3List& x_lin, const Vec3Lis
   for (size_t e = 0; e < m.elements.size(); ++e) {
     const TetElement& el = m.elements[e];
     TwistModes& t = modes[e];
-    t = twist_modes(el, m.lame, deformation_gradient(el, x_lin));
+    t = twist_modes(el, m.lame[e], deformation_gradient(el, x_lin));
     for (int32_t q = 0; q < t.count; ++q) {
       double c = 0;
       for (int a = 0; a < 4; ++a) c += t.q[q][a].dot(v_lin[el.nodes[a]]);

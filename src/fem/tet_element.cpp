@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "fem/tet_element.hpp"
 
+#include <cmath>
+
 #include <Eigen/LU>
 
 namespace mica {
@@ -27,16 +29,19 @@ Mat3 deformation_gradient(const TetElement& e, const Vec3List& x) {
   return ds * e.dm_inv;
 }
 
-namespace {
-// Small strain in the rotated frame and its stress: eps = sym(R^T F) - I.
 Mat3 rotated_strain(const Mat3& R, const Mat3& F) {
   const Mat3 G = R.transpose() * F;
   return 0.5 * (G + G.transpose()) - Mat3::Identity();
 }
+
 Mat3 stress(const Lame& m, const Mat3& eps) {
   return 2 * m.mu * eps + m.lambda * eps.trace() * Mat3::Identity();
 }
-}  // namespace
+
+double von_mises(const Mat3& sigma) {
+  const Mat3 s = sigma - (sigma.trace() / 3) * Mat3::Identity();
+  return std::sqrt(1.5 * s.squaredNorm());
+}
 
 void add_elastic_forces(const TetElement& e, const Lame& m, const Mat3& R, const Mat3& F, Vec3List& f) {
   const Mat3 P = -e.volume * (R * stress(m, rotated_strain(R, F)));

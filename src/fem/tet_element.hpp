@@ -23,6 +23,13 @@ TetElement make_tet_element(const Vec3List& rest, const Tet& nodes);
 
 Mat3 deformation_gradient(const TetElement& e, const Vec3List& x);
 
+// Small strain in the rotated frame: eps = sym(R^T F) - I (R = I: the linear model's strain).
+Mat3 rotated_strain(const Mat3& R, const Mat3& F);
+// Hooke's law: sigma = 2 mu eps + lambda tr(eps) I, Pa.
+Mat3 stress(const Lame& m, const Mat3& eps);
+// sqrt(3/2 s:s) with s the deviatoric part of sigma, Pa.
+double von_mises(const Mat3& sigma);
+
 // Elastic forces f_a = -R Ke (R^T x - X) on the element's four nodes, added to f.
 // With eps = sym(R^T F) - I the small strain in the rotated frame, f_a = -V R sigma g_a.
 void add_elastic_forces(const TetElement& e, const Lame& m, const Mat3& R, const Mat3& F, Vec3List& f);

@@ -84,6 +84,19 @@ class DeviceLink {
   const DeviceSettings& settings() const { return settings_; }
   const DeviceInfo& info() const { return info_; }
   const ServoStats& stats() const { return stats_; }
+  // The servo path's filter state (the moving average and the last force sent), for
+  // World::save_state; only while no servo loop runs (servo_running()).
+  struct FilterState {
+    MovingAverage::State average;
+    Vec3 previous_force = Vec3::Zero();
+  };
+  bool servo_running() const { return on_scheduler_ || thread_.running(); }
+  FilterState filter_state() const { return {filter_.state(), safety_.previous()}; }
+  // Throws Error(InvalidArgument), unchanged, when the state is of another filter window.
+  void set_filter_state(const FilterState& s) {
+    filter_.set_state(s.average);
+    safety_.set_previous(s.previous_force);
+  }
 
  private:
   static void tick(void* self);

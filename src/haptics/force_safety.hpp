@@ -49,6 +49,7 @@ class ForceSafety {
   // something other than apply()'s result, e.g. zero after a device failure.
   void reset() noexcept { previous_.setZero(); }
   const Vec3& previous() const { return previous_; }
+  void set_previous(const Vec3& force) { previous_ = force; }  // a saved state (World::restore_state)
 
  private:
   SafetySettings settings_;

@@ -1,6 +1,9 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "haptics/moving_average.hpp"
 
+#include <algorithm>
+#include <string>
+
 #include "core/error.hpp"
 
 namespace mica {
@@ -37,6 +40,20 @@ Vec3 MovingAverage::filter(const Vec3& raw, bool in_contact) noexcept {
   // the error by that of N updates, however long the run (O(1) amortised).
   if (++since_resum_ >= n) resum();
   return sum_ / double(count_);
+}
+
+void MovingAverage::set_state(const State& s) {
+  const int32_t n = window();
+  if (s.samples.size() != samples_.size() || s.next < 0 || s.next >= n || s.count < 0 || s.count > n ||
+      s.since_resum < 0)
+    fail(Errc::InvalidArgument, "moving average: the saved state is of a window of " +
+                                    std::to_string(s.samples.size()) + " samples, this one has " + std::to_string(n));
+  std::copy(s.samples.begin(), s.samples.end(), samples_.begin());
+  next_ = s.next;
+  count_ = s.count;
+  since_resum_ = s.since_resum;
+  sum_ = s.sum;
+  in_contact_ = s.in_contact;
 }
 
 void MovingAverage::reset() noexcept {

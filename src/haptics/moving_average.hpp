@@ -38,6 +38,16 @@ class MovingAverage {
 
   // How many samples the last output averaged.
   int32_t count() const { return count_; }
+  // Everything a later filter() depends on (World::save_state; not on the servo path).
+  struct State {
+    std::vector<Vec3> samples;
+    int32_t next = 0, count = 0, since_resum = 0;
+    Vec3 sum = Vec3::Zero();
+    bool in_contact = false;
+  };
+  State state() const { return {samples_, next_, count_, since_resum_, sum_, in_contact_}; }
+  // Throws Error(InvalidArgument), unchanged, unless the state is of a window of this size.
+  void set_state(const State& s);
 
  private:
   bool restart_ = true;

@@ -1,5 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
-// Gmsh ASCII mesh reader, format versions 2.2 and 4.1: keeps the 4-node tetrahedra.
+// Gmsh ASCII mesh reader, format versions 2.2 and 4.1: keeps the 4-node tetrahedra and the
+// physical tag of each (its region: 2.2 lists it first among an element's tags, 4.1 in the
+// $Entities record of the volume the element block belongs to; 0 without one).
 // Nodes are renumbered 0..n-1 in the order the $Nodes section lists them; nodes that no
 // tetrahedron uses are dropped. Memory reserved for a count read from the file is capped by
 // what the bytes left can hold, so a lying header fails at the end of the text, unallocated.
@@ -45,6 +47,8 @@ class GmshParser {
         version_ == Version::Legacy2 ? read_nodes_v2() : read_nodes_v4();
       } else if (header == "$Elements") {
         version_ == Version::Legacy2 ? read_elements_v2() : read_elements_v4();
+      } else if (header == "$Entities" && version_ == Version::Modern4) {
+        read_entities_v4();
       } else {
         skip_section(header);
       }
@@ -52,7 +56,15 @@ class GmshParser {
     if (tets_.empty()) {
       lines_.expected("at least one 4-node tetrahedron (element type 4)", "end of file");
     }
-    return detail::drop_unused_nodes(nodes_, tets_);
+    TetMesh mesh = detail::drop_unused_nodes(nodes_, tets_);
+    mesh.regions = std::move(regions_);
+    if (version_ == Version::Modern4) {  // entity tags to physical tags ($Entities may come anywhere)
+      for (std::int32_t& r : mesh.regions) {
+        const auto it = volume_physical_.find(r);
+        r = it == volume_physical_.end() ? 0 : it->second;
+      }
+    }
+    return mesh;
   }
 
  private:
@@ -85,6 +97,31 @@ class GmshParser {
     const std::string end_marker = "$End" + std::string(header.substr(1));
     while (lines_.next(end_marker) != end_marker) {
     }
+  }
+
+  static constexpr std::int64_t kMinInt32 = std::numeric_limits<std::int32_t>::min();
+  static constexpr std::int64_t kMaxInt32 = std::numeric_limits<std::int32_t>::max();
+
+  // 4.1: "numPoints numCurves numSurfaces numVolumes", then one line per entity; a volume's line
+  // is "tag minX minY minZ maxX maxY maxZ numPhysicalTags physicalTags... numSurfaces ...".
+  // Keeps each volume's first physical tag; skips the points, curves and surfaces.
+  void read_entities_v4() {
+    Fields header(lines_, lines_.next("an $Entities header 'numPoints numCurves numSurfaces numVolumes'"));
+    std::int64_t lower_dimensional = 0;
+    for (const char* what : {"a point count", "a curve count", "a surface count"})
+      lower_dimensional += header.count(what);
+    const std::int64_t volumes = header.count("a volume count");
+    header.finish();
+    for (std::int64_t i = 0; i < lower_dimensional; ++i) lines_.next("a point, curve or surface entity line");
+    for (std::int64_t i = 0; i < volumes; ++i) {
+      Fields f(lines_, lines_.next("a volume entity line 'tag minX minY minZ maxX maxY maxZ numPhysicalTags ...'"));
+      const std::int64_t tag = f.integer("a volume tag", kMinInt32 + 1, kMaxInt32);
+      for (const char* what : {"minX", "minY", "minZ", "maxX", "maxY", "maxZ"}) f.real(what);
+      const std::int64_t physical_count = f.count("a physical tag count");
+      if (physical_count > 0)
+        volume_physical_[std::int32_t(tag)] = std::int32_t(f.integer("a physical tag", kMinInt32, kMaxInt32));
+    }
+    expect_line("$EndEntities");
   }
 
   // Records that `tag` names the node that will sit at `index` of nodes_.
@@ -186,8 +223,15 @@ class GmshParser {
       f.integer("an element tag");
       const std::int64_t type = f.integer("an element type");
       const std::int64_t num_tags = f.integer("a tag count", 0, kMaxTag);
-      for (std::int64_t t = 0; t < num_tags; ++t) f.integer("an element tag value");
-      if (type == kTet4) read_tet(f);
+      std::int32_t physical = 0;  // the first tag, 0 when there is none
+      for (std::int64_t t = 0; t < num_tags; ++t) {
+        const std::int64_t value = f.integer("an element tag value");
+        if (t == 0) {
+          if (value < kMinInt32 || value > kMaxInt32) lines_.expected("a physical tag within int32", f.last());
+          physical = std::int32_t(value);
+        }
+      }
+      if (type == kTet4) read_tet(f, physical);
     }
     expect_line("$EndElements");
   }
@@ -206,8 +250,8 @@ class GmshParser {
     for (std::int64_t b = 0; b < blocks; ++b) {
       Fields block(lines_,
                    lines_.next("an element block header 'entityDim entityTag type numElements'"));
-      block.integer("an entity dimension 0 to 3", 0, 3);
-      block.integer("an entity tag");
+      const std::int64_t dimension = block.integer("an entity dimension 0 to 3", 0, 3);
+      const std::int64_t entity = block.integer("an entity tag");
       const std::int64_t type = block.integer("an element type");
       const std::int64_t n =
           block.count("a block element count within the $Elements total", total - seen);
@@ -216,25 +260,33 @@ class GmshParser {
       for (std::int64_t i = 0; i < n; ++i) {
         Fields f(lines_, lines_.next("an element line 'tag nodes...'"));
         f.integer("an element tag");
-        if (type == kTet4) read_tet(f);
+        // The volume's entity tag for now; parse() turns it into its physical tag.
+        const bool in_volume = dimension == 3 && entity > kMinInt32 && entity <= kMaxInt32;
+        if (type == kTet4) read_tet(f, in_volume ? std::int32_t(entity) : kNoEntity);
       }
     }
     if (seen != total) more_expected("element", total, seen);
     expect_line("$EndElements");
   }
 
-  void read_tet(Fields& f) {
+  void read_tet(Fields& f, std::int32_t region) {
     Tet t;
     for (auto& v : t) v = node_index(f);
     f.finish();
     tets_.push_back(t);
+    regions_.push_back(region);
   }
+
+  // 4.1: a tet block not in a volume entity (no such entity: no physical tag, region 0).
+  static constexpr std::int32_t kNoEntity = std::numeric_limits<std::int32_t>::min();
 
   LineReader lines_;
   Version version_ = Version::Legacy2;
   Vec3List nodes_;                                               // in file order
   std::unordered_map<std::int64_t, std::int32_t> index_of_tag_;  // tag -> position in nodes_
   std::vector<Tet> tets_;                                        // positions in nodes_
+  std::vector<std::int32_t> regions_;                            // per tet (4.1: entity tag until parse() ends)
+  std::unordered_map<std::int32_t, std::int32_t> volume_physical_;  // 4.1: volume tag -> first physical tag
 };
 
 }  // namespace

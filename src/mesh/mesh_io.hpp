@@ -30,11 +30,13 @@ TetMesh parse_tetgen(std::string_view node_text, std::string_view ele_text,
 TetMesh read_tetgen(const std::string& path);  // path to the .node or the .ele (or no suffix)
 
 // One piece of a VTK legacy unstructured grid: a body's current positions and its tets,
-// with optional per-node vectors (name, values) written as POINT_DATA.
+// with optional per-node vectors (name, values) written as POINT_DATA and per-tet scalars
+// (name, values) written as CELL_DATA after "piece".
 struct VtkPiece {
   const Vec3List* positions = nullptr;
   const std::vector<Tet>* tets = nullptr;
   std::vector<std::pair<std::string, const Vec3List*>> point_vectors;
+  std::vector<std::pair<std::string, const std::vector<double>*>> cell_scalars;
 };
 
 // Writes all pieces as one grid (a cell scalar "piece" tells them apart).

@@ -16,6 +16,9 @@ double signed_volume(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d)
 void validate_topology(const TetMesh& mesh, const std::string& source) {
   const auto n = int64_t(mesh.nodes.size());
   if (mesh.tets.empty()) fail(Errc::BadMesh, source + ": the mesh has no tetrahedra");
+  if (!mesh.regions.empty() && mesh.regions.size() != mesh.tets.size())
+    fail(Errc::InvalidArgument, source + ": " + std::to_string(mesh.regions.size()) + " regions for " +
+                                    std::to_string(mesh.tets.size()) + " tets");
   for (int64_t i = 0; i < n; ++i) {
     if (!mesh.nodes[i].allFinite())
       fail(Errc::InvalidArgument, source + ": node " + std::to_string(i) + " has a non-finite coordinate");

@@ -13,6 +13,8 @@ namespace mica {
 struct TetMesh {
   Vec3List nodes;
   std::vector<Tet> tets;
+  // Per tet, the region it belongs to (Gmsh physical tag, TetGen region attribute); empty: all 0.
+  std::vector<int32_t> regions;
 };
 
 // Signed volume of a tetrahedron, positive for the convention above.

@@ -2,9 +2,12 @@
 // TetGen .node/.ele reader. '#' starts a comment anywhere on a line; blank lines are skipped.
 // The first point index of the .node file (0 or 1) sets the numbering of both files. Points
 // are renumbered 0..n-1 in file order; points that no tetrahedron uses (such as the edge
-// nodes of 10-node tets) are dropped.
+// nodes of 10-node tets) are dropped. A tet's first attribute is its region (tetgen -A) when
+// every tet's first attribute is an integer in int32; otherwise every region is 0.
 // Memory reserved for a count read from a file is capped by what the bytes left can hold, so a
 // lying header fails at the end of the text, unallocated.
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <string>
@@ -65,8 +68,9 @@ PointList read_points(std::string_view text, const std::string& name) {
 }
 
 // .ele: "ntets nodes_per_tet nattr", then "index n1 n2 n3 n4 [6 more] [attributes]" per tet.
+// `first_attribute` receives each tet's first attribute (empty when there are none).
 std::vector<Tet> read_tets(std::string_view text, const std::string& name,
-                           const PointList& points) {
+                           const PointList& points, std::vector<double>& first_attribute) {
   LineReader lines(text, name, "#");
   Fields header(lines, lines.next("a header 'ntets nodes_per_tet nattr'"));
   const std::int64_t n = header.integer("a positive tetrahedron count", 1, kMaxCount);
@@ -94,7 +98,10 @@ std::vector<Tet> read_tets(std::string_view text, const std::string& name,
     for (std::int64_t k = 4; k < nodes_per_tet; ++k) {
       f.integer(node_what, lo, hi);  // edge midpoints
     }
-    for (std::int64_t a = 0; a < num_attributes; ++a) f.real("a finite tetrahedron attribute");
+    for (std::int64_t a = 0; a < num_attributes; ++a) {
+      const double value = f.real("a finite tetrahedron attribute");
+      if (a == 0) first_attribute.push_back(value);
+    }
     f.finish();
     tets.push_back(t);
   }
@@ -107,7 +114,15 @@ std::vector<Tet> read_tets(std::string_view text, const std::string& name,
 TetMesh parse_tetgen(std::string_view node_text, std::string_view ele_text,
                      const std::string& node_name, const std::string& ele_name) {
   const PointList points = read_points(node_text, node_name);
-  return detail::drop_unused_nodes(points.points, read_tets(ele_text, ele_name, points));
+  std::vector<double> attribute;
+  TetMesh mesh = detail::drop_unused_nodes(points.points, read_tets(ele_text, ele_name, points, attribute));
+  const auto is_region = [](double a) {
+    return a == std::floor(a) && a >= std::numeric_limits<std::int32_t>::min() &&
+           a <= std::numeric_limits<std::int32_t>::max();
+  };
+  if (!attribute.empty() && std::all_of(attribute.begin(), attribute.end(), is_region))
+    for (double a : attribute) mesh.regions.push_back(static_cast<std::int32_t>(a));
+  return mesh;
 }
 
 TetMesh read_tetgen(const std::string& path) {

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // VTK legacy ASCII writer: all pieces as one unstructured grid of linear tetrahedra
 // (VTK cell type 10, whose positive orientation is ours), a cell scalar "piece" telling the
-// pieces apart, and the requested per-node vectors. Doubles are written with 17 significant
+// pieces apart, the requested per-tet scalars and the requested per-node vectors. Doubles are written with 17 significant
 // digits so that they read back exactly.
 #include <cerrno>
 #include <cstdint>
@@ -27,6 +27,31 @@ bool has_space(const std::string& s) {
   return false;
 }
 
+// Every piece must carry the same fields, in the same order, as piece 0, each a one-word name
+// and one value per node (per tet).
+template <class Field>
+void check_fields(const std::string& where, const std::string& kind, const std::vector<Field>& fields,
+                  const std::vector<Field>& reference, std::size_t count, const char* per) {
+  if (fields.size() != reference.size()) {
+    fail(Errc::InvalidArgument, where + " has " + std::to_string(fields.size()) + " " + kind +
+                                    " fields, piece 0 has " + std::to_string(reference.size()));
+  }
+  for (std::size_t f = 0; f < fields.size(); ++f) {
+    const std::string& name = fields[f].first;
+    if (name.empty() || has_space(name)) {
+      fail(Errc::InvalidArgument, where + ": " + kind + " name '" + name + "' must be one word");
+    }
+    if (name != reference[f].first) {
+      fail(Errc::InvalidArgument, where + ": " + kind + " " + std::to_string(f) + " is '" + name +
+                                      "', piece 0 has '" + reference[f].first + "'");
+    }
+    if (!fields[f].second || fields[f].second->size() != count) {
+      fail(Errc::InvalidArgument, where + ": " + kind + " '" + name + "' needs one value per " + per + " (" +
+                                      std::to_string(count) + ")");
+    }
+  }
+}
+
 // Throws InvalidArgument / OutOfRange for a piece the grid cannot be written from.
 void check_pieces(const std::vector<VtkPiece>& pieces) {
   for (std::size_t p = 0; p < pieces.size(); ++p) {
@@ -45,28 +70,9 @@ void check_pieces(const std::vector<VtkPiece>& pieces) {
         }
       }
     }
-    // Every piece must carry the same fields, in the same order, as piece 0.
-    const auto& fields = piece.point_vectors;
-    const auto& reference = pieces[0].point_vectors;
-    if (fields.size() != reference.size()) {
-      fail(Errc::InvalidArgument, where + " has " + std::to_string(fields.size()) +
-                                      " point vector fields, piece 0 has " +
-                                      std::to_string(reference.size()));
-    }
-    for (std::size_t f = 0; f < fields.size(); ++f) {
-      const std::string& name = fields[f].first;
-      if (name.empty() || has_space(name)) {
-        fail(Errc::InvalidArgument, where + ": point vector name '" + name + "' must be one word");
-      }
-      if (name != reference[f].first) {
-        fail(Errc::InvalidArgument, where + ": point vector " + std::to_string(f) + " is '" + name +
-                                        "', piece 0 has '" + reference[f].first + "'");
-      }
-      if (!fields[f].second || fields[f].second->size() != piece.positions->size()) {
-        fail(Errc::InvalidArgument, where + ": point vector '" + name +
-                                        "' needs one value per node (" + std::to_string(n) + ")");
-      }
-    }
+    check_fields(where, "point vector", piece.point_vectors, pieces[0].point_vectors, piece.positions->size(),
+                 "node");
+    check_fields(where, "cell scalar", piece.cell_scalars, pieces[0].cell_scalars, piece.tets->size(), "tet");
   }
 }
 
@@ -141,6 +147,12 @@ void write_grid(std::ostream& out, const std::vector<VtkPiece>& pieces, const st
     out << "CELL_DATA " << num_cells << "\nSCALARS piece int 1\nLOOKUP_TABLE default\n";
     for (std::size_t p = 0; p < pieces.size(); ++p) {
       for (std::size_t c = 0; c < pieces[p].tets->size(); ++c) out << p << '\n';
+    }
+    for (std::size_t f = 0; f < pieces[0].cell_scalars.size(); ++f) {
+      out << "SCALARS " << pieces[0].cell_scalars[f].first << " double 1\nLOOKUP_TABLE default\n";
+      for (const VtkPiece& piece : pieces) {
+        for (double v : *piece.cell_scalars[f].second) out << v << '\n';
+      }
     }
   }
 

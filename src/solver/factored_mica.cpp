@@ -321,4 +321,25 @@ SolveReport FactoredMicaSolver::solve(const SolveContext& ctx, std::vector<Solve
   return report;
 }
 
+void FactoredMicaSolver::save_body(uint64_t key, ByteWriter& out) const {
+  const FactoredBodyCache* cache = find_cache(key);
+  out.put(uint8_t(cache != nullptr));
+  if (cache) cache->factor.save(out);
+}
+
+void FactoredMicaSolver::restore_bodies(const std::vector<SavedBody>& bodies) {
+  std::vector<std::pair<uint64_t, std::unique_ptr<FactoredBodyCache>>> made;
+  for (const SavedBody& b : bodies) {
+    ByteReader in(b.data, b.size);
+    std::unique_ptr<FactoredBodyCache> cache;
+    if (in.get<uint8_t>("a body's factor flag")) {
+      cache = std::make_unique<FactoredBodyCache>();
+      cache->factor.load(in, b.fem->pattern);
+    }
+    if (in.remaining()) fail(Errc::Parse, "a body's solver state is longer than its factor: corrupt state");
+    made.emplace_back(b.key, std::move(cache));
+  }
+  replace_caches(made);
+}
+
 }  // namespace mica

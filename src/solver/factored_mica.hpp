@@ -49,6 +49,9 @@ class FactoredMicaSolver : public CachingVelocitySolver<FactoredBodyCache> {
   void rollback_step() override {
     for_each_cache([](FactoredBodyCache& c) { c.factor.rollback(); });
   }
+  // Each body's lagged factor (LaggedFactor::save, load).
+  void save_body(uint64_t key, ByteWriter& out) const override;
+  void restore_bodies(const std::vector<SavedBody>& bodies) override;
 
  private:
   // What the loop needs beyond SolverBody, per body of a solve.

@@ -2,6 +2,7 @@
 #include "solver/lagged_factor.hpp"
 
 #include <algorithm>
+#include <future>
 
 namespace mica {
 
@@ -15,6 +16,8 @@ void LaggedFactor::factor(Slot& slot, const BlockPattern& pattern, const BlockVa
                           const std::vector<Mat3>* node_rotation) {
   if (!slot.direct.analyzed()) slot.direct.analyze(pattern);
   slot.direct.factorize(ProjectedSystem{pattern, A, projection});
+  slot.A = A;  // what it was made from, for a saved state (the same size: no allocation after the first)
+  slot.projection = projection;
   if (node_rotation) slot.rotation = *node_rotation;
   else slot.rotation.clear();
   slot.born = step_;
@@ -178,6 +181,91 @@ void LaggedFactor::rollback() {
   columns_kept_.clear();
   columns_added_.clear();
   columns_cleared_ = false;
+}
+
+void LaggedFactor::save_slot(const Slot& slot, ByteWriter& out) {
+  out.put_vector(slot.A);
+  out.put_vector(slot.projection.S);
+  out.put_vector(slot.projection.z);
+  out.put_vector(slot.projection.nodes);
+  out.put_vector(slot.projection.is_constrained);
+  out.put_vector(slot.rotation);
+  out.put(slot.born);
+}
+
+void LaggedFactor::load_slot(Slot& slot, ByteReader& in, const BlockPattern& pattern) {
+  const size_t n = pattern.row_start.size() - 1;
+  in.get_vector(slot.A, "a factor's matrix");
+  in.get_vector(slot.projection.S, "a factor's projection");
+  in.get_vector(slot.projection.z, "a factor's projection");
+  in.get_vector(slot.projection.nodes, "a factor's projection");
+  in.get_vector(slot.projection.is_constrained, "a factor's projection");
+  in.get_vector(slot.rotation, "a factor's rotations");
+  slot.born = in.get<int64_t>("a factor's step");
+  bool fits = slot.A.size() == size_t(pattern.block_count()) && slot.projection.S.size() == n &&
+              slot.projection.z.size() == n && slot.projection.is_constrained.size() == n &&
+              (slot.rotation.empty() || slot.rotation.size() == n);
+  for (int32_t node : slot.projection.nodes) fits = fits && node >= 0 && size_t(node) < n;
+  if (!fits) fail(Errc::Parse, "a saved factor does not fit its body's matrix pattern: corrupt state");
+  slot.direct.analyze(pattern);
+  slot.direct.factorize(ProjectedSystem{pattern, slot.A, slot.projection});
+}
+
+void LaggedFactor::save(ByteWriter& out) const {
+  out.put(key_);
+  out.put(step_);
+  out.put(launched_at_);
+  out.put(factorizations_);
+  out.put(node_count_);
+  const bool active = active_->direct.analyzed();
+  const bool in_flight = job_.valid();
+  out.put(uint8_t(active));
+  out.put(uint8_t(in_flight));
+  if (active) save_slot(*active_, out);
+  if (in_flight) save_slot(*pending_, out);
+  // The cached columns, by node (each 3n x 3, column-major).
+  std::vector<int32_t> nodes;
+  for (const auto& [node, cols] : columns_) nodes.push_back(node);
+  std::sort(nodes.begin(), nodes.end());
+  out.put(uint64_t(nodes.size()));
+  for (int32_t node : nodes) {
+    const Eigen::MatrixXd& cols = columns_.at(node);
+    out.put(node);
+    out.put(int64_t(cols.rows()));
+    out.put_bytes(cols.data(), size_t(cols.size()) * sizeof(double));
+  }
+}
+
+void LaggedFactor::load(ByteReader& in, const BlockPattern& pattern) {
+  const int64_t n = int64_t(pattern.row_start.size()) - 1;
+  key_ = in.get<Key>("a factor's key");
+  step_ = in.get<int64_t>("a factor's schedule");
+  launched_at_ = in.get<int64_t>("a factor's schedule");
+  factorizations_ = in.get<int64_t>("a factor's count");
+  node_count_ = in.get<int32_t>("a factor's node count");
+  const bool active = in.get<uint8_t>("a factor's flags") != 0;
+  const bool in_flight = in.get<uint8_t>("a factor's flags") != 0;
+  if ((active || node_count_ != 0) && node_count_ != n)
+    fail(Errc::Parse, "a saved factor is of " + std::to_string(node_count_) + " nodes, its body has " +
+                          std::to_string(n) + ": corrupt state");
+  if (active) load_slot(*active_, in, pattern);
+  if (in_flight) {
+    load_slot(*pending_, in, pattern);
+    std::promise<void> done;  // factored now: adopted on the schedule it was launched with
+    done.set_value();
+    job_ = done.get_future().share();
+  }
+  const uint64_t count = in.get<uint64_t>("the cached columns");
+  if (count > uint64_t(std::max<int64_t>(n, 0))) fail(Errc::Parse, "more cached columns than nodes: corrupt state");
+  for (uint64_t k = 0; k < count; ++k) {
+    const int32_t node = in.get<int32_t>("a cached column");
+    const int64_t rows = in.get<int64_t>("a cached column");
+    if (node < 0 || node >= n || rows != 3 * n)
+      fail(Errc::Parse, "a cached column does not fit its body: corrupt state");
+    Eigen::MatrixXd cols(rows, 3);
+    in.get_bytes(cols.data(), size_t(cols.size()) * sizeof(double), "a cached column");
+    columns_[node] = std::move(cols);
+  }
 }
 
 void LaggedFactor::solve(const Vec3List& in, Vec3List& out) const {

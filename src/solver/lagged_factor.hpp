@@ -16,6 +16,7 @@
 #include <memory>
 #include <unordered_map>
 
+#include "core/byte_stream.hpp"
 #include "fem/fem_model.hpp"
 #include "solver/direct_solver.hpp"
 #include "solver/pcg.hpp"
@@ -72,11 +73,18 @@ class LaggedFactor {
   void begin();
   void commit();
   void rollback();
+  // What a later solve depends on (World::save_state), between steps only: the key and refresh
+  // schedule, the systems the factor in use and the one in flight were made from (each slot
+  // keeps a copy), and the cached columns. load() into a fresh LaggedFactor reads it back and
+  // factors those systems again (the same matrix factors to the same bits); it throws
+  // Error(Parse) on a state that does not fit `pattern`.
+  void save(ByteWriter& out) const;
+  void load(ByteReader& in, const BlockPattern& pattern);
 
  private:
   struct Slot {
     DirectSolver direct;
-    BlockValues A;            // the copy the worker factors
+    BlockValues A;            // the system factored (a copy: the worker factors it; a saved state keeps it)
     Projection projection;
     std::vector<Mat3> rotation;  // R_f per node (empty: identity)
     int64_t born = -1;           // the solve whose system it is
@@ -87,6 +95,8 @@ class LaggedFactor {
   void launch(const BlockPattern& pattern);  // the background factorization of *pending_
   Slot& writable_active();  // active_, or in a step between begin() and its end a slot in its place
   void clear_columns();
+  static void save_slot(const Slot& slot, ByteWriter& out);
+  static void load_slot(Slot& slot, ByteReader& in, const BlockPattern& pattern);
 
   Key key_;
   std::unique_ptr<Slot> active_, pending_;

@@ -15,6 +15,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "core/byte_stream.hpp"
 #include "core/colouring.hpp"
 #include "core/thread_pool.hpp"
 #include "fem/fem_model.hpp"
@@ -103,6 +104,19 @@ class VelocitySolver {
   virtual void begin_step() {}
   virtual void commit_step() {}
   virtual void rollback_step() {}
+  // A saved state (World::save_state), between steps: what the solver keeps for a body that
+  // changes later results (a lagged factor; not a factor of the current matrix, which
+  // World::restore_state makes the solver redo by bumping the body's matrix_version).
+  virtual void save_body(uint64_t /*key*/, ByteWriter& /*out*/) const {}
+  // Reads, for each body, what save_body wrote, and replaces what the solver keeps for it: all
+  // or nothing (throws with nothing replaced).
+  struct SavedBody {
+    uint64_t key;
+    const FemModel* fem;
+    const uint8_t* data;
+    size_t size;
+  };
+  virtual void restore_bodies(const std::vector<SavedBody>& /*bodies*/) {}
 };
 
 // A solver that keeps a Cache per body (factors, workspaces), by SolverBody::key, made on first
@@ -125,6 +139,18 @@ class CachingVelocitySolver : public VelocitySolver {
   template <class F>
   void for_each_cache(F&& f) {
     for (auto& [key, cache] : caches_) f(*cache);
+  }
+  const Cache* find_cache(uint64_t key) const {
+    const auto it = caches_.find(key);
+    return it == caches_.end() ? nullptr : it->second.get();
+  }
+  // Puts these caches in place of the bodies' (a null one: none); no-throw once reserved.
+  void replace_caches(std::vector<std::pair<uint64_t, std::unique_ptr<Cache>>>& caches) {
+    caches_.reserve(caches_.size() + caches.size());
+    for (auto& [key, cache] : caches) {
+      if (cache) caches_[key] = std::move(cache);
+      else caches_.erase(key);
+    }
   }
 
  private:

@@ -33,8 +33,9 @@ struct BodyModel {
   BodySettings settings;
   std::string name;            // "body 0x..." in messages
   uint64_t key;                // unique in its world, never reused: the solver's caches are keyed by it
-  FemModel fem;
+  FemModel fem;                // rebuilt by World::set_body_materials (same rest shape and tets)
   std::vector<Tet> tets;
+  std::vector<int32_t> regions;  // per tet: the mesh file's region (Gmsh physical tag), else 0
   std::vector<Tri> surface;
   std::vector<int32_t> surface_node_list;  // candidates for contact
   double surface_edge = 0;                 // m, mean surface edge length: the deepest penetration looked for

@@ -80,8 +80,11 @@ StepContext World::begin_step(double h) {
   ctx.pool = pool_.get();
   ctx.h = h;
   ctx.plan = plan();
-  bodies_.for_each([&](Id, Body& b) {
-    if (b.is_dynamic()) ctx.dynamic.push_back(&b);
+  step_bodies_.clear();  // keeps its capacity
+  bodies_.for_each([&](Id id, Body& b) {
+    if (!b.is_dynamic()) return;
+    ctx.dynamic.push_back(&b);
+    step_bodies_.push_back(id);
   });
   return ctx;
 }
@@ -250,6 +253,7 @@ void World::collide(StepContext& ctx) {
   const double h = ctx.h;
   contacts_.clear();
   ctx.tools.clear();
+  step_tools_.clear();
   // Tool velocities from the pose change the host made since the last step.
   tools_.for_each([&](Id, Tool& t) {
     t.velocity = (t.position - t.previous_position) / h;
@@ -271,6 +275,7 @@ void World::collide(StepContext& ctx) {
   });
   tools_.for_each([&](Id tool_id, Tool& t) {
     ctx.tools.push_back(&t);
+    step_tools_.push_back(tool_id);
     for (const SurfaceView& v : views)
       if (v.index >= 0) collide_tool(t, int32_t(ctx.tools.size() - 1), tool_id, v, h, contacts_);
   });

@@ -11,8 +11,7 @@ void World::save_undo() {
   saved_debt_ = debt_;
   saved_tools_.clear();  // keeps its capacity: no allocation once the tool count is reached
   tools_.for_each([&](Id, Tool& t) {
-    saved_tools_.push_back({&t, t.position, t.orientation, t.velocity, t.angular_velocity, t.force, t.torque,
-                            t.stiffness, t.contact_count});
+    saved_tools_.push_back({&t, t.state(), t.scratch()});
   });
   saved_reactions_.clear();
   lpcs_.for_each([&](Id, Lpc& c) { saved_reactions_.push_back(c.reaction); });
@@ -23,15 +22,8 @@ void World::undo() {
   stats_ = saved_stats_;
   debt_ = saved_debt_;
   for (const SavedTool& s : saved_tools_) {
-    Tool& t = *s.tool;
-    t.position = s.position;  // follow_devices moved it
-    t.orientation = s.orientation;
-    t.velocity = s.velocity;
-    t.angular_velocity = s.angular_velocity;
-    t.force = s.force;
-    t.torque = s.torque;
-    t.stiffness = s.stiffness;
-    t.contact_count = s.contact_count;
+    static_cast<ToolState&>(*s.tool) = s.state;  // the pose (follow_devices moved it) and the results
+    static_cast<ToolScratch&>(*s.tool) = s.scratch;
   }
   size_t k = 0;
   lpcs_.for_each([&](Id, Lpc& c) { c.reaction = saved_reactions_[k++]; });

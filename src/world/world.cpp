@@ -116,6 +116,18 @@ void World::set_node_forces(Id id, const std::vector<int32_t>& nodes, const Vec3
   for (const Vec3& f : b.node_forces) b.has_node_forces = b.has_node_forces || !f.isZero(0);
 }
 
+void World::set_body_materials(Id id, const std::vector<Material>& materials) {
+  Body& b = body(id);
+  TetMesh mesh{b.fem.rest, b.tets, b.regions};
+  FemModel rebuilt = build_fem_model(mesh, materials, b.settings.mass, b.name);  // may throw: nothing changed yet
+  solver_->forget(b.key);  // its factors (one may be in the making on the body's pattern) first
+  b.fem = std::move(rebuilt);
+  b.matrix_current = false;  // A and everything factored from it belong to the old materials
+  ++b.matrix_version;
+  b.relin.u_start_known = false;
+  b.relin.modes.clear();
+}
+
 Mat3 constrained_projector(const LpcSpec& spec) {
   auto unit = [](const Vec3& d, const char* what) {
     const double n = d.norm();

@@ -23,6 +23,8 @@ namespace mica {
 
 enum class LogLevel { Error, Warning, Info };
 
+struct StateShape;  // state_io.cpp
+
 constexpr int32_t kMaxThreads = 1024;  // WorldSettings::threads above this is refused
 // The shortest time step World::step takes (s): below it forces (impulse / h) and stiffnesses
 // (1 / h^2) leave double precision.
@@ -125,6 +127,14 @@ class World {
   Body& body(Id id) { return bodies_.get(id, "body"); }
   const Body& body(Id id) const { return bodies_.get(id, "body"); }
   void set_node_forces(Id body, const std::vector<int32_t>& nodes, const Vec3List& forces);
+  // The host moves a body's nodes (node_state.cpp): one finite value per node, else throws with
+  // the world unchanged. Positions drop what was derived from the old ones (see there).
+  void set_positions(Id body, const Vec3List& x);
+  void set_velocities(Id body, const Vec3List& v);
+  // One material per tet: rebuilds the body's model (stiffness, mass, so damping and gravity) and
+  // drops the solver's factors of it; positions and velocities stay. Throws, changing nothing,
+  // for a wrong count or a material out of its domain (the message names the tet).
+  void set_body_materials(Id body, const std::vector<Material>& materials);
   // Numeric factorizations the solver has made of this body's systems so far.
   int64_t factorizations(Id body) const;
 
@@ -160,6 +170,17 @@ class World {
   const std::vector<Contact>& contacts() const { return contacts_; }
   const ContactRows& contact_rows() const { return rows_; }
   const std::vector<double>& impulses() const { return lambda_; }  // per contact row, N s
+  // The ids behind the last step's indices: Contact::a.body / b.body index step_bodies(),
+  // Contact::tool indexes step_tools().
+  const std::vector<Id>& step_bodies() const { return step_bodies_; }
+  const std::vector<Id>& step_tools() const { return step_tools_; }
+
+  // The dynamic state (state_io.cpp): positions, velocities, warm starts, the solver's lagged
+  // factors, tool poses and forces, constraint targets and handles, device filters, counters.
+  // save_state() serialises it; restore_state() checks the buffer whole (header, checksum, the
+  // world's shape) and throws with the world unchanged, or puts the state back.
+  std::vector<uint8_t> save_state() const;
+  void restore_state(const uint8_t* data, size_t size);
 
   // One implicit step of h seconds. Throws Error(Numerical) and keeps the old state when
   // the result is not finite.
@@ -202,6 +223,8 @@ class World {
   void save_undo();
   void undo();
 
+  void state_shape(StateShape& out) const;  // state_io.cpp
+
   bool needs_loads(const Body& b) const;
   bool needs_damping(const Body& b) const;
 
@@ -214,6 +237,7 @@ class World {
   std::vector<Contact> contacts_;
   ContactRows rows_;                                // the rows of G
   std::vector<double> lambda_;                      // impulse per row, N s
+  std::vector<Id> step_bodies_, step_tools_;        // the last step's dynamic bodies and tools, by index
   std::unordered_map<uint64_t, double> warm_start_; // impulses by row key
   struct {  // relinearise: the energy (J) the steps since it last went down added, net
     double committed = 0, pending = 0;
@@ -224,11 +248,8 @@ class World {
   decltype(debt_) saved_debt_;
   struct SavedTool {  // save_undo(): what a failed step puts back
     Tool* tool;
-    Vec3 position;
-    Eigen::Quaterniond orientation;
-    Vec3 velocity, angular_velocity, force, torque;
-    Mat3 stiffness;
-    int32_t contact_count;
+    ToolState state;
+    ToolScratch scratch;
   };
   std::vector<SavedTool> saved_tools_;
   Vec3List saved_reactions_;

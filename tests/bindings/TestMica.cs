@@ -321,6 +321,142 @@ static class TestMica
         }
     }
 
+    // Setting node state, saving and restoring, and the contacts readout.
+    static void StateAndContacts()
+    {
+        var def = Mica.WorldDef();
+        using (var world = new World(def))
+        {
+            var bdef = Mica.BodyDef();
+            bdef.youngs_modulus = 2e4;
+            var body = world.CreateBox(new double[] { 0, 0, 0 }, new double[] { 0.1, 0.1, 0.1 }, new[] { 2, 2, 2 }, 5, bdef);
+            var bottom = body.SelectNodesByPlane(new double[] { 0, 0, 0 }, new double[] { 0, 1, 0 }, 1e-9, true);
+            var ldef = Mica.LpcDef();
+            ulong lpc;
+            Mica.Check(MicaNative.mica_add_lpc(world.Handle, body.Id, bottom, bottom.Length, ref ldef, out lpc), world.Handle);
+            var tdef = Mica.ToolDef();
+            unsafe { tdef.radius = 0.02; tdef.position[0] = 0.05; tdef.position[1] = 0.1205; tdef.position[2] = 0.05; }
+            var tool = world.CreateTool(tdef);
+            // Set and read back.
+            var x = body.GetPositions();
+            var moved = (double[])x.Clone();
+            for (int i = 0; i < moved.Length; ++i) moved[i] += 1e-4;
+            body.SetPositions(moved);
+            Expect(body.GetPositions().SequenceEqual(moved), "positions read back");
+            body.SetPositions(x);
+            body.SetVelocities(new double[x.Length]);
+            try
+            {
+                body.SetVelocities(new double[3]);
+                Expect(false, "a wrong node count throws");
+            }
+            catch (MicaException e)
+            {
+                Expect(e.Status == MicaNative.MICA_ERR_INVALID_ARGUMENT, "MICA_ERR_INVALID_ARGUMENT");
+            }
+            // Save, run, restore, run again: the same bits.
+            Func<int, List<double>> run = first =>
+            {
+                var record = new List<double>();
+                for (int k = first; k < first + 10; ++k)
+                {
+                    tool.SetPose(new double[] { 0.05, 0.1205 - 0.0003 * Math.Min(k, 15), 0.05 }, new double[] { 1, 0, 0, 0 });
+                    world.Step(0.01);
+                    record.AddRange(body.GetPositions());
+                    record.AddRange(tool.GetForce());
+                }
+                return record;
+            };
+            run(0);
+            var state = world.SaveState();
+            var a = run(10);
+            world.RestoreState(state);
+            var b = run(10);
+            Expect(a.Select(BitConverter.DoubleToInt64Bits).SequenceEqual(b.Select(BitConverter.DoubleToInt64Bits)),
+                   "the restored run repeats the first bit for bit");
+            // The contacts add up to the tool force.
+            var force = tool.GetForce();
+            var contacts = world.GetContacts();
+            Expect(contacts.Length > 0 && force[1] > 0, "the tool is pressing");
+            double sum = 0;
+            unsafe
+            {
+                foreach (var c in contacts)
+                {
+                    var k = c;
+                    sum += k.normal[1] * k.normal_impulse + k.tangent_impulse[1];
+                }
+            }
+            Expect(Math.Abs(sum / 0.01 + force[1]) <= 1e-12 * Math.Abs(force[1]) * contacts.Length,
+                   "the contacts sum to the tool force");
+            try
+            {
+                world.RestoreState(state.Take(state.Length - 1).ToArray());
+                Expect(false, "a truncated state throws");
+            }
+            catch (MicaException e)
+            {
+                Expect(e.Status == MicaNative.MICA_ERR_PARSE, "MICA_ERR_PARSE");
+            }
+    // A box held on a uniform stretch eps along x, nu = 0: strain eps and von Mises E eps in every
+    // tet; node masses sum to density x volume; doubling E doubles the stress; regions of a file.
+    static void RegionsMaterialsAndFields()
+    {
+        double eps = 1e-3, E = 2e4, rho = 1100;
+        var wdef = Mica.WorldDef();
+        unsafe { wdef.gravity[1] = 0; }
+        using (var world = new World(wdef))
+        {
+            var bdef = Mica.BodyDef();
+            bdef.youngs_modulus = E;
+            bdef.poisson_ratio = 0;
+            bdef.density = rho;
+            var box = world.CreateBox(new double[] { 0, 0, 0 }, new double[] { 0.1, 0.05, 0.05 }, new[] { 2, 1, 1 }, 5, bdef);
+            int nodes, tets, triangles;
+            box.GetCounts(out nodes, out tets, out triangles);
+            Expect(box.GetTets().Length == 4 * tets, "4 indices a tet");
+            Expect(box.GetTetRegions().All(r => r == 0), "a box has region 0");
+            Expect(Math.Abs(box.GetNodeMasses().Sum() - rho * 0.1 * 0.05 * 0.05) < 1e-15, "node masses sum to rho V");
+            var rest = new double[3 * nodes];
+            int count;
+            Mica.Check(MicaNative.mica_body_get_rest_positions(world.Handle, box.Id, rest, nodes, out count), world.Handle);
+            var all = Enumerable.Range(0, nodes).ToArray();
+            var lpc = box.AddLpc(all, Mica.LpcDef());
+            var targets = new double[3 * nodes];
+            for (int i = 0; i < nodes; ++i)
+            {
+                targets[3 * i] = rest[3 * i] * (1 + eps);
+                targets[3 * i + 1] = rest[3 * i + 1];
+                targets[3 * i + 2] = rest[3 * i + 2];
+            }
+            Mica.Check(MicaNative.mica_lpc_set_targets(world.Handle, lpc.Id, targets, nodes), world.Handle);
+            world.Step(0.01);
+            var strains = box.GetStrains();
+            var vm = box.GetVonMises();
+            Expect(strains.Length == 6 * tets && vm.Length == tets, "6 strains and 1 stress a tet");
+            for (int e = 0; e < tets; ++e)
+            {
+                Expect(Math.Abs(strains[6 * e] - eps) < 1e-12, "strain xx = eps");
+                for (int c = 1; c < 6; ++c) Expect(Math.Abs(strains[6 * e + c]) < 1e-12, "other strains 0");
+                Expect(Math.Abs(vm[e] - E * eps) < 1e-9 * E * eps, "von Mises = E eps");
+            }
+            box.SetMaterials(Enumerable.Repeat(2 * E, tets).ToArray());
+            Expect(Math.Abs(box.GetVonMises()[0] - 2 * E * eps) < 1e-9 * E * eps, "twice E, twice the stress");
+            var bad = Enumerable.Repeat(rho, tets).ToArray();
+            bad[3] = -1;
+            try { box.SetMaterials(null, null, bad); Expect(false, "a negative density raises"); }
+            catch (MicaException e)
+            {
+                Expect(e.Status == MicaNative.MICA_ERR_INVALID_ARGUMENT && e.LibraryMessage.Contains("tet 3"), "names tet 3: " + e.LibraryMessage);
+            }
+            string mesh = Path.Combine(Environment.GetEnvironmentVariable("MICA_SOURCE_DIR"), "tests", "data", "two_regions_v41.msh");
+            var fdef = Mica.BodyDef();
+            unsafe { fdef.translation[0] = 2; }
+            var cube = world.CreateBodyFromFile(mesh, fdef);
+            Expect(cube.GetTetRegions().SequenceEqual(new[] { 7, 7, 7, 9, 9, 0 }), "Gmsh physical tags");
+        }
+    }
+
     // User code in its own assembly: a mesh from a file, and an id from the raw layer wrapped.
     static void LoaderAndRawIds()
     {
@@ -442,10 +578,12 @@ static class TestMica
         Test("drift: struct sizes, field offsets, sizes and types", DriftStructs);
         Test("drift: callbacks and constants", DriftCallbacksAndConstants);
         Test("defaults, views and stats", DefaultsAndViews);
+        Test("node state, saved state and contacts", StateAndContacts);
         Test("errors, the log callback and the SafeHandle", Errors);
         Test("sphere indent matches C to 1e-9", SphereIndent);
         Test("a device backend in C#", DeviceBackendInCSharp);
         Test("a mesh file and raw ids, from another assembly", LoaderAndRawIds);
+        Test("tissue regions, materials and fields", RegionsMaterialsAndFields);
         Test("System.Numerics Vector3 and Quaternion overloads", NumericsOverloads);
         Console.WriteLine("{0} passed, {1} failed, {2} skipped", passed, failed, skipped);
         return failed == 0 ? 0 : 1;

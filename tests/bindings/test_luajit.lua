@@ -261,5 +261,104 @@ test("loaders, grasp and constraint helpers", function()
   world:close()
 end)
 
+test("node state, saved state and contacts", function()
+  local world = mica.world{ gravity = { 0, -9.81, 0 } }
+  local box = world:create_box({ 0, 0, 0 }, { 0.1, 0.1, 0.1 }, { 2, 2, 2 }, 5, { youngs_modulus = 2e4 })
+  local bottom, n = world:select_nodes_by_plane(box, { 0, 0, 0 }, { 0, 1, 0 })
+  world:add_lpc(box, bottom, n)
+  local tool = world:create_tool{ radius = 0.02, position = { 0.05, 0.1205, 0.05 } }
+  local nodes = ffi.new("int32_t[1]")
+  world:check(C.mica_body_get_counts(world.ptr, box, nodes, nil, nil))
+  -- Set and read back.
+  local x, n3 = world:positions(box)
+  local moved = {}
+  for i = 0, 3 * n3 - 1 do moved[i + 1] = x[i] + 1e-4 end
+  world:set_positions(box, moved)
+  x = world:positions(box)
+  for i = 0, 3 * n3 - 1 do expect(x[i] == moved[i + 1], "a position reads back") end
+  for i = 1, #moved do moved[i] = moved[i] - 1e-4 end
+  world:set_positions(box, moved)
+  local zeros = {}
+  for i = 1, #moved do zeros[i] = 0 end
+  world:set_velocities(box, zeros)
+  local ok, err = pcall(world.set_velocities, world, box, { 0, 0, 0 })
+  expect(not ok and err.status == C.MICA_ERR_INVALID_ARGUMENT, "a wrong node count raises")
+  -- Save, run, restore, run again: the same bits.
+  local function run(first)
+    local out = {}
+    for k = first, first + 9 do
+      world:set_tool_pose(tool, { 0.05, 0.1205 - 0.0003 * math.min(k, 15), 0.05 })
+      world:step(0.01)
+      local p, count = world:positions(box)
+      out[#out + 1] = ffi.string(p, 24 * count) .. ffi.string(world:tool_force(tool), 24)
+    end
+    return table.concat(out)
+  end
+  run(0)
+  local state = world:save_state()
+  local a = run(10)
+  world:restore_state(state)
+  local b = run(10)
+  expect(a == b, "the restored run repeats the first bit for bit")
+  -- The contacts add up to the tool force.
+  local contacts, count = world:contacts()
+  local force = world:tool_force(tool)
+  expect(count > 0 and force[1] > 0, "the tool is pressing")
+  local sum = 0
+  for c = 0, count - 1 do sum = sum + contacts[c].normal[1] * contacts[c].normal_impulse + contacts[c].tangent_impulse[1] end
+  expect(math.abs(sum / 0.01 + force[1]) <= 1e-12 * math.abs(force[1]) * count, "the contacts sum to the tool force")
+  ok, err = pcall(world.restore_state, world, state:sub(1, #state - 1))
+  expect(not ok and err.status == C.MICA_ERR_PARSE, "a truncated state raises MICA_ERR_PARSE")
+test("tissue regions, materials and fields", function()
+  -- A box held on a uniform stretch eps along x, nu = 0: strain eps and von Mises E eps in every
+  -- tet; node masses sum to density x volume; doubling E doubles the stress.
+  local eps, E, rho = 1e-3, 2e4, 1100
+  local world = mica.world{ gravity = { 0, 0, 0 } }
+  local box = world:create_box({ 0, 0, 0 }, { 0.1, 0.05, 0.05 }, { 2, 1, 1 }, 5,
+                               { youngs_modulus = E, poisson_ratio = 0, density = rho })
+  local tets, t = world:tets(box)
+  expect(t == 10 and tets[4 * t - 1] >= 0, "10 tets of 4 nodes")
+  local regions = world:tet_regions(box)
+  for e = 0, t - 1 do expect(regions[e] == 0, "a box has region 0") end
+  local masses, n = world:node_masses(box)
+  local total = 0
+  for i = 0, n - 1 do total = total + masses[i] end
+  expect(math.abs(total - rho * 0.1 * 0.05 * 0.05) < 1e-15, "node masses sum to rho V")
+  local all, targets = ffi.new("int32_t[?]", n), {}
+  local rest = ffi.new("double[?]", 3 * n)
+  world:check(C.mica_body_get_rest_positions(world.ptr, box, rest, n, nil))
+  for i = 0, n - 1 do
+    all[i] = i
+    targets[#targets + 1] = rest[3 * i] * (1 + eps)
+    targets[#targets + 1] = rest[3 * i + 1]
+    targets[#targets + 1] = rest[3 * i + 2]
+  end
+  world:set_lpc_targets(world:add_lpc(box, all, n), targets)
+  world:step(0.01)
+  local strains = world:strains(box)
+  local vm = world:von_mises(box)
+  for e = 0, t - 1 do
+    expect(math.abs(strains[6 * e] - eps) < 1e-12, "strain xx = eps")
+    for c = 1, 5 do expect(math.abs(strains[6 * e + c]) < 1e-12, "other strains 0") end
+    expect(math.abs(vm[e] - E * eps) < 1e-9 * E * eps, "von Mises = E eps")
+  end
+  local stiff = {}
+  for e = 1, t do stiff[e] = 2 * E end
+  world:set_materials(box, stiff)
+  vm = world:von_mises(box)
+  expect(math.abs(vm[0] - 2 * E * eps) < 1e-9 * E * eps, "twice E, twice the stress")
+  local bad = {}
+  for e = 1, t do bad[e] = rho end
+  bad[4] = -1
+  local ok, err = pcall(world.set_materials, world, box, nil, nil, bad)
+  expect(not ok and err.status == C.MICA_ERR_INVALID_ARGUMENT and err.message:find("tet 3"), "a bad density names its tet")
+  local cube = world:create_body_from_file(os.getenv("MICA_SOURCE_DIR") .. "/tests/data/two_regions_v41.msh",
+                                           { translation = { 2, 0, 0 } })
+  local r = world:tet_regions(cube)
+  local want = { 7, 7, 7, 9, 9, 0 }
+  for e = 0, 5 do expect(r[e] == want[e + 1], "Gmsh physical tags") end
+  world:close()
+end)
+
 print(string.format("%d passed, %d failed, %d skipped", passed, failed, skipped))
 os.exit(failed == 0 and 0 or 1)

@@ -279,6 +279,90 @@ class Behaviour(unittest.TestCase):
             self.assertEqual(list(position), [1, 2, 3])
             self.assertEqual(list(orientation), [1, 0, 0, 0])
 
+    def test_node_state_save_restore_and_contacts(self):
+        def scene():
+            world = mica.World(gravity=(0, -9.81, 0))
+            body = world.create_box((0, 0, 0), (0.1, 0.1, 0.1), (3, 3, 3), youngs_modulus=2e4)
+            body.add_lpc(body.select_nodes_by_plane((0, 0, 0), (0, 1, 0)))
+            tool = world.create_tool(radius=0.02, position=(0.05, 0.1205, 0.05), friction=0.3)
+            return world, body, tool
+
+        def run(world, body, tool, first, steps):
+            xs, fs = [], []
+            for k in range(first, first + steps):
+                tool.set_pose((0.05 + 0.0002 * k, 0.1205 - 0.0002 * min(k, 20), 0.05), (1, 0, 0, 0))
+                world.step(0.01)
+                xs.append(body.get_positions())
+                fs.append(np.array(tool.force()[0]))
+            return np.array(xs), np.array(fs)
+
+        world, body, tool = scene()
+        with world:
+            # Set and read back.
+            x = body.rest_positions() + 1e-4
+            body.set_positions(x)
+            np.testing.assert_array_equal(body.get_positions(), x)
+            v = np.full_like(x, 0.001)
+            body.set_velocities(v)
+            np.testing.assert_array_equal(body.velocities(), v)
+            body.set_positions(body.rest_positions())
+            body.set_velocities(np.zeros_like(x))
+            with self.assertRaises(mica.MicaError) as caught:
+                body.set_positions(x[:-1])
+            self.assertEqual(caught.exception.status, mica.MICA_ERR_INVALID_ARGUMENT)
+            # Save, run, restore, run again: the same bits.
+            run(world, body, tool, 0, 15)
+            state = world.save_state()
+            xa, fa = run(world, body, tool, 15, 15)
+            world.restore_state(state)
+            xb, fb = run(world, body, tool, 15, 15)
+            self.assertEqual(xa.tobytes(), xb.tobytes())
+            self.assertEqual(fa.tobytes(), fb.tobytes())
+            self.assertGreater(fa[-1][1], 0, "the tool is pressing")
+            # The contacts add up to the tool force.
+            impulse = np.zeros(3)
+            for c in world.contacts():
+                self.assertEqual(c.other_kind, mica.MICA_CONTACT_OTHER_TOOL)
+                impulse += np.array(c.normal) * c.normal_impulse + np.array(c.tangent_impulse)
+            np.testing.assert_allclose(impulse / 0.01, -fb[-1], rtol=1e-12, atol=1e-12 * np.abs(fb[-1]).sum())
+            # A truncated state is refused.
+            with self.assertRaises(mica.MicaError) as caught:
+                world.restore_state(state[:-1])
+            self.assertEqual(caught.exception.status, mica.MICA_ERR_PARSE)
+
+    def test_regions_materials_and_fields(self):
+        # A box held on a uniform stretch eps along x, nu = 0: strain (eps, 0...) and von Mises
+        # E eps in every tet; node masses sum to density x volume; doubling E doubles the stress.
+        eps, E, rho = 1e-3, 2e4, 1100
+        with mica.World(gravity=(0, 0, 0)) as world:
+            body = world.create_box((0, 0, 0), (0.1, 0.05, 0.05), (2, 1, 1), 5, youngs_modulus=E,
+                                    poisson_ratio=0, density=rho)
+            nodes, tets, _ = body.counts()
+            self.assertEqual(body.tets().shape, (tets, 4))
+            self.assertTrue(np.all(body.tet_regions() == 0))
+            self.assertAlmostEqual(body.node_masses().sum(), rho * 0.1 * 0.05 * 0.05, delta=1e-15)
+            rest = body.rest_positions()
+            lpc = body.add_lpc(np.arange(nodes))
+            lpc.set_targets(rest * (1 + eps, 1, 1))
+            world.step(0.01)
+            strains = body.strains()
+            self.assertEqual(strains.shape, (tets, 6))
+            np.testing.assert_allclose(strains, np.tile([eps, 0, 0, 0, 0, 0], (tets, 1)), atol=1e-12)
+            np.testing.assert_allclose(body.von_mises(), E * eps, rtol=1e-9)
+            body.set_materials(youngs_modulus=np.full(tets, 2 * E))
+            np.testing.assert_allclose(body.von_mises(), 2 * E * eps, rtol=1e-9)
+            with self.assertRaises(ValueError):
+                body.set_materials(density=[rho])
+            bad = np.full(tets, rho)
+            bad[3] = -1
+            with self.assertRaises(mica.MicaError) as e:
+                body.set_materials(density=bad)
+            self.assertEqual(e.exception.status, mica.MICA_ERR_INVALID_ARGUMENT)
+            self.assertIn("tet 3", e.exception.message)
+            data = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "data")
+            cube = world.create_body_from_file(os.path.join(data, "two_regions_v41.msh"), translation=(2, 0, 0))
+            self.assertEqual(list(cube.tet_regions()), [7, 7, 7, 9, 9, 0])
+
     def test_library_found_next_to_the_build_tree(self):
         # The package copied into <build>/bindings/python finds <build>/libmica without help.
         pkg = os.path.join(os.environ["MICA_BINDINGS_BUILD_DIR"], "python")

@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /* Bad input to capi/body.cpp through the C ABI: the three body creators and their def, meshes
- * and mesh files, node forces, selections, getters and their buffers, stale body ids. The checks
+ * and mesh files, node forces, selections, materials per tet, getters and their buffers, stale
+ * body ids. The checks
  * are in bad_input_util.h. */
 #include "bad_input_util.h"
 
@@ -22,6 +23,12 @@ enum body_call {
   SELECT_IN_BOX,
   SELECT_BY_PLANE,
   GET_ENERGY,
+  GET_TETS,
+  GET_TET_REGIONS,
+  SET_MATERIALS,
+  GET_NODE_MASSES,
+  GET_STRAINS,
+  GET_VON_MISES,
   WORLDLESS_BODY_CALLS, /* the calls above are also made without a world */
   SIZE_QUERY = WORLDLESS_BODY_CALLS,
   CLEAR_FORCES,
@@ -60,6 +67,12 @@ static mica_status call_on_body(bad_call* c, mica_world* w, mica_body_id id, int
     case SELECT_IN_BOX: CALL(mica_body_select_nodes_in_box, (w, id, kLo, kHi, 1, ibuf, 256, &count)); break;
     case SELECT_BY_PLANE: CALL(mica_body_select_nodes_by_plane, (w, id, v3, n3, 0.0, 1, ibuf, 256, &count)); break;
     case GET_ENERGY: CALL(mica_body_get_energy, (w, id, &e1, &e2, &e3)); break;
+    case GET_TETS: CALL(mica_body_get_tets, (w, id, ibuf, 192, &count)); break;
+    case GET_TET_REGIONS: CALL(mica_body_get_tet_regions, (w, id, ibuf, 256, &count)); break;
+    case SET_MATERIALS: CALL(mica_body_set_materials, (w, id, NULL, NULL, NULL, 18)); break;
+    case GET_NODE_MASSES: CALL(mica_body_get_node_masses, (w, id, buf, 64, &count)); break;
+    case GET_STRAINS: CALL(mica_body_get_strains, (w, id, buf, 32, &count)); break;
+    case GET_VON_MISES: CALL(mica_body_get_von_mises, (w, id, buf, 64, &count)); break;
     case SIZE_QUERY: CALL(mica_body_get_positions, (w, id, NULL, 0, &count)); break;
     case CLEAR_FORCES: CALL(mica_body_set_node_forces, (w, id, NULL, NULL, 0)); break;
     case ADD_LPC: CALL(mica_add_lpc, (w, id, nodes, 1, &ld, &out_lpc)); break;
@@ -157,6 +170,11 @@ static mica_status nowhere_to_answer(bad_call* c) {
     case GET_VELOCITIES: return mica_body_get_velocities(w, b, NULL, 0, NULL);
     case GET_REST_POSITIONS: return mica_body_get_rest_positions(w, b, NULL, 0, NULL);
     case GET_SURFACE: return mica_body_get_surface(w, b, NULL, 0, NULL);
+    case GET_TETS: return mica_body_get_tets(w, b, NULL, 0, NULL);
+    case GET_TET_REGIONS: return mica_body_get_tet_regions(w, b, NULL, 0, NULL);
+    case GET_NODE_MASSES: return mica_body_get_node_masses(w, b, NULL, 0, NULL);
+    case GET_STRAINS: return mica_body_get_strains(w, b, NULL, 0, NULL);
+    case GET_VON_MISES: return mica_body_get_von_mises(w, b, NULL, 0, NULL);
     default: {
       int32_t count = 0;
       return mica_body_positions_view(w, b, NULL, &count);
@@ -193,6 +211,16 @@ static const bad_case kNullCases[] = {
      .with.arg = GET_REST_POSITIONS},
     {"mica_body_get_surface: nowhere to answer", nowhere_to_answer, MICA_ERR_NULL_ARGUMENT, "out_count",
      .with.arg = GET_SURFACE},
+    {"mica_body_get_tets: nowhere to answer", nowhere_to_answer, MICA_ERR_NULL_ARGUMENT, "out_count",
+     .with.arg = GET_TETS},
+    {"mica_body_get_tet_regions: nowhere to answer", nowhere_to_answer, MICA_ERR_NULL_ARGUMENT, "out_count",
+     .with.arg = GET_TET_REGIONS},
+    {"mica_body_get_node_masses: nowhere to answer", nowhere_to_answer, MICA_ERR_NULL_ARGUMENT, "out_count",
+     .with.arg = GET_NODE_MASSES},
+    {"mica_body_get_strains: nowhere to answer", nowhere_to_answer, MICA_ERR_NULL_ARGUMENT, "out_count",
+     .with.arg = GET_STRAINS},
+    {"mica_body_get_von_mises: nowhere to answer", nowhere_to_answer, MICA_ERR_NULL_ARGUMENT, "out_count",
+     .with.arg = GET_VON_MISES},
     {"mica_body_positions_view: NULL out", nowhere_to_answer, MICA_ERR_NULL_ARGUMENT, "out",
      .with.arg = POSITIONS_VIEW},
     {"mica_body_set_node_forces: NULL nodes", set_node_forces_with_null, MICA_ERR_NULL_ARGUMENT, "nodes",
@@ -666,7 +694,36 @@ static mica_status select_by_plane_bad_rest(bad_call* c) {
   return select_by_plane(c, zero, n3, 0.0, kBadRest[c->i]);
 }
 
+/* mica_body_set_materials: one property of one tet (.with.arg: E 0, nu 1, rho 2) out of its
+ * domain, the others the fixture's defaults; the message names the tet. */
+static const double kBadMaterial[3][4] = {{0, -1e4, NAN, INFINITY}, {0.5, -0.1, NAN, INFINITY}, {0, -1, NAN, INFINITY}};
+static const int32_t kBadMaterialTet[3] = {5, 17, 0};
+static mica_status set_bad_material(bad_call* c) {
+  double values[3][18];
+  const double defaults[3] = {1e4, 0.3, 1000};
+  for (int p = 0; p < 3; ++p)
+    for (int e = 0; e < 18; ++e) values[p][e] = defaults[p];
+  const int32_t tet = kBadMaterialTet[c->with.arg];
+  values[c->with.arg][tet] = kBadMaterial[c->with.arg][c->i];
+  bad_needle(c, 0, "tet %d", tet);
+  return mica_body_set_materials(c->fx->world, c->fx->body, values[0], values[1], values[2], 18);
+}
+static const int32_t kBadTetCountForMaterials[] = {17, 19, 0, -1, INT32_MIN, INT32_MAX};
+static mica_status set_materials_bad_count(bad_call* c) {
+  double E[18];
+  for (int e = 0; e < 18; ++e) E[e] = 2e4;
+  return mica_body_set_materials(c->fx->world, c->fx->body, E, NULL, NULL, kBadTetCountForMaterials[c->i]);
+}
+
 static const bad_case kForceAndSelectionCases[] = {
+    {"mica_body_set_materials: youngs_modulus of tet 5", set_bad_material, MICA_ERR_INVALID_ARGUMENT, "Young's", 4,
+     .with.arg = 0},
+    {"mica_body_set_materials: poisson_ratio of tet 17", set_bad_material, MICA_ERR_INVALID_ARGUMENT, "Poisson", 4,
+     .with.arg = 1},
+    {"mica_body_set_materials: density of tet 0", set_bad_material, MICA_ERR_INVALID_ARGUMENT, "density", 4,
+     .with.arg = 2},
+    {"mica_body_set_materials: tet_count", set_materials_bad_count, MICA_ERR_INVALID_ARGUMENT, "tet_count",
+     COUNT_OF(kBadTetCountForMaterials)},
     {"mica_body_set_node_forces: non-finite", set_nonfinite_force, MICA_ERR_INVALID_ARGUMENT, NULL, 18},
     {"mica_body_set_node_forces: node out of range at position 0", set_force_on_bad_node, MICA_ERR_OUT_OF_RANGE,
      "position 0", 3, .with.arg = 0},
@@ -706,13 +763,15 @@ static int32_t capacity(int too_small, int i, int32_t needed) {
 
 /* A node getter (the row's) with capacity(too_small, i); without out_count when !with_count. */
 static mica_status node_getter_short(bad_call* c, int too_small, int i, int with_count) {
-  const int32_t n = c->fx->node_count;
-  double* buf = malloc(sizeof(double) * 3 * (size_t)n);
-  for (int32_t k = 0; k < 3 * n; ++k) buf[k] = SENTINEL_D;
+  int32_t n = -1; /* nodes, or tets for the per-tet getters: the size query says */
+  const mica_status query = c->with.nodes(c->fx->world, c->fx->body, NULL, 0, &n);
+  if (query != MICA_OK || n <= 0) return bad_wrong(c, "the size query gave %d, %d", query, n), query;
+  double* buf = malloc(sizeof(double) * 6 * (size_t)n);
+  for (int32_t k = 0; k < 6 * n; ++k) buf[k] = SENTINEL_D;
   int32_t out_count = SENTINEL_I;
   if (too_small && with_count) bad_needle(c, 0, "%d", n);
   const mica_status s = doubles_unwritten(
-      c, buf, 3 * (size_t)n,
+      c, buf, 6 * (size_t)n,
       c->with.nodes(c->fx->world, c->fx->body, buf, capacity(too_small, i, n), with_count ? &out_count : NULL));
   if (too_small && with_count && out_count != n)
     bad_wrong(c, "*out_count is %d, want the needed count %d", out_count, n);
@@ -757,11 +816,40 @@ static mica_status get_by_plane(fixture* fx, int32_t* out, int32_t capacity, int
   const double p[3] = {0.15, 0, 0}, n[3] = {1, 0, 0};
   return mica_body_select_nodes_by_plane(fx->world, fx->body, p, n, 1e-9, 0, out, capacity, out_count);
 }
+static mica_status get_tets(fixture* fx, int32_t* out, int32_t capacity, int32_t* out_count) {
+  return mica_body_get_tets(fx->world, fx->body, out, capacity, out_count);
+}
+static mica_status get_tet_regions(fixture* fx, int32_t* out, int32_t capacity, int32_t* out_count) {
+  return mica_body_get_tet_regions(fx->world, fx->body, out, capacity, out_count);
+}
 static const index_list kSurface = {"mica_body_get_surface", get_surface, 3};
+static const index_list kTets = {"mica_body_get_tets", get_tets, 4};
+static const index_list kTetRegions = {"mica_body_get_tet_regions", get_tet_regions, 1};
 static const index_list kInBox = {"mica_body_select_nodes_in_box", get_in_box, 1};
 static const index_list kByPlane = {"mica_body_select_nodes_by_plane", get_by_plane, 1};
 
 static const bad_case kBufferCases[] = {
+    {"mica_body_get_tets: capacity too small", indices_too_small, MICA_ERR_BUFFER_TOO_SMALL, NULL, 2,
+     {.indices = &kTets}},
+    {"mica_body_get_tet_regions: capacity too small", indices_too_small, MICA_ERR_BUFFER_TOO_SMALL, NULL, 2,
+     {.indices = &kTetRegions}},
+    {"mica_body_get_tets: negative capacity", indices_negative, MICA_ERR_INVALID_ARGUMENT, NULL, 2, {.indices = &kTets}},
+    {"mica_body_get_tet_regions: negative capacity", indices_negative, MICA_ERR_INVALID_ARGUMENT, NULL, 2,
+     {.indices = &kTetRegions}},
+    {"mica_body_get_node_masses: capacity too small", nodes_too_small, MICA_ERR_BUFFER_TOO_SMALL, NULL, 2,
+     {.nodes = mica_body_get_node_masses}},
+    {"mica_body_get_strains: capacity too small", nodes_too_small, MICA_ERR_BUFFER_TOO_SMALL, NULL, 2,
+     {.nodes = mica_body_get_strains}},
+    {"mica_body_get_von_mises: capacity too small", nodes_too_small, MICA_ERR_BUFFER_TOO_SMALL, NULL, 2,
+     {.nodes = mica_body_get_von_mises}},
+    {"mica_body_get_strains: capacity too small, no out_count", nodes_too_small_no_count, MICA_ERR_BUFFER_TOO_SMALL,
+     NULL, 1, {.nodes = mica_body_get_strains}},
+    {"mica_body_get_node_masses: negative capacity", nodes_negative, MICA_ERR_INVALID_ARGUMENT, NULL, 2,
+     {.nodes = mica_body_get_node_masses}},
+    {"mica_body_get_strains: negative capacity", nodes_negative, MICA_ERR_INVALID_ARGUMENT, NULL, 2,
+     {.nodes = mica_body_get_strains}},
+    {"mica_body_get_von_mises: negative capacity", nodes_negative, MICA_ERR_INVALID_ARGUMENT, NULL, 2,
+     {.nodes = mica_body_get_von_mises}},
     {"mica_body_get_positions: capacity too small", nodes_too_small, MICA_ERR_BUFFER_TOO_SMALL, NULL, 2,
      {.nodes = mica_body_get_positions}},
     {"mica_body_get_velocities: capacity too small", nodes_too_small, MICA_ERR_BUFFER_TOO_SMALL, NULL, 2,

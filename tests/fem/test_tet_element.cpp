@@ -61,7 +61,7 @@ static void test_rigid_rotation_gives_no_force(void**) {
   const Mat3 Q = rotation_about(Vec3(0.3, -1, 0.5), M_PI / 2);  // 90 degrees
   Vec3List x(m.rest.size());
   for (size_t i = 0; i < x.size(); ++i) x[i] = Q * m.rest[i] + Vec3(1, 2, 3);
-  const double E = m.material.youngs_modulus;
+  const double E = m.materials[0].youngs_modulus;
   double corot = 0, linear = 0;
   for (const Vec3& f : forces(m, x, true)) corot = std::max(corot, f.norm());
   for (const Vec3& f : forces(m, x, false)) linear = std::max(linear, f.norm());

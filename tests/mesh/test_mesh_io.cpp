@@ -243,6 +243,28 @@ void gmsh41_blocks_give_the_same_mesh_as_22(void**) {
   assert_same_mesh(v41, expected_gmsh_mesh());
 }
 
+// The region of a tet: 2.2 its first tag, 4.1 the first physical tag of its volume entity.
+void gmsh_keeps_each_tets_physical_tag(void**) {
+  const std::vector<int32_t> one = {1, 1};
+  assert_true(mica::parse_gmsh(kGmsh22, "t.msh").regions == one);
+  assert_true(mica::parse_gmsh(kGmsh41, "t.msh").regions == one);
+  // 2.2: tags per element, none at all for the second tet.
+  std::string v22 = kGmsh22;
+  v22.replace(v22.find("3 4 2 1 1 10"), 12, "3 4 2 7 1 10");
+  v22.replace(v22.find("4 4 2 1 1 20"), 12, "4 4 0 20");
+  assert_true(mica::parse_gmsh(v22, "t.msh").regions == std::vector<int32_t>({7, 0}));
+  // 4.1: the volume has no physical tag, or another volume has one.
+  std::string untagged = kGmsh41;
+  untagged.replace(untagged.find("1 0 0 0 1 1 1 1 1 0"), 19, "1 0 0 0 1 1 1 0 0");
+  assert_true(mica::parse_gmsh(untagged, "t.msh").regions == std::vector<int32_t>({0, 0}));
+  std::string other = kGmsh41;
+  other.replace(other.find("1 0 0 1\n"), 8, "1 0 0 2\n");
+  other.replace(other.find("1 0 0 0 1 1 1 1 1 0"), 19, "1 0 0 0 1 1 1 1 -4 0\n2 0 0 0 1 1 1 1 12 0");
+  assert_true(mica::parse_gmsh(other, "t.msh").regions == std::vector<int32_t>({-4, -4}));
+  other.replace(other.find("3 1 4 2\n"), 8, "3 2 4 2\n");
+  assert_true(mica::parse_gmsh(other, "t.msh").regions == std::vector<int32_t>({12, 12}));
+}
+
 void gmsh_accepts_crlf_and_blank_lines(void**) {
   std::string crlf;
   for (const std::string& line : split_lines(kGmsh22)) crlf += line + "\r\n\r\n";
@@ -403,6 +425,23 @@ void tetgen_drops_unused_points_and_renumbers(void**) {
       mica::parse_tetgen(kNode1, "1 10 0\n1 1 2 3 4  5 5 5 5 5 5\n", "t.node", "t.ele");
   expected.tets = {{0, 1, 2, 3}};
   assert_same_mesh(m, expected);
+}
+
+// The first tet attribute is the region when every tet's is an integer; otherwise none is.
+void tetgen_region_attributes(void**) {
+  const std::string two = "2 4 2\n0 0 1 2 3 %s 0.5\n1 1 4 2 3 %s 0.25\n";
+  const auto regions = [&](const char* a, const char* b) {
+    char ele[128];
+    std::snprintf(ele, sizeof ele, two.c_str(), a, b);
+    return mica::parse_tetgen("5 3 0 0\n0 0 0 0\n1 1 0 0\n2 0 1 0\n3 0 0 1\n4 1 1 1\n", ele, "t.node", "t.ele")
+        .regions;
+  };
+  assert_true(regions("3", "-2") == std::vector<int32_t>({3, -2}));
+  assert_true(regions("3", "2.5").empty());
+  assert_true(regions("3", "1e10").empty());
+  assert_true(mica::parse_tetgen("4 3 0 0\n0 0 0 0\n1 1 0 0\n2 0 1 0\n3 0 0 1\n", "1 4 0\n0 0 1 2 3\n", "t.node",
+                                 "t.ele")
+                  .regions.empty());  // no attributes
 }
 
 void tetgen_reals_read_like_strtod_in_the_c_locale(void**) {
@@ -770,6 +809,25 @@ void vtk_file_matches_stream_and_reports_io(void**) {
                (bad + ": cannot open for writing").c_str());
 }
 
+// Per-tet scalars follow "piece" in CELL_DATA, both pieces' values in order, read back exactly.
+void vtk_writes_cell_scalars(void**) {
+  const TetMesh m = expected_gmsh_mesh();
+  const std::vector<double> a = {1.0 / 3.0, -2.5}, b = {7, 1e-300};
+  std::ostringstream o;
+  mica::write_vtk(o, {{&m.nodes, &m.tets, {}, {{"von_mises", &a}}}, {&m.nodes, &m.tets, {}, {{"von_mises", &b}}}},
+                  "x");
+  const std::string text = o.str();
+  const std::size_t at = text.find("SCALARS von_mises double 1\nLOOKUP_TABLE default\n");
+  assert_true(at != std::string::npos);
+  assert_true(text.find("SCALARS piece int 1") < at);
+  std::istringstream values(text.substr(text.find("default\n", at) + 8));
+  for (double expected : {a[0], a[1], b[0], b[1]}) {
+    double v = 0;
+    values >> v;
+    assert_true(v == expected);
+  }
+}
+
 void vtk_rejects_inconsistent_pieces(void**) {
   const TetMesh m = expected_gmsh_mesh();
   const std::vector<mica::Tet> bad_tets = {{0, 1, 2, 5}};
@@ -806,6 +864,19 @@ void vtk_rejects_inconsistent_pieces(void**) {
         mica::write_vtk(o, {{nullptr, &m.tets, {}}}, "x");
       },
       Errc::InvalidArgument, "piece 0 has no positions");
+  const std::vector<double> one = {1.0}, two = {1.0, 2.0};
+  expect_error(
+      [&] {
+        std::ostringstream o;
+        mica::write_vtk(o, {{&m.nodes, &m.tets, {}, {{"s", &one}}}}, "x");
+      },
+      Errc::InvalidArgument, "cell scalar 's' needs one value per tet (2)");
+  expect_error(
+      [&] {
+        std::ostringstream o;
+        mica::write_vtk(o, {{&m.nodes, &m.tets, {}, {{"s", &two}}}, {&m.nodes, &m.tets, {}, {}}}, "x");
+      },
+      Errc::InvalidArgument, "write_vtk: piece 1 has 0 cell scalar fields, piece 0 has 1");
   std::ostringstream failed;
   failed.setstate(std::ios::badbit);
   expect_error(
@@ -821,6 +892,7 @@ int main() {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(gmsh22_keeps_tets_and_renumbers_in_file_order),
       cmocka_unit_test(gmsh41_blocks_give_the_same_mesh_as_22),
+      cmocka_unit_test(gmsh_keeps_each_tets_physical_tag),
       cmocka_unit_test(gmsh_accepts_crlf_and_blank_lines),
       cmocka_unit_test(gmsh_truncated_section),
       cmocka_unit_test(gmsh_missing_end_markers),
@@ -835,6 +907,7 @@ int main() {
       cmocka_unit_test(tetgen_ten_node_tets_keep_their_corners),
       cmocka_unit_test(tetgen_keeps_file_orientation),
       cmocka_unit_test(tetgen_drops_unused_points_and_renumbers),
+      cmocka_unit_test(tetgen_region_attributes),
       cmocka_unit_test(tetgen_reals_read_like_strtod_in_the_c_locale),
       cmocka_unit_test(tetgen_dimension_must_be_3),
       cmocka_unit_test(tetgen_node_index_out_of_range),
@@ -849,6 +922,7 @@ int main() {
       cmocka_unit_test(load_mesh_extensions_ignore_case),
       cmocka_unit_test(vtk_round_trips_exactly),
       cmocka_unit_test(vtk_file_matches_stream_and_reports_io),
+      cmocka_unit_test(vtk_writes_cell_scalars),
       cmocka_unit_test(vtk_rejects_inconsistent_pieces),
   };
   return cmocka_run_group_tests_name("mesh_io", tests, nullptr, nullptr);

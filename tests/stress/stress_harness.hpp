@@ -254,9 +254,8 @@ class Monitor {
     // The smallest energy scale that means anything: the strain energy of a 1e-6 strain.
     for (Id id : bodies_) {
       const Body& b = world_.body(id);
-      double volume = 0;
-      for (const TetElement& e : b.fem.elements) volume += e.volume;
-      floor_ += 1e-12 * b.fem.material.youngs_modulus * volume;
+      for (size_t q = 0; q < b.fem.elements.size(); ++q)
+        floor_ += 1e-12 * b.fem.materials[q].youngs_modulus * b.fem.elements[q].volume;
     }
     for (Id id : bodies_) r_.inverted_start += count_inverted(world_.body(id));
     r_.max_inverted = r_.inverted_start;
@@ -482,7 +481,7 @@ class Monitor {
         double frozen = 0;
         for (size_t q = 0; q < b.fem.elements.size(); ++q) {
           const TetElement& el = b.fem.elements[q];
-          frozen += elastic_energy(el, b.fem.lame, b.R[q], deformation_gradient(el, b.x));
+          frozen += elastic_energy(el, b.fem.lame[q], b.R[q], deformation_gradient(el, b.x));
         }
         rotation_update_ += en.elastic - frozen;
       }

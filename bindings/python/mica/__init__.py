@@ -335,6 +335,32 @@ class World:
         self._check(native.mica_world_get_stats(self.handle, byref(s)), "mica_world_get_stats")
         return s
 
+    def save_state(self) -> bytes:
+        """The world's dynamic state (mica_world_save_state), for restore_state()."""
+        size = ctypes.c_size_t()
+        self._check(native.mica_world_state_size(self.handle, byref(size)), "mica_world_state_size")
+        buffer = ctypes.create_string_buffer(size.value)
+        self._check(native.mica_world_save_state(self.handle, buffer, size.value), "mica_world_save_state")
+        return buffer.raw
+
+    def restore_state(self, state: bytes) -> None:
+        """Puts back a state from save_state() (a world of the same shape); raises MicaError
+        with the world unchanged otherwise."""
+        state = bytes(state)
+        self._view_epoch += 1
+        self._check(native.mica_world_restore_state(self.handle, state, len(state)), "mica_world_restore_state")
+
+    def contacts(self) -> list:
+        """The contacts of the last step, a list of mica_contact."""
+        n = c_int32()
+        self._check(native.mica_world_get_contacts(self.handle, None, 0, byref(n)), "mica_world_get_contacts")
+        if n.value == 0:
+            return []
+        out = (native.mica_contact * n.value)()
+        out[0].struct_size = sizeof(native.mica_contact)
+        self._check(native.mica_world_get_contacts(self.handle, out, n.value, byref(n)), "mica_world_get_contacts")
+        return list(out)
+
     def write_vtk(self, path: PathLike) -> None:
         self._check(native.mica_world_write_vtk(self.handle, str(path).encode()), "mica_world_write_vtk")
 
@@ -496,12 +522,63 @@ class Body(_Object):
             self.world.handle, self.id, nodes.ctypes.data_as(POINTER(c_int32)),
             forces.ctypes.data_as(POINTER(c_double)), len(nodes)), "mica_body_set_node_forces")
 
+    def _set_nodes(self, fn, values, name):
+        values = np.ascontiguousarray(values, dtype=np.float64).reshape(-1, 3)
+        self.world._check(fn(self.world.handle, self.id, values.ctypes.data_as(POINTER(c_double)), len(values)), name)
+
+    def set_positions(self, positions: ArrayLike) -> None:
+        """Sets every node's position (m), (n, 3); drops what was derived from the old ones."""
+        self._set_nodes(native.mica_body_set_positions, positions, "mica_body_set_positions")
+
+    def set_velocities(self, velocities: ArrayLike) -> None:
+        """Sets every node's velocity (m/s), (n, 3)."""
+        self._set_nodes(native.mica_body_set_velocities, velocities, "mica_body_set_velocities")
+
     def energy(self) -> Tuple[float, float, float]:
         """(kinetic, elastic, potential) in J."""
         k, e, p = c_double(), c_double(), c_double()
         self.world._check(native.mica_body_get_energy(self.world.handle, self.id, byref(k), byref(e), byref(p)),
                           "mica_body_get_energy")
         return k.value, e.value, p.value
+
+    def tets(self) -> np.ndarray:
+        """The tets (t, 4), 0-based node indices."""
+        return self._get(native.mica_body_get_tets, 4, np.int32, "mica_body_get_tets")
+
+    def tet_regions(self) -> np.ndarray:
+        """Region of each tet (t,): the Gmsh physical tag or TetGen region attribute, else 0."""
+        return self._get(native.mica_body_get_tet_regions, 1, np.int32, "mica_body_get_tet_regions").ravel()
+
+    def set_materials(self, youngs_modulus: Optional[ArrayLike] = None, poisson_ratio: Optional[ArrayLike] = None,
+                      density: Optional[ArrayLike] = None) -> None:
+        """Per tet: Young's modulus (Pa), Poisson ratio, density (kg/m^3); None keeps that property.
+        Rebuilds the body's stiffness, mass and damping."""
+        tets = self.counts()[1]
+        arrays = []
+        for name, values in (("youngs_modulus", youngs_modulus), ("poisson_ratio", poisson_ratio),
+                             ("density", density)):
+            if values is None:
+                arrays.append(None)
+                continue
+            a = np.ascontiguousarray(values, dtype=np.float64).ravel()
+            if len(a) != tets:
+                raise ValueError(f"{name}: one value per tet ({tets}), got {len(a)}")
+            arrays.append(a)
+        pointers = [None if a is None else a.ctypes.data_as(POINTER(c_double)) for a in arrays]
+        self.world._check(native.mica_body_set_materials(self.world.handle, self.id, *pointers, tets),
+                          "mica_body_set_materials")
+
+    def node_masses(self) -> np.ndarray:
+        """Mass of each node (n,), kg: the row sums of the mass matrix."""
+        return self._get(native.mica_body_get_node_masses, 1, np.float64, "mica_body_get_node_masses").ravel()
+
+    def strains(self) -> np.ndarray:
+        """Strain of each tet (t, 6): xx, yy, zz, yz, xz, xy (tensor shears), co-rotated."""
+        return self._get(native.mica_body_get_strains, 6, np.float64, "mica_body_get_strains")
+
+    def von_mises(self) -> np.ndarray:
+        """Von Mises stress of each tet (t,), Pa."""
+        return self._get(native.mica_body_get_von_mises, 1, np.float64, "mica_body_get_von_mises").ravel()
 
     def add_lpc(self, nodes: ArrayLike, definition: Optional[native.mica_lpc_def] = None, **fields: Any) -> Lpc:
         """A projection constraint on `nodes` (kind=MICA_LPC_FIXED by default)."""

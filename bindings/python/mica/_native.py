@@ -8,11 +8,11 @@ import ctypes
 import ctypes.util
 import os
 from ctypes import (CFUNCTYPE, POINTER, Structure, c_char, c_char_p, c_double, c_int32, c_int64,
-                    c_uint32, c_uint64, c_void_p)
+                    c_size_t, c_uint32, c_uint64, c_void_p)
 
 # --- Constants (mica.h)
 MICA_VERSION_MAJOR = 0
-MICA_VERSION_MINOR = 5
+MICA_VERSION_MINOR = 6
 MICA_VERSION_PATCH = 0
 MICA_VERSION_NUMBER = MICA_VERSION_MAJOR * 10000 + MICA_VERSION_MINOR * 100 + MICA_VERSION_PATCH
 
@@ -76,6 +76,12 @@ MICA_STAGE_INTEGRATE = 6
 MICA_STAGE_COLLIDE = 7
 MICA_STAGE_FORCES = 8
 MICA_STAGE_COUNT = 9
+
+MICA_CONTACT_NODE = 1
+MICA_CONTACT_EDGE = 2
+MICA_CONTACT_TRIANGLE = 3
+MICA_CONTACT_OTHER_TOOL = 0
+MICA_CONTACT_OTHER_BODY = 1
 
 # --- Constants (mica_device.h)
 MICA_DEVICE_CALLBACKS = 0
@@ -203,6 +209,27 @@ class mica_world_stats(Structure):
     ]
 
 
+class mica_contact(Structure):
+    _fields_ = [
+        ("struct_size", c_uint32),
+        ("kind", c_int32),
+        ("body", c_uint64),
+        ("nodes", c_int32 * 3),
+        ("other_kind", c_int32),
+        ("weights", c_double * 3),
+        ("other", c_uint64),
+        ("other_nodes", c_int32 * 3),
+        ("reserved0", c_int32),
+        ("other_weights", c_double * 3),
+        ("point", c_double * 3),
+        ("normal", c_double * 3),
+        ("gap", c_double),
+        ("normal_impulse", c_double),
+        ("tangent_impulse", c_double * 3),
+        ("friction", c_double),
+    ]
+
+
 # --- Structs (mica_device.h)
 class mica_device_info(Structure):
     _fields_ = [
@@ -324,6 +351,15 @@ PROTOTYPES = {
     "mica_body_select_nodes_by_plane": (mica_status, [mica_world_p, mica_body_id, _p(_d), _p(_d), _d, _i,
                                                       _p(_i), _i, _p(_i)]),
     "mica_body_get_energy": (mica_status, [mica_world_p, mica_body_id, _p(_d), _p(_d), _p(_d)]),
+    "mica_body_set_positions": (mica_status, [mica_world_p, mica_body_id, _p(_d), _i]),
+    "mica_body_set_velocities": (mica_status, [mica_world_p, mica_body_id, _p(_d), _i]),
+    # since 0.6: tissue regions, the mesh and its fields
+    "mica_body_get_tets": (mica_status, [mica_world_p, mica_body_id, _p(_i), _i, _p(_i)]),
+    "mica_body_get_tet_regions": (mica_status, [mica_world_p, mica_body_id, _p(_i), _i, _p(_i)]),
+    "mica_body_set_materials": (mica_status, [mica_world_p, mica_body_id, _p(_d), _p(_d), _p(_d), _i]),
+    "mica_body_get_node_masses": (mica_status, [mica_world_p, mica_body_id, _p(_d), _i, _p(_i)]),
+    "mica_body_get_strains": (mica_status, [mica_world_p, mica_body_id, _p(_d), _i, _p(_i)]),
+    "mica_body_get_von_mises": (mica_status, [mica_world_p, mica_body_id, _p(_d), _i, _p(_i)]),
     # projection constraints
     "mica_lpc_def_init": (mica_status, [_p(mica_lpc_def), _u]),
     "mica_add_lpc": (mica_status, [mica_world_p, mica_body_id, _p(_i), _i, _p(mica_lpc_def), _p(mica_lpc_id)]),
@@ -343,6 +379,11 @@ PROTOTYPES = {
     "mica_tool_get_force": (mica_status, [mica_world_p, mica_tool_id, _p(_d), _p(_d), _p(_i)]),
     # stepping, statistics, output
     "mica_step": (mica_status, [mica_world_p, _d]),
+    # state and contacts
+    "mica_world_state_size": (mica_status, [mica_world_p, _p(c_size_t)]),
+    "mica_world_save_state": (mica_status, [mica_world_p, c_void_p, c_size_t]),
+    "mica_world_restore_state": (mica_status, [mica_world_p, c_void_p, c_size_t]),
+    "mica_world_get_contacts": (mica_status, [mica_world_p, _p(mica_contact), _i, _p(_i)]),
     "mica_world_get_stats": (mica_status, [mica_world_p, _p(mica_world_stats)]),
     "mica_stage_name": (c_char_p, [_i]),
     "mica_body_write_vtk": (mica_status, [mica_world_p, mica_body_id, c_char_p]),

@@ -231,6 +231,36 @@ namespace LibMica
             return s;
         }
 
+        /// <summary>The world's dynamic state (mica_world_save_state), for RestoreState.</summary>
+        public byte[] SaveState()
+        {
+            ulong size;
+            Check(MicaNative.mica_world_state_size(Handle, out size));
+            var buffer = new byte[size];
+            Check(MicaNative.mica_world_save_state(Handle, buffer, size));
+            return buffer;
+        }
+
+        /// <summary>Puts back a state from SaveState (a world of the same shape); throws with the
+        /// world unchanged otherwise.</summary>
+        public void RestoreState(byte[] state)
+        {
+            if (state == null) throw new ArgumentNullException("state");
+            Check(MicaNative.mica_world_restore_state(Handle, state, (ulong)state.Length));
+        }
+
+        /// <summary>The contacts of the last step.</summary>
+        public MicaNative.mica_contact[] GetContacts()
+        {
+            int n;
+            Check(MicaNative.mica_world_get_contacts(Handle, null, 0, out n));
+            var contacts = new MicaNative.mica_contact[n];
+            if (n == 0) return contacts;
+            unsafe { contacts[0].struct_size = (uint)sizeof(MicaNative.mica_contact); }
+            Check(MicaNative.mica_world_get_contacts(Handle, contacts, n, out n));
+            return contacts;
+        }
+
         public Body CreateBox(double[] lo, double[] hi, int[] cells, int tetsPerCell, MicaNative.mica_body_def def)
         {
             ulong id;
@@ -308,6 +338,20 @@ namespace LibMica
             return into;
         }
 
+        /// <summary>Sets every node's position (m), 3 values a node.</summary>
+        public void SetPositions(double[] xyz)
+        {
+            if (xyz == null) throw new ArgumentNullException("xyz");
+            World.Check(MicaNative.mica_body_set_positions(World.Handle, Id, xyz, xyz.Length / 3));
+        }
+
+        /// <summary>Sets every node's velocity (m/s), 3 values a node.</summary>
+        public void SetVelocities(double[] xyz)
+        {
+            if (xyz == null) throw new ArgumentNullException("xyz");
+            World.Check(MicaNative.mica_body_set_velocities(World.Handle, Id, xyz, xyz.Length / 3));
+        }
+
         /// <summary>Zero-copy view of the positions, owned by the world: valid until the next
         /// Step() or the body's or world's destruction. Take a new one after each step.</summary>
         public PositionsView Positions()
@@ -329,6 +373,65 @@ namespace LibMica
             World.Check(MicaNative.mica_body_select_nodes_by_plane(World.Handle, Id, point, normal, tolerance,
                                                                    useRest ? 1 : 0, nodes, n, out n));
             return nodes;
+        }
+
+        /// <summary>The tets, 4 node indices each (0-based).</summary>
+        public int[] GetTets()
+        {
+            int n;
+            World.Check(MicaNative.mica_body_get_tets(World.Handle, Id, null, 0, out n));
+            var tets = new int[4 * n];
+            World.Check(MicaNative.mica_body_get_tets(World.Handle, Id, tets, n, out n));
+            return tets;
+        }
+
+        /// <summary>Region of each tet: the Gmsh physical tag or TetGen region attribute, else 0.</summary>
+        public int[] GetTetRegions()
+        {
+            int n;
+            World.Check(MicaNative.mica_body_get_tet_regions(World.Handle, Id, null, 0, out n));
+            var regions = new int[n];
+            World.Check(MicaNative.mica_body_get_tet_regions(World.Handle, Id, regions, n, out n));
+            return regions;
+        }
+
+        /// <summary>Per tet: Young's modulus (Pa), Poisson ratio, density (kg/m^3); null keeps that
+        /// property. Rebuilds the body's stiffness, mass and damping.</summary>
+        public void SetMaterials(double[] youngsModulus, double[] poissonRatio = null, double[] density = null)
+        {
+            int nodes, tets, triangles;
+            GetCounts(out nodes, out tets, out triangles);
+            foreach (var a in new[] { youngsModulus, poissonRatio, density })
+                if (a != null && a.Length != tets)
+                    throw new ArgumentException("one value per tet (" + tets + "), got " + a.Length);
+            World.Check(MicaNative.mica_body_set_materials(World.Handle, Id, youngsModulus, poissonRatio, density, tets));
+        }
+
+        double[] ReadDoubles(Func<double[], int, Tuple<int, int>> call, int width)
+        {
+            var first = call(null, 0);
+            World.Check(first.Item1);
+            var values = new double[width * first.Item2];
+            World.Check(call(values, first.Item2).Item1);
+            return values;
+        }
+
+        /// <summary>Mass of each node (kg): the row sums of the mass matrix.</summary>
+        public double[] GetNodeMasses()
+        {
+            return ReadDoubles((o, c) => { int n; int s = MicaNative.mica_body_get_node_masses(World.Handle, Id, o, c, out n); return Tuple.Create(s, n); }, 1);
+        }
+
+        /// <summary>Strain of each tet, 6 values: xx, yy, zz, yz, xz, xy (tensor shears), co-rotated.</summary>
+        public double[] GetStrains()
+        {
+            return ReadDoubles((o, c) => { int n; int s = MicaNative.mica_body_get_strains(World.Handle, Id, o, c, out n); return Tuple.Create(s, n); }, 6);
+        }
+
+        /// <summary>Von Mises stress of each tet (Pa).</summary>
+        public double[] GetVonMises()
+        {
+            return ReadDoubles((o, c) => { int n; int s = MicaNative.mica_body_get_von_mises(World.Handle, Id, o, c, out n); return Tuple.Create(s, n); }, 1);
         }
 
         public Lpc AddLpc(int[] nodes, MicaNative.mica_lpc_def def)

@@ -16,7 +16,7 @@ namespace LibMica
 
         // --- Constants (mica.h)
         public const int MICA_VERSION_MAJOR = 0;
-        public const int MICA_VERSION_MINOR = 5;
+        public const int MICA_VERSION_MINOR = 6;
         public const int MICA_VERSION_PATCH = 0;
         public const int MICA_VERSION_NUMBER = MICA_VERSION_MAJOR * 10000 + MICA_VERSION_MINOR * 100 + MICA_VERSION_PATCH;
 
@@ -80,6 +80,12 @@ namespace LibMica
         public const int MICA_STAGE_COLLIDE = 7;
         public const int MICA_STAGE_FORCES = 8;
         public const int MICA_STAGE_COUNT = 9;
+
+        public const int MICA_CONTACT_NODE = 1;
+        public const int MICA_CONTACT_EDGE = 2;
+        public const int MICA_CONTACT_TRIANGLE = 3;
+        public const int MICA_CONTACT_OTHER_TOOL = 0;
+        public const int MICA_CONTACT_OTHER_BODY = 1;
 
         // --- Constants (mica_device.h)
         public const int MICA_DEVICE_CALLBACKS = 0;
@@ -200,6 +206,27 @@ namespace LibMica
             public long runs_total;
             public double ms_last_step;
             public double ms_total;
+        }
+
+        [StructLayout(LayoutKind.Sequential)]
+        public struct mica_contact
+        {
+            public uint struct_size;
+            public int kind;
+            public ulong body;
+            public fixed int nodes[3];
+            public int other_kind;
+            public fixed double weights[3];
+            public ulong other;
+            public fixed int other_nodes[3];
+            public int reserved0;
+            public fixed double other_weights[3];
+            public fixed double point[3];
+            public fixed double normal[3];
+            public double gap;
+            public double normal_impulse;
+            public fixed double tangent_impulse[3];
+            public double friction;
         }
 
         [StructLayout(LayoutKind.Sequential)]
@@ -388,6 +415,37 @@ namespace LibMica
         public static extern int mica_body_get_energy(WorldHandle world, ulong body, out double kinetic, out double elastic,
                                                       out double potential);
 
+        // Since 0.6: tissue regions, the mesh and its fields.
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern int mica_body_get_tets(WorldHandle world, ulong body, int[] @out, int capacity,
+                                                    out int out_count);
+
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern int mica_body_get_tet_regions(WorldHandle world, ulong body, int[] @out, int capacity,
+                                                           out int out_count);
+
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern int mica_body_set_materials(WorldHandle world, ulong body, double[] youngs_modulus,
+                                                         double[] poisson_ratio, double[] density, int tet_count);
+
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern int mica_body_get_node_masses(WorldHandle world, ulong body, double[] @out, int capacity,
+                                                           out int out_count);
+
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern int mica_body_get_strains(WorldHandle world, ulong body, double[] @out, int capacity,
+                                                       out int out_count);
+
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern int mica_body_get_von_mises(WorldHandle world, ulong body, double[] @out, int capacity,
+                                                         out int out_count);
+
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern int mica_body_set_positions(WorldHandle world, ulong body, double[] xyz, int node_count);
+
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern int mica_body_set_velocities(WorldHandle world, ulong body, double[] xyz, int node_count);
+
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
         public static extern int mica_lpc_def_init(ref mica_lpc_def def, uint struct_size);
 
@@ -441,6 +499,20 @@ namespace LibMica
 
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
         public static extern int mica_step(WorldHandle world, double dt);
+
+        // size_t is ulong: the bindings are for 64-bit hosts.
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern int mica_world_state_size(WorldHandle world, out ulong out_bytes);
+
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern int mica_world_save_state(WorldHandle world, byte[] buffer, ulong bytes);
+
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern int mica_world_restore_state(WorldHandle world, byte[] buffer, ulong bytes);
+
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern int mica_world_get_contacts(WorldHandle world, [In, Out] mica_contact[] @out, int capacity,
+                                                         out int out_count);
 
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
         public static extern int mica_world_get_stats(WorldHandle world, ref mica_world_stats @out);

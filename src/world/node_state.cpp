@@ -1,0 +1,61 @@
+// SPDX-License-Identifier: Apache-2.0
+// The host sets a body's node positions or velocities (checking a simulation, starting from a
+// computed state). What the world derived from the old positions goes with them:
+//  - the end-of-step rotations kept for the next step (x_end, R_end: recomputed from x);
+//  - the surface tree and pseudo-normals (refitted here: a static body's are not refitted by
+//    the step);
+//  - the warm-start impulses of the body's contacts (their features may no longer touch, and a
+//    remembered force would stiffen the next step's contact rows, add_contact_stiffness);
+//  - the re-linearisation's energy debt (the host's change is no work of the step).
+// The solvers' factors are not dropped: a co-rotational body's lagged factor is warped by the
+// rotations of the new positions (lagged_factor.hpp), and the system matrices are rebuilt from
+// x by every step (a linear body's does not depend on x).
+#include <cmath>
+
+#include "world/world.hpp"
+
+namespace mica {
+
+namespace {
+
+void check_values(const Body& b, const Vec3List& values, const char* what) {
+  if (values.size() != size_t(b.fem.node_count()))
+    fail(Errc::InvalidArgument, b.name + " has " + std::to_string(b.fem.node_count()) + " nodes, got " +
+                                    std::to_string(values.size()) + " " + what);
+  for (size_t i = 0; i < values.size(); ++i)
+    if (!values[i].allFinite())
+      fail(Errc::InvalidArgument, std::string(what) + " of node " + std::to_string(i) + " is not finite");
+}
+
+}  // namespace
+
+void World::set_positions(Id id, const Vec3List& x) {
+  Body& b = body(id);
+  check_values(b, x, "positions");
+  // The keys of the rows of the last step's contacts on this body (by its index then).
+  std::vector<uint64_t> stale;
+  int32_t index = -1;
+  for (size_t k = 0; k < step_bodies_.size(); ++k)
+    if (step_bodies_[k] == id) index = int32_t(k);
+  for (size_t r = 0; r < rows_.size(); ++r) {
+    const Contact& c = contacts_[size_t(rows_.contact[r])];
+    const bool ours = (index >= 0 && (c.a.body == index || (c.b.count > 0 && c.b.body == index))) || c.other == id;
+    if (ours) stale.push_back(rows_.key[r]);
+  }
+  b.x = x;  // the same size: no allocation, nothing thrown from here on
+  b.x_end.clear();
+  b.relin.u_start_known = false;
+  b.bvh.refit(b.x);
+  b.pseudo_normals.update(b.x, b.surface);
+  for (uint64_t key : stale) warm_start_.erase(key);
+  debt_ = decltype(debt_){};
+}
+
+void World::set_velocities(Id id, const Vec3List& v) {
+  Body& b = body(id);
+  if (!b.is_dynamic()) fail(Errc::WrongState, b.name + " is static: it has no velocities to set");
+  check_values(b, v, "velocities");
+  b.v = v;
+}
+
+}  // namespace mica
