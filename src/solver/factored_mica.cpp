@@ -178,6 +178,16 @@ double FactoredMicaSolver::complementarity_error(const ContactRows& rows, const 
   return std::sqrt(e2);
 }
 
+void FactoredMicaSolver::refactor_now(const std::vector<SolverBody>& bodies, const ContactRows& rows,
+                                      std::vector<double>& lambda) {
+  for (size_t bi = 0; bi < bodies.size(); ++bi)
+    if (factored_[bi].node_rotation)
+      factored_[bi].factor->refactor_now(bodies[bi].pattern(), *bodies[bi].A, *bodies[bi].projection,
+                                         factored_[bi].node_rotation);
+  for (size_t bi = 0; bi < bodies.size(); ++bi) warp_[bi].bind(factored_[bi].factor, factored_[bi].node_rotation);
+  start_compliance(bodies, rows, lambda);
+}
+
 void FactoredMicaSolver::row_velocities(const std::vector<SolverBody>& bodies, const ContactRows& rows) {
   w_.assign(rows.size(), 0.0);
   for (size_t r = 0; r < rows.size(); ++r) {
@@ -232,12 +242,7 @@ SolveReport FactoredMicaSolver::solve(const SolveContext& ctx, std::vector<Solve
     // fast under a tool) gives up on the factor: the current system is factored now, and the loop
     // then ends in a few rounds. Once per solve; the secant history belongs to the old factor.
     if (may_refactor && report.iterations >= settings.refactor_after) {
-      for (size_t bi = 0; bi < nb; ++bi)
-        if (factored[bi].node_rotation)
-          factored[bi].factor->refactor_now(bodies[bi].pattern(), *bodies[bi].A, *bodies[bi].projection,
-                                            factored[bi].node_rotation);
-      for (size_t bi = 0; bi < nb; ++bi) warp_[bi].bind(factored[bi].factor, factored[bi].node_rotation);
-      start_compliance(bodies, rows, lambda);
+      refactor_now(bodies, rows, lambda);
       previous_inner_tolerance = 1;
       may_refactor = false;
     }

@@ -73,6 +73,8 @@ class FactoredMicaSolver : public CachingVelocitySolver<FactoredBodyCache> {
                        const std::optional<std::chrono::steady_clock::time_point>& deadline);
   // Of the current lambda against the current row velocities w_ (N s).
   double complementarity_error(const ContactRows& rows, const std::vector<double>& lambda);
+  // The current systems factored now (co-rotational bodies), W and its diagonal from the new factor.
+  void refactor_now(const std::vector<SolverBody>& bodies, const ContactRows& rows, std::vector<double>& lambda);
   // w_ = G v + bias of the bodies' current velocities.
   void row_velocities(const std::vector<SolverBody>& bodies, const ContactRows& rows);
 

@@ -236,7 +236,7 @@ SolveReport FactoredMicaSolver::solve_active_set(const SolveContext& ctx, std::v
   using Clock = SolveContext::Clock;
   const SolverSettings& settings = settings_;
   const std::optional<Clock::time_point>& deadline = ctx.deadline;
-  const size_t nb = bodies.size(), nr = rows.size();
+  const size_t nr = rows.size();
   W0_ = W_;
   bool may_refactor = false;
   for (const FactoredBody& f : factored_) may_refactor = may_refactor || (f.node_rotation && settings.refactor_after > 0);
@@ -258,12 +258,7 @@ SolveReport FactoredMicaSolver::solve_active_set(const SolveContext& ctx, std::v
       break;
     }
     if (may_refactor && report.iterations >= settings.refactor_after) {  // as in solve(): once
-      for (size_t bi = 0; bi < nb; ++bi)
-        if (factored_[bi].node_rotation)
-          factored_[bi].factor->refactor_now(bodies[bi].pattern(), *bodies[bi].A, *bodies[bi].projection,
-                                             factored_[bi].node_rotation);
-      for (size_t bi = 0; bi < nb; ++bi) warp_[bi].bind(factored_[bi].factor, factored_[bi].node_rotation);
-      start_compliance(bodies, rows, lambda_next_);
+      refactor_now(bodies, rows, lambda_next_);
       W0_ = W_;
       may_refactor = false;
       have_pair = false;

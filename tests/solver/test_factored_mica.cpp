@@ -34,6 +34,13 @@ void compare(SolverProblem& mica, double mu, double tol, const char* what) {
   assert_le(dl, tol);
 }
 
+// The problem's system assembled at the rest shape (R = I): an earlier system than its own.
+void at_rest_shape(SolverProblem& p) {
+  compute_rotations(p.fem, p.fem.rest, p.R);
+  set_scaled_mass(p.fem, 1.0, p.A);
+  assemble_elastic(p.fem, p.fem.rest, &p.R, SolverProblem::kH * SolverProblem::kH, &p.A, p.f_int);
+}
+
 }  // namespace
 
 static void test_matches_exact(void**) {
@@ -70,11 +77,7 @@ static void test_warm_start(void**) {
 // more iterations, the same answer; the factor is not made again for the same key.
 static void check_lagged_factor(bool active_set) {
   SolverProblem earlier(0.0), p(0.0);
-  // The earlier system: the rest shape (R = I).
-  compute_rotations(earlier.fem, earlier.fem.rest, earlier.R);
-  set_scaled_mass(earlier.fem, 1.0, earlier.A);
-  assemble_elastic(earlier.fem, earlier.fem.rest, &earlier.R, SolverProblem::kH * SolverProblem::kH, &earlier.A,
-                   earlier.f_int);
+  at_rest_shape(earlier);
   FactoredMicaSolver solver(tight(active_set));
   earlier.solve(solver);
   assert_int_equal(solver.factorizations(1), 1);
@@ -105,10 +108,7 @@ static void test_lagged_factor_converges_to_exact(void**) {
 static void test_deadline_stops_the_solve(void**) {
   for (bool active_set : kLoops) {
     SolverProblem earlier(0.0), p(0.0);
-    compute_rotations(earlier.fem, earlier.fem.rest, earlier.R);
-    set_scaled_mass(earlier.fem, 1.0, earlier.A);
-    assemble_elastic(earlier.fem, earlier.fem.rest, &earlier.R, SolverProblem::kH * SolverProblem::kH, &earlier.A,
-                     earlier.f_int);
+    at_rest_shape(earlier);
     FactoredMicaSolver solver(tight(active_set));
     earlier.solve(solver);
     SolveContext late;
