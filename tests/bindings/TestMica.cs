@@ -398,6 +398,9 @@ static class TestMica
             {
                 Expect(e.Status == MicaNative.MICA_ERR_PARSE, "MICA_ERR_PARSE");
             }
+        }
+    }
+
     // A box held on a uniform stretch eps along x, nu = 0: strain eps and von Mises E eps in every
     // tet; node masses sum to density x volume; doubling E doubles the stress; regions of a file.
     static void RegionsMaterialsAndFields()

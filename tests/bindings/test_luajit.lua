@@ -309,6 +309,9 @@ test("node state, saved state and contacts", function()
   expect(math.abs(sum / 0.01 + force[1]) <= 1e-12 * math.abs(force[1]) * count, "the contacts sum to the tool force")
   ok, err = pcall(world.restore_state, world, state:sub(1, #state - 1))
   expect(not ok and err.status == C.MICA_ERR_PARSE, "a truncated state raises MICA_ERR_PARSE")
+  world:close()
+end)
+
 test("tissue regions, materials and fields", function()
   -- A box held on a uniform stretch eps along x, nu = 0: strain eps and von Mises E eps in every
   -- tet; node masses sum to density x volume; doubling E doubles the stress.
