@@ -8,10 +8,12 @@
 //     G_E v + bias_E = 0 on the pressing rows E, gives velocities and lambda_E that balance A, not
 //     its factor (Gould, Hribar and Nocedal 2001, the constraint preconditioner
 //     [P C^T; C 0] with P the warped factor: a step of it costs one solve pair);
-//  3. the same stopping test as the loop of factored_mica.cpp.
-// A round costs one solve to tolerance; the plain loop needs ~10 rounds of inexact solves per
-// step where the factor's compliance misses A's (rotations turned since it was made), this one
-// ~2-3 (the active set and sliding directions settle), so far fewer solve pairs per step.
+//  3. done when the solved impulses and row velocities are complementary (the natural residual
+//     of factored_mica.cpp's test) and the momentum balances; else step 1 around them.
+// A round costs one solve to tolerance; the alternating loop needs ~10 rounds of inexact solves
+// per step where the factor's compliance misses A's (rotations turned since it was made), this
+// one 1-2 on the nidus press (the active set and sliding directions settle), so far fewer solve
+// pairs per step.
 #include <Eigen/QR>
 #include <algorithm>
 #include <cmath>
