@@ -188,6 +188,17 @@ void FactoredMicaSolver::refactor_now(const std::vector<SolverBody>& bodies, con
   start_compliance(bodies, rows, lambda);
 }
 
+void FactoredMicaSolver::secant_update() {
+  const Eigen::Index nr = Eigen::Index(w_.size());
+  secant_y_ = Eigen::Map<const Eigen::VectorXd>(w_.data(), nr) - Eigen::Map<const Eigen::VectorXd>(w_prev_.data(), nr);
+  secant_Ws_.noalias() = W_ * secant_s_;
+  const double sWs = secant_s_.dot(secant_Ws_), sy = secant_s_.dot(secant_y_);
+  if (sWs > 0 && sy > 1e-3 * sWs) {  // curvature confirmed (inexact solves blur small steps)
+    W_ += secant_y_ * secant_y_.transpose() / sy - secant_Ws_ * secant_Ws_.transpose() / sWs;
+    for (size_t q = 0; q < diag_.size(); ++q) diag_[q] = diag_[q] > 0 ? W_(Eigen::Index(q), Eigen::Index(q)) : 0.0;
+  }
+}
+
 void FactoredMicaSolver::row_velocities(const std::vector<SolverBody>& bodies, const ContactRows& rows) {
   w_.assign(rows.size(), 0.0);
   for (size_t r = 0; r < rows.size(); ++r) {
@@ -285,15 +296,8 @@ SolveReport FactoredMicaSolver::solve(const SolveContext& ctx, std::vector<Solve
     // positive definite (while s.y > 0, as for the true W), so the rotations the warped factor
     // misses stop slowing the loop.
     if (outer > 1 && std::max(inner_tolerance, previous_inner_tolerance) <= final_tolerance) {  // only solved pairs measure it
-      const Eigen::Map<const Eigen::VectorXd> s_(dlambda_.data(), Eigen::Index(nr));
-      const Eigen::VectorXd y = Eigen::Map<const Eigen::VectorXd>(w_.data(), Eigen::Index(nr)) -
-                                Eigen::Map<const Eigen::VectorXd>(w_prev_.data(), Eigen::Index(nr));
-      const Eigen::VectorXd Ws = W_ * s_;
-      const double sWs = s_.dot(Ws), sy = s_.dot(y);
-      if (sWs > 0 && sy > 1e-3 * sWs) {  // curvature confirmed (inexact solves blur small steps)
-        W_ += y * y.transpose() / sy - Ws * Ws.transpose() / sWs;
-        for (size_t q = 0; q < nr; ++q) diag_[q] = diag_[q] > 0 ? W_(q, q) : 0.0;
-      }
+      secant_s_ = Eigen::Map<const Eigen::VectorXd>(dlambda_.data(), Eigen::Index(nr));
+      secant_update();
     }
     w_prev_ = w_;
     previous_inner_tolerance = inner_tolerance;

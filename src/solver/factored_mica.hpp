@@ -75,6 +75,9 @@ class FactoredMicaSolver : public CachingVelocitySolver<FactoredBodyCache> {
   double complementarity_error(const ContactRows& rows, const std::vector<double>& lambda);
   // The current systems factored now (co-rotational bodies), W and its diagonal from the new factor.
   void refactor_now(const std::vector<SolverBody>& bodies, const ContactRows& rows, std::vector<double>& lambda);
+  // Two solved velocity fields secant_s_ apart in the impulses measure the true compliance along
+  // it, y = w_ - w_prev_: a BFGS update takes that into W_ (kept symmetric positive definite).
+  void secant_update();
   // w_ = G v + bias of the bodies' current velocities.
   void row_velocities(const std::vector<SolverBody>& bodies, const ContactRows& rows);
 
@@ -114,6 +117,7 @@ class FactoredMicaSolver : public CachingVelocitySolver<FactoredBodyCache> {
   std::vector<double> warped_diag_;  // W_rr before the secant updates
   std::vector<Vec3List> rhs_;
   Eigen::VectorXd y_;
+  Eigen::VectorXd secant_s_, secant_y_, secant_Ws_;  // secant_update's (no allocation once sized)
   // The active-set loop's.
   Eigen::MatrixXd W0_;  // G P^-1 G^T of the factor, without the secant updates (the projections need it exact)
   Eigen::MatrixXd W_eq_;

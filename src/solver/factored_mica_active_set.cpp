@@ -300,16 +300,9 @@ SolveReport FactoredMicaSolver::solve_active_set(const SolveContext& ctx, std::v
     // The solved pair measures the true compliance along the impulses' change (secant update, as
     // in solve()); then the small problem around the solved impulses predicts the next set.
     if (have_pair) {
-      const Eigen::VectorXd s_ = Eigen::Map<const Eigen::VectorXd>(lambda.data(), Eigen::Index(nr)) -
-                                 Eigen::Map<const Eigen::VectorXd>(lambda_prev_.data(), Eigen::Index(nr));
-      const Eigen::VectorXd y = Eigen::Map<const Eigen::VectorXd>(w_.data(), Eigen::Index(nr)) -
-                                Eigen::Map<const Eigen::VectorXd>(w_prev_.data(), Eigen::Index(nr));
-      const Eigen::VectorXd Ws = W_ * s_;
-      const double sWs = s_.dot(Ws), sy = s_.dot(y);
-      if (sWs > 0 && sy > 1e-3 * sWs) {
-        W_ += y * y.transpose() / sy - Ws * Ws.transpose() / sWs;
-        for (size_t q = 0; q < nr; ++q) diag_[q] = diag_[q] > 0 ? W_(q, q) : 0.0;
-      }
+      secant_s_ = Eigen::Map<const Eigen::VectorXd>(lambda.data(), Eigen::Index(nr)) -
+                  Eigen::Map<const Eigen::VectorXd>(lambda_prev_.data(), Eigen::Index(nr));
+      secant_update();
     }
     w_prev_ = w_;
     lambda_prev_ = lambda;
