@@ -24,6 +24,7 @@ mica_status to_status(mica::Errc code) {
     case mica::Errc::Unsupported: return MICA_ERR_UNSUPPORTED;
     case mica::Errc::Device: return MICA_ERR_DEVICE;
     case mica::Errc::Internal: return MICA_ERR_INTERNAL;
+    case mica::Errc::Diverged: return MICA_ERR_DIVERGED;
   }
   return MICA_ERR_INTERNAL;
 }
@@ -68,6 +69,7 @@ MICA_API const char* mica_status_string(mica_status status) {
     case MICA_ERR_DEVICE: return "MICA_ERR_DEVICE: haptic device failure";
     case MICA_ERR_OUT_OF_MEMORY: return "MICA_ERR_OUT_OF_MEMORY: allocation failed";
     case MICA_ERR_INTERNAL: return "MICA_ERR_INTERNAL: internal error";
+    case MICA_ERR_DIVERGED: return "MICA_ERR_DIVERGED: the replay did not reproduce its recording";
     default: return "unknown mica_status";
   }
 }

@@ -99,6 +99,7 @@ typedef int32_t mica_status;
 #define MICA_ERR_DEVICE (-14)          /**< a haptic device failed */
 #define MICA_ERR_OUT_OF_MEMORY (-15)   /**< an allocation failed */
 #define MICA_ERR_INTERNAL (-16)        /**< a bug in libmica: please report it with the message */
+#define MICA_ERR_DIVERGED (-17)        /**< since 0.6: a replay did not reproduce its recording (mica_replay_step) */
 
 /** Static text naming a status ("MICA_ERR_STALE_ID: ..."). Thread: any.
  *  @param status any ::mica_status (unknown values get a generic text).
@@ -960,6 +961,77 @@ MICA_API mica_status mica_world_save_state(const mica_world* world, void* buffer
  *          device's servo loop runs); MICA_ERR_NUMERICAL (a saved factor no longer factors);
  *          MICA_ERR_OUT_OF_MEMORY. */
 MICA_API mica_status mica_world_restore_state(mica_world* world, const void* buffer, size_t bytes);
+
+/** @name Recording and replay (since 0.6)
+ *  A recording keeps what the host fed a world - every call that changes it (bodies with their
+ *  meshes, materials, constraints, grabs, tools, devices, poses, targets, node forces, positions,
+ *  restored states) and every step with the poses its devices gave their tools - so that a fresh
+ *  world replays the session bit for bit: to score a training session afterwards, or to attach to
+ *  a bug report. What a device did between steps (the servo path's forces) is not recorded: the
+ *  steps do not depend on it. A world with a time budget (mica_world_def.time_budget_ms) may not
+ *  replay bit for bit: its steps depend on the clock. A recording is for this libmica on this kind
+ *  of machine (native byte order), like a saved state. The tool `mica_replay` (examples_c) replays
+ *  one and writes CSV and VTK.
+ *  @{ */
+
+/** Starts recording the world into a file (created or truncated). A recording starts from a new
+ *  world: call it after mica_world_create(), before anything is added. Each step is flushed to the
+ *  file as it ends, so a host that crashes leaves a recording of every step before the crash.
+ *  The world's thread (the one thread using the world at a time).
+ *  @param world the world.
+ *  @param path the file (UTF-8).
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` or `path` is NULL); MICA_ERR_WRONG_STATE
+ *          (already recording, or a body, tool, constraint or device was ever added); MICA_ERR_IO
+ *          (the file cannot be opened or written: the message names it). */
+MICA_API mica_status mica_world_record_start(mica_world* world, const char* path);
+
+/** Stops recording, flushes and closes the file (destroying the world also closes it). A write
+ *  that failed during the recording (a full disk) did not fail the call that made it: it is
+ *  reported here. The world's thread.
+ *  @param world the world.
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` is NULL); MICA_ERR_WRONG_STATE (not
+ *          recording); MICA_ERR_IO (a write failed: the recording ends at the last whole entry
+ *          before it, and the message says why). */
+MICA_API mica_status mica_world_record_stop(mica_world* world);
+
+/** A recording being replayed into a world of its own. */
+typedef struct mica_replay mica_replay;
+
+/** Opens a recording and makes the world it was recorded in (the recorded settings; no log
+ *  callback). Thread: any; the replay and its world are then used by one thread at a time.
+ *  @param path the recording (UTF-8).
+ *  @param out_replay receives the replay, or NULL on failure.
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`path` or `out_replay` is NULL); MICA_ERR_IO (the
+ *          file cannot be read); MICA_ERR_PARSE (not a recording, of another format or machine
+ *          kind); MICA_ERR_INVALID_ARGUMENT (recorded settings this libmica refuses);
+ *          MICA_ERR_OUT_OF_MEMORY. The message: mica_world_last_error(NULL). */
+MICA_API mica_status mica_replay_open(const char* path, mica_replay** out_replay);
+
+/** Closes a replay and destroys its world.
+ *  @param replay the replay, or NULL (nothing happens). */
+MICA_API void mica_replay_close(mica_replay* replay);
+
+/** The replay's world, to read between steps with any call that reads a world (positions, tool
+ *  forces, contacts, mica_world_write_vtk, mica_world_last_error). Ids are the recorded ones.
+ *  Changing the world makes the rest of the replay diverge. Owned by the replay.
+ *  @param replay the replay.
+ *  @return the world, or NULL when `replay` is NULL. */
+MICA_API mica_world* mica_replay_world(const mica_replay* replay);
+
+/** Makes the recorded calls up to the next step, then that step, and checks the step's results
+ *  (positions, velocities, tool forces and torques, constraint reactions) against the recording's
+ *  fingerprint of them. The replay's thread.
+ *  @param replay the replay.
+ *  @param out_stepped receives 1 when a step was replayed, 0 at the end of the recording (the
+ *         calls recorded after its last step have been made). May be NULL.
+ *  @return the step's status as mica_step() returned it when recorded (MICA_OK,
+ *          MICA_WARN_NOT_CONVERGED, or the error of a step that failed then and now); or
+ *          MICA_ERR_NULL_ARGUMENT (`replay` is NULL); MICA_ERR_DIVERGED (a recorded call failed, a
+ *          creation got another id, or the step's results differ: the message says which and at
+ *          which step); MICA_ERR_PARSE (a corrupt entry; a recording cut off inside an entry ends at
+ *          the entry before). Messages: mica_world_last_error(mica_replay_world(replay)). */
+MICA_API mica_status mica_replay_step(mica_replay* replay, int32_t* out_stepped);
+/** @} */
 
 #define MICA_CONTACT_NODE 1     /**< the body's point is a node (weights[0] = 1) */
 #define MICA_CONTACT_EDGE 2     /**< a point of a surface edge: two nodes and their weights */

@@ -41,7 +41,9 @@ class ByteWriter {
 
 class ByteReader {
  public:
-  ByteReader(const uint8_t* data, size_t size) : data_(data), size_(size) {}
+  // `source` names what is read in messages ("the state", "the recording").
+  ByteReader(const uint8_t* data, size_t size, const char* source = "the state")
+      : data_(data), size_(size), source_(source) {}
   template <class T>
   T get(const char* what) {
     static_assert(std::is_standard_layout<T>::value, "plain values only");
@@ -66,12 +68,20 @@ class ByteReader {
 
  private:
   [[noreturn]] void truncated(const char* what) const {
-    fail(Errc::Parse, "the state ends inside " + std::string(what) + " (at byte " + std::to_string(at_) + " of " +
+    fail(Errc::Parse, std::string(source_) + " ends inside " + std::string(what) + " (at byte " + std::to_string(at_) + " of " +
                           std::to_string(size_) + "): truncated or corrupt");
   }
   const uint8_t* data_;
   size_t size_;
+  const char* source_;
   size_t at_ = 0;
 };
+
+// FNV-1a over bytes, continuing from `hash` (chain calls to hash several arrays).
+inline uint64_t fnv1a(const void* data, size_t size, uint64_t hash = 0xcbf29ce484222325ull) {
+  const auto* p = static_cast<const uint8_t*>(data);
+  for (size_t i = 0; i < size; ++i) hash = (hash ^ p[i]) * 0x100000001b3ull;
+  return hash;
+}
 
 }  // namespace mica

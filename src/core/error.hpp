@@ -17,7 +17,8 @@ enum class Errc {
   WrongState,       // the call is not allowed now
   Unsupported,      // the feature is not available in this build or on this scene
   Device,           // a haptic device failed
-  Internal          // a bug in libmica
+  Internal,         // a bug in libmica
+  Diverged          // a replay did not reproduce its recording
 };
 
 class Error : public std::runtime_error {

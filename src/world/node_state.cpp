@@ -12,6 +12,7 @@
 // x by every step (a linear body's does not depend on x).
 #include <cmath>
 
+#include "world/recording.hpp"
 #include "world/world.hpp"
 
 namespace mica {
@@ -49,6 +50,7 @@ void World::set_positions(Id id, const Vec3List& x) {
   b.pseudo_normals.update(b.x, b.surface);
   for (uint64_t key : stale) warm_start_.erase(key);
   debt_ = decltype(debt_){};
+  if (recorder_) recorder_->write(RecordKind::SetPositions, id, x);
 }
 
 void World::set_velocities(Id id, const Vec3List& v) {
@@ -56,6 +58,7 @@ void World::set_velocities(Id id, const Vec3List& v) {
   if (!b.is_dynamic()) fail(Errc::WrongState, b.name + " is static: it has no velocities to set");
   check_values(b, v, "velocities");
   b.v = v;
+  if (recorder_) recorder_->write(RecordKind::SetVelocities, id, v);
 }
 
 }  // namespace mica

@@ -77,6 +77,9 @@ class SlotMap {
     return (item && s.generation.load(std::memory_order_seq_cst) == ((id >> 32) & 0xffffffu)) ? item : nullptr;
   }
 
+  // Slots ever used (0: nothing was ever inserted, so the next ids are the first ones).
+  uint32_t slots_used() const { return size_; }
+
   T& get(Id id, const char* what) const {
     T* item = find(id);
     if (!item) fail(Errc::StaleId, std::string(what) + " id " + hex(id) + " is null, of another kind, or destroyed");

@@ -22,6 +22,7 @@
 #include <cstring>
 
 #include "core/byte_stream.hpp"
+#include "world/recording.hpp"
 #include "world/world.hpp"
 
 namespace mica {
@@ -41,12 +42,6 @@ struct Header {
   uint64_t checksum;  // FNV-1a of the bytes after the header
 };
 constexpr size_t kHeaderSize = sizeof(Header);
-
-uint64_t fnv1a(const uint8_t* data, size_t size) {
-  uint64_t h = 0xcbf29ce484222325ull;
-  for (size_t i = 0; i < size; ++i) h = (h ^ data[i]) * 0x100000001b3ull;
-  return h;
-}
 
 }  // namespace
 
@@ -461,6 +456,21 @@ void World::restore_state(const uint8_t* data, size_t size) {
   });
   k = 0;
   devices_.for_each([&](Id, DeviceLink& link) { link.set_filter_state(device_data[k++]); });
+  if (recorder_) recorder_->write(RecordKind::RestoreState, std::vector<uint8_t>(data, data + size));
+}
+
+uint64_t World::fingerprint() const {
+  uint64_t h = fnv1a(nullptr, 0);
+  bodies_.for_each([&](Id, const Body& b) {
+    h = fnv1a(b.x.data(), b.x.size() * sizeof(Vec3), h);
+    h = fnv1a(b.v.data(), b.v.size() * sizeof(Vec3), h);
+  });
+  tools_.for_each([&](Id, const Tool& t) {
+    h = fnv1a(t.force.data(), sizeof(Vec3), h);
+    h = fnv1a(t.torque.data(), sizeof(Vec3), h);
+  });
+  lpcs_.for_each([&](Id, const Lpc& c) { h = fnv1a(c.reaction.data(), sizeof(Vec3), h); });
+  return h;
 }
 
 }  // namespace mica

@@ -8,6 +8,7 @@
 
 #include "collision/contact_curvature.hpp"
 #include "core/assert.hpp"
+#include "world/recording.hpp"
 #include "world/world.hpp"
 
 namespace mica {
@@ -66,9 +67,22 @@ void World::step(double h) {
     advance(h);
   } catch (...) {
     undo();
+    if (recorder_) recorder_->write(RecordKind::Step, h, adopted_, false, uint64_t(0));
     throw;
   }
   solver_->commit_step();
+  if (recorder_) recorder_->write(RecordKind::Step, h, adopted_, true, fingerprint());
+}
+
+void World::step_replayed(double h, const std::vector<AdoptedPose>& poses) {
+  replayed_ = &poses;
+  try {
+    step(h);
+  } catch (...) {
+    replayed_ = nullptr;
+    throw;
+  }
+  replayed_ = nullptr;
 }
 
 StepContext World::begin_step(double h) {
@@ -138,6 +152,16 @@ void World::advance(double h) {
 }
 
 void World::follow_devices() {
+  adopted_.clear();  // keeps its capacity
+  if (replayed_) {  // a replay: the recorded poses stand in for the devices
+    for (const AdoptedPose& p : *replayed_) {
+      Tool& t = tool(p.tool);
+      t.position = p.position;
+      t.orientation = p.orientation;
+    }
+    adopted_ = *replayed_;
+    return;
+  }
   // Each device's newest pose moves its tool before the step (the servo thread wrote it).
   devices_.for_each([&](Id, DeviceLink& link) {
     ScenePose pose;
@@ -147,6 +171,7 @@ void World::follow_devices() {
       Tool& t = tool(link.settings().tool);
       t.position = pose.position;
       t.orientation = pose.orientation;
+      if (recorder_) adopted_.push_back(AdoptedPose{link.settings().tool, pose.position, pose.orientation});
     }
   });
 }

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "fem/element_colouring.hpp"
+#include "world/recording.hpp"
 #include "solver/node_colouring.hpp"
 
 namespace mica {
@@ -45,9 +46,12 @@ World::World(const WorldSettings& settings) : settings_(settings) {
   solver_ = make_velocity_solver(settings.solver, settings.mica_sweep, settings);
 }
 
+World::~World() = default;
+
 void World::set_gravity(const Vec3& g) {
   require_finite(g, "gravity");
   settings_.gravity = g;
+  if (recorder_) recorder_->write(RecordKind::SetGravity, g);
 }
 
 Id World::add_body(const TetMesh& mesh, const BodySettings& settings, const Vec3& translation, const Vec3& velocity) {
@@ -87,6 +91,7 @@ Id World::add_body(const TetMesh& mesh, const BodySettings& settings, const Vec3
       }
     }
   }
+  if (recorder_) recorder_->write(RecordKind::AddBody, mesh, settings, translation, velocity, id);
   return id;
 }
 
@@ -99,6 +104,7 @@ void World::remove_body(Id id) {
   for (Id lpc : doomed) lpcs_.erase(lpc);
   solver_->forget(body(id).key);  // its factors (one may be in the making on the body's pattern) first
   bodies_.erase(id);
+  if (recorder_) recorder_->write(RecordKind::RemoveBody, id);
 }
 
 int64_t World::factorizations(Id id) const { return solver_->factorizations(body(id).key); }
@@ -114,6 +120,7 @@ void World::set_node_forces(Id id, const std::vector<int32_t>& nodes, const Vec3
   for (size_t k = 0; k < nodes.size(); ++k) b.node_forces[nodes[k]] = forces[k];
   b.has_node_forces = false;
   for (const Vec3& f : b.node_forces) b.has_node_forces = b.has_node_forces || !f.isZero(0);
+  if (recorder_) recorder_->write(RecordKind::SetNodeForces, id, nodes, forces);
 }
 
 void World::set_body_materials(Id id, const std::vector<Material>& materials) {
@@ -126,6 +133,7 @@ void World::set_body_materials(Id id, const std::vector<Material>& materials) {
   ++b.matrix_version;
   b.relin.u_start_known = false;
   b.relin.modes.clear();
+  if (recorder_) recorder_->write(RecordKind::SetMaterials, id, materials);
 }
 
 Mat3 constrained_projector(const LpcSpec& spec) {
@@ -150,6 +158,12 @@ Mat3 constrained_projector(const LpcSpec& spec) {
 }
 
 Id World::add_lpc(Id body_id, const std::vector<int32_t>& nodes, const LpcSpec& spec) {
+  const Id id = insert_lpc(body_id, nodes, spec);
+  if (recorder_) recorder_->write(RecordKind::AddLpc, body_id, nodes, spec, id);
+  return id;
+}
+
+Id World::insert_lpc(Id body_id, const std::vector<int32_t>& nodes, const LpcSpec& spec) {
   Body& b = body(body_id);
   if (nodes.empty()) fail(Errc::InvalidArgument, "a constraint needs at least one node");
   for (size_t k = 0; k < nodes.size(); ++k)
@@ -173,7 +187,9 @@ Id World::add_tool(const Tool& tool) {
   t.orientation.normalize();
   t.previous_position = t.position;
   t.previous_orientation = t.orientation;
-  return tools_.insert(std::make_unique<Tool>(t));
+  const Id id = tools_.insert(std::make_unique<Tool>(t));
+  if (recorder_) recorder_->write(RecordKind::AddTool, tool, id);
+  return id;
 }
 
 Id World::add_device(std::unique_ptr<Device> device, const DeviceSettings& settings) {
@@ -195,12 +211,15 @@ Id World::add_device(std::unique_ptr<Device> device, const DeviceSettings& setti
     fail(Errc::InvalidArgument, "the coupling stiffness and damping must be finite and >= 0");
   DeviceSettings normalised = settings;
   normalised.rotation.normalize();
-  return devices_.insert(std::make_unique<DeviceLink>(std::move(device), normalised));
+  const Id id = devices_.insert(std::make_unique<DeviceLink>(std::move(device), normalised));
+  if (recorder_) recorder_->write(RecordKind::AddDevice, settings, id);
+  return id;
 }
 
 void World::remove_device(Id id) {
   device(id).stop();
   devices_.erase(id);
+  if (recorder_) recorder_->write(RecordKind::RemoveDevice, id);
 }
 
 void World::remove_tool(Id id) {
@@ -217,6 +236,7 @@ void World::remove_tool(Id id) {
     }
   });
   tools_.erase(id);
+  if (recorder_) recorder_->write(RecordKind::RemoveTool, id);
 }
 
 void World::set_tool_pose(Id id, const Vec3& position, const Eigen::Quaterniond& orientation) {
@@ -225,6 +245,7 @@ void World::set_tool_pose(Id id, const Vec3& position, const Eigen::Quaterniond&
     fail(Errc::InvalidArgument, "the tool pose must be finite with a non-zero quaternion");
   t.position = position;
   t.orientation = orientation.normalized();
+  if (recorder_) recorder_->write(RecordKind::SetToolPose, id, position, orientation);
 }
 
 void World::set_lpc_velocity(Id id, const Vec3& velocity) {
@@ -232,6 +253,7 @@ void World::set_lpc_velocity(Id id, const Vec3& velocity) {
   require_finite(velocity, "the prescribed velocity");
   c.velocity = velocity;
   c.handle.reset();
+  if (recorder_) recorder_->write(RecordKind::SetLpcVelocity, id, velocity);
 }
 
 void World::set_lpc_targets(Id id, const Vec3List& targets) {
@@ -243,6 +265,7 @@ void World::set_lpc_targets(Id id, const Vec3List& targets) {
   auto handle = std::make_unique<Handle>();
   handle->offsets = targets;
   c.handle = std::move(handle);
+  if (recorder_) recorder_->write(RecordKind::SetLpcTargets, id, targets);
 }
 
 Id World::grab(Id body_id, const Vec3& center, double radius, Id tool_id) {
@@ -261,8 +284,9 @@ Id World::grab(Id body_id, const Vec3& center, double radius, Id tool_id) {
   handle->position = tool_id ? tool(tool_id).position : center;
   handle->orientation = tool_id ? tool(tool_id).orientation : Eigen::Quaterniond::Identity();
   for (int32_t i : nodes) handle->offsets.push_back(handle->orientation.inverse() * (b.x[i] - handle->position));
-  const Id id = add_lpc(body_id, nodes, LpcSpec{});
+  const Id id = insert_lpc(body_id, nodes, LpcSpec{});
   lpcs_.get(id, "constraint").handle = std::move(handle);
+  if (recorder_) recorder_->write(RecordKind::Grab, body_id, center, radius, tool_id, id);
   return id;
 }
 
@@ -275,12 +299,14 @@ void World::set_handle_pose(Id id, const Vec3& position, const Eigen::Quaternion
     fail(Errc::InvalidArgument, "the handle orientation must be a finite non-zero quaternion");
   c.handle->position = position;
   c.handle->orientation = orientation.normalized();
+  if (recorder_) recorder_->write(RecordKind::SetHandlePose, id, position, orientation);
 }
 
 void World::remove_lpc(Id id) {
   const Lpc& c = lpcs_.get(id, "constraint");
   Body* b = bodies_.find(c.body);
   lpcs_.erase(id);
+  if (recorder_) recorder_->write(RecordKind::RemoveLpc, id);
   if (!b) return;
   ++b->lpc_version;
   b->projection.reset(b->fem.node_count());  // the constraints stage rebuilds what remains

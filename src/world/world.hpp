@@ -105,12 +105,23 @@ struct BodyOverlap {
   double reach = 0;     // m: how deep body contacts look for that node (the other body's surface edge, or the margin)
 };
 
+// The pose a device gave its tool at the start of a step (World::follow_devices): what a
+// recording keeps of the device, and what its replay hands the step instead.
+struct AdoptedPose {
+  Id tool = 0;
+  Vec3 position = Vec3::Zero();
+  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();
+};
+
+class Recorder;  // recording.hpp
+
 // Throws Error(InvalidArgument) naming the first setting out of its domain.
 void validate(const WorldSettings& settings);
 
 class World {
  public:
   explicit World(const WorldSettings& settings);
+  ~World();
 
   const WorldSettings& settings() const { return settings_; }
   void set_gravity(const Vec3& g);
@@ -186,6 +197,20 @@ class World {
   // the result is not finite.
   void step(double h);
 
+  // Recording (recording.cpp): from a world with nothing in it yet, every call that changes the
+  // world and every step is written to `path` (throws Error(Io) if it cannot be opened,
+  // Error(WrongState) if the world already has a body, tool, constraint or device).
+  // stop_recording() flushes and closes it, and throws Error(Io) if a write failed.
+  void start_recording(const std::string& path);
+  void stop_recording();
+  bool recording() const { return recorder_ != nullptr; }
+  // A replay's step (replay.cpp): the poses the recorded devices gave their tools stand in for
+  // the devices (this world's are inert stand-ins made by the replay).
+  void step_replayed(double h, const std::vector<AdoptedPose>& poses);
+  // FNV-1a of what the last step left: positions and velocities of the bodies, force and torque of
+  // the tools, reactions of the constraints. A replay compares it with the recording's.
+  uint64_t fingerprint() const;
+
   Plan plan() const;
   const WorldStats& stats() const { return stats_; }
   int32_t thread_count() const { return pool_ ? pool_->size() : 1; }  // settings().threads resolved
@@ -224,6 +249,7 @@ class World {
   void undo();
 
   void state_shape(StateShape& out) const;  // state_io.cpp
+  Id insert_lpc(Id body, const std::vector<int32_t>& nodes, const LpcSpec& spec);  // add_lpc, unrecorded
 
   bool needs_loads(const Body& b) const;
   bool needs_damping(const Body& b) const;
@@ -256,6 +282,9 @@ class World {
   int64_t bodies_created_ = 0;
   bool warned_exact_rows_ = false;
   std::vector<BodyOverlap> last_overlaps_;          // of the last add_body
+  std::unique_ptr<Recorder> recorder_;              // while recording
+  std::vector<AdoptedPose> adopted_;                // the poses follow_devices gave tools this step
+  const std::vector<AdoptedPose>* replayed_ = nullptr;  // step_replayed: these instead of the devices
   std::vector<std::pair<Id, Id>> overlapping_;      // pairs whose contacts are skipped until their bounds part
   std::unique_ptr<ThreadPool> pool_;                // threads > 1 only; the step's parallel loops
   // Chosen once from the settings; keeps per-body factors (some factored in the background on
