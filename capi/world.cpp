@@ -207,3 +207,16 @@ MICA_API mica_status mica_world_write_vtk(const mica_world* world, const char* p
 }
 
 }  // extern "C"
+
+MICA_API mica_status mica_world_get_ids(const mica_world* world, int32_t kind, uint64_t* out, int32_t capacity,
+                                        int32_t* out_count) {
+  return guarded(world, "mica_world_get_ids", [&] {
+    require(world, "world");
+    if (kind < MICA_OBJECT_BODY || kind > MICA_OBJECT_DEVICE)
+      refuse(MICA_ERR_INVALID_ARGUMENT, "kind is " + std::to_string(kind) + ", not a MICA_OBJECT_* value");
+    static_assert(MICA_OBJECT_BODY == int(mica::IdKind::Body) && MICA_OBJECT_DEVICE == int(mica::IdKind::Device),
+                  "the C object kinds are the core's id kinds");
+    const std::vector<uint64_t> ids = world->world.ids(mica::IdKind(kind));
+    return copy_out(ids.data(), int32_t(ids.size()), 1, out, capacity, out_count);
+  });
+}

@@ -5,13 +5,14 @@
  * a soft block for a second and lets go. Prints the rates and forces and writes
  * haptic_loop.csv (servo samples: time, raw and filtered force) for the paper's Figure 1 b/c.
  *
- * usage: haptic_loop [output-folder] [seconds]
+ * usage: haptic_loop [output-folder] [seconds] [--record file]
  */
 #include <math.h>
 #include <pthread.h>
 #include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 #include <time.h>
 
 #include <mica/mica.h>
@@ -87,20 +88,30 @@ static void* servo_thread(void* arg) {
   } while (0)
 
 static const char kUsage[] =
-    "usage: haptic_loop [output-folder] [seconds]\n"
+    "usage: haptic_loop [output-folder] [seconds] [--record file]\n"
     "A 60 Hz simulation thread and a 1 kHz servo thread: the Geomagic Touch when OpenHaptics' libHD\n"
     "is found (MICA_HD_LIBRARY), else a simulated stylus pressing into a soft block. Prints the rates\n"
     "and forces and writes haptic_loop.csv (time, raw and rendered force) into the output folder.\n"
     "  output-folder  where the CSV goes (default .)\n"
     "  seconds        how long the loop runs (default 2)\n"
+    "  --record file  record the session (mica_world_record_start); mica_replay replays it\n"
     "  --help         this text\n";
 
 int main(int argc, char** argv) {
-  const int cli = cli_check(argc, argv, kUsage, NULL);
+  static const char* const options[] = {"--record", NULL};
+  const int cli = cli_check(argc, argv, kUsage, options);
   if (cli >= 0) return cli;
-  const char* out_dir = argc > 1 ? argv[1] : ".";
+  const char* positional[2] = {".", "2"};
+  const char* record = NULL;
+  for (int i = 1, n = 0; i < argc; ++i) {
+    if (strcmp(argv[i], "--record") == 0 && i + 1 < argc)
+      record = argv[++i];
+    else if (n < 2)
+      positional[n++] = argv[i];
+  }
+  const char* out_dir = positional[0];
   static loop L;
-  L.seconds = argc > 2 ? atof(argv[2]) : 2.0;
+  L.seconds = atof(positional[1]);
   mica_world* world = NULL;
   mica_world_def wd = mica_world_def_default();
   wd.gravity[1] = 0;
@@ -111,6 +122,7 @@ int main(int argc, char** argv) {
     fprintf(stderr, "%s\n", mica_world_last_error(NULL));
     return 1;
   }
+  if (record) CHECK(mica_world_record_start(world, record));
   /* The soft block (scenes/box_scene.h): 10 cm wide, its top face at y = 0, fixed at its bottom
    * face, a 2 cm sphere above it. */
   box_scene_def def = box_scene_block_def();
@@ -159,6 +171,10 @@ int main(int argc, char** argv) {
   }
   atomic_store(&L.running, 0);
   pthread_join(servo, NULL);
+  if (record) {
+    CHECK(mica_world_record_stop(world));
+    printf("recorded %d steps into %s (mica_replay replays them)\n", steps, record);
+  }
   const double elapsed = now_s() - start;
   mica_device_stats st = {.struct_size = sizeof st};
   CHECK(mica_device_get_stats(world, L.device, &st));

@@ -962,6 +962,26 @@ MICA_API mica_status mica_world_save_state(const mica_world* world, void* buffer
  *          MICA_ERR_OUT_OF_MEMORY. */
 MICA_API mica_status mica_world_restore_state(mica_world* world, const void* buffer, size_t bytes);
 
+/** Object kinds of mica_world_get_ids() (since 0.6). */
+#define MICA_OBJECT_BODY 1
+#define MICA_OBJECT_LPC 2
+#define MICA_OBJECT_TOOL 3
+#define MICA_OBJECT_DEVICE 4
+
+/** The ids of the world's live objects of one kind (since 0.6): what a tool that did not build the
+ *  world (an inspector, the replay tool) needs to read it. In slot order: creation order until an
+ *  object of the kind is destroyed (a later one may then take its slot). The world's thread.
+ *  @param world the world (not changed).
+ *  @param kind MICA_OBJECT_BODY, _LPC, _TOOL or _DEVICE.
+ *  @param out the caller's buffer (mica_body_id, mica_lpc_id, mica_tool_id or mica_device_id
+ *         values), or NULL to ask for the count only. @param capacity its size in ids.
+ *  @param out_count receives the count (may be NULL when `out` is not).
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world`, or both `out` and `out_count`, NULL);
+ *          MICA_ERR_INVALID_ARGUMENT (an unknown kind, `capacity` < 0); MICA_ERR_BUFFER_TOO_SMALL
+ *          (`capacity` below the count: nothing copied, `*out_count` = the count needed). */
+MICA_API mica_status mica_world_get_ids(const mica_world* world, int32_t kind, uint64_t* out, int32_t capacity,
+                                        int32_t* out_count);
+
 /** @name Recording and replay (since 0.6)
  *  A recording keeps what the host fed a world - every call that changes it (bodies with their
  *  meshes, materials, constraints, grabs, tools, devices, poses, targets, node forces, positions,

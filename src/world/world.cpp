@@ -302,6 +302,18 @@ void World::set_handle_pose(Id id, const Vec3& position, const Eigen::Quaternion
   if (recorder_) recorder_->write(RecordKind::SetHandlePose, id, position, orientation);
 }
 
+std::vector<Id> World::ids(IdKind kind) const {
+  std::vector<Id> out;
+  auto add = [&](Id id, const auto&) { out.push_back(id); };
+  switch (kind) {
+    case IdKind::Body: bodies_.for_each(add); break;
+    case IdKind::Lpc: lpcs_.for_each(add); break;
+    case IdKind::Tool: tools_.for_each(add); break;
+    case IdKind::Device: devices_.for_each(add); break;
+  }
+  return out;
+}
+
 void World::remove_lpc(Id id) {
   const Lpc& c = lpcs_.get(id, "constraint");
   Body* b = bodies_.find(c.body);

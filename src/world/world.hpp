@@ -217,6 +217,8 @@ class World {
 
   template <class F>
   void for_each_body(F&& f) const { bodies_.for_each(f); }
+  // The ids of the live objects of one kind, in slot order (creation order until one is destroyed).
+  std::vector<Id> ids(IdKind kind) const;
 
  private:
   // The stages of a step (step.cpp), in the order advance() runs them.

@@ -302,6 +302,27 @@ static void test_bad_calls_and_files(void** state) {
   OK(w, box_scene_create(w, &def, &s));
   assert_int_equal(mica_world_record_start(w, "test_recording_late.micarec"), MICA_ERR_WRONG_STATE);
   assert_non_null(strstr(mica_world_last_error(w), "new world"));
+
+  /* mica_world_get_ids lists what the scene made, by kind, in creation order. */
+  uint64_t ids[4];
+  int32_t count = -1;
+  OK(w, mica_world_get_ids(w, MICA_OBJECT_BODY, ids, 4, &count));
+  assert_int_equal(count, 1);
+  assert_true(ids[0] == s.body);
+  OK(w, mica_world_get_ids(w, MICA_OBJECT_LPC, ids, 4, &count));
+  assert_int_equal(count, 1);
+  assert_true(ids[0] == s.base);
+  OK(w, mica_world_get_ids(w, MICA_OBJECT_TOOL, NULL, 0, &count));
+  assert_int_equal(count, 1);
+  OK(w, mica_world_get_ids(w, MICA_OBJECT_DEVICE, ids, 4, &count));
+  assert_int_equal(count, 0);
+  assert_int_equal(mica_world_get_ids(w, MICA_OBJECT_TOOL, ids, 0, &count), MICA_ERR_BUFFER_TOO_SMALL);
+  assert_int_equal(count, 1);
+  assert_int_equal(mica_world_get_ids(w, 0, ids, 4, &count), MICA_ERR_INVALID_ARGUMENT);
+  assert_non_null(strstr(mica_world_last_error(w), "MICA_OBJECT_"));
+  assert_int_equal(mica_world_get_ids(w, MICA_OBJECT_BODY, ids, -1, &count), MICA_ERR_INVALID_ARGUMENT);
+  assert_int_equal(mica_world_get_ids(w, MICA_OBJECT_BODY, NULL, 0, NULL), MICA_ERR_NULL_ARGUMENT);
+  assert_int_equal(mica_world_get_ids(NULL, MICA_OBJECT_BODY, ids, 4, &count), MICA_ERR_NULL_ARGUMENT);
   mica_world_destroy(w);
 
   mica_replay* r = (mica_replay*)&r;
