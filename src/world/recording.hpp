@@ -161,5 +161,9 @@ inline void take(ByteReader& in, WorldSettings& s) {
 }
 // A setting added to these structs must be added above too: their sizes are pinned here.
 static_assert(sizeof(void*) != 8 || sizeof(SolverSettings) == 48, "a new solver setting: record it above");
+static_assert(sizeof(void*) != 8 || sizeof(BodySettings) == 48, "a new body setting: record it above");
+static_assert(sizeof(void*) != 8 || sizeof(LpcSpec) == 80, "a new constraint setting: record it above");
+static_assert(sizeof(void*) != 8 || sizeof(DeviceSettings) == 144, "a new device setting: record it above");
+static_assert(sizeof(void*) != 8 || sizeof(ToolModel) == 152, "a new tool field: record it above");
 
 }  // namespace mica
