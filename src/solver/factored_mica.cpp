@@ -48,7 +48,8 @@ void FactoredMicaSolver::build_compliance(const std::vector<SolverBody>& bodies,
       if (term.body == int32_t(bi)) contact_nodes_.push_back(term.node);
     factored[bi].factor->prepare_columns(contact_nodes_);
   }
-  std::vector<int32_t> row_of(nt);
+  std::vector<int32_t>& row_of = term_row_;
+  row_of.resize(nt);
   for (size_t r = 0; r < nr; ++r)
     for (int32_t t = rows.start[r]; t < rows.start[r + 1]; ++t) {
       const RowTerm& term = rows.terms[t];
@@ -151,7 +152,8 @@ void FactoredMicaSolver::solve_small_lcp(const ContactRows& rows, double toleran
   FrictionalSettings fs;
   fs.tolerance = std::max(1e-3 * tolerance, 1e-13);
   fs.deadline = deadline;
-  const FrictionalSolution sol = solve_frictional_contact(small_M_, small_q_, small_mu_, small_normal_, small_start_, fs);
+  FrictionalSolution& sol = small_solution_;
+  solve_frictional_contact(small_M_, small_q_, small_mu_, small_normal_, small_start_, fs, small_workspace_, sol);
   for (Eigen::Index a = 0; a < n; ++a) lambda_next_[live_[a]] = sol.z(a);
 }
 
@@ -194,7 +196,11 @@ void FactoredMicaSolver::secant_update() {
   secant_Ws_.noalias() = W_ * secant_s_;
   const double sWs = secant_s_.dot(secant_Ws_), sy = secant_s_.dot(secant_y_);
   if (sWs > 0 && sy > 1e-3 * sWs) {  // curvature confirmed (inexact solves blur small steps)
-    W_ += secant_y_ * secant_y_.transpose() / sy - secant_Ws_ * secant_Ws_.transpose() / sWs;
+    // W += y y^T / sy - Ws Ws^T / sWs entry by entry (as a product expression it made two n x n
+    // temporaries).
+    for (Eigen::Index j = 0; j < nr; ++j)
+      for (Eigen::Index i = 0; i < nr; ++i)
+        W_(i, j) += secant_y_(i) * secant_y_(j) / sy - secant_Ws_(i) * secant_Ws_(j) / sWs;
     for (size_t q = 0; q < diag_.size(); ++q) diag_[q] = diag_[q] > 0 ? W_(Eigen::Index(q), Eigen::Index(q)) : 0.0;
   }
 }

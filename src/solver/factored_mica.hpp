@@ -13,9 +13,11 @@
 #pragma once
 #include <Eigen/QR>
 #include <chrono>
+#include <memory>
 #include <optional>
 #include <vector>
 
+#include "solver/frictional_contact.hpp"
 #include "solver/lagged_factor.hpp"
 #include "solver/pcg.hpp"
 #include "solver/velocity_solver.hpp"
@@ -32,6 +34,12 @@ struct FactoredBodyCache {
 // Each body's factor is updated once per solve for its SystemKey and constraint version
 // (LaggedFactor::update); a co-rotational body's (SolverBody::rotation) is warped by its node
 // rotations and refreshed every SolverSettings::refactor_interval solves in the background.
+//
+// Allocation: solve() allocates only while its workspaces grow: on the first solves, when the
+// contact rows change in number (W, the small problem's and the active set's workspaces are
+// sized by them; the active set's decompositions, one per size, only grow with them), and when a
+// factor is made or adopted (its columns afresh).
+// Otherwise it makes no heap allocation (tests/solver/test_solve_allocations.cpp).
 class FactoredMicaSolver : public CachingVelocitySolver<FactoredBodyCache> {
  public:
   explicit FactoredMicaSolver(const SolverSettings& settings = {}) : settings_(settings) {}
@@ -92,21 +100,25 @@ class FactoredMicaSolver : public CachingVelocitySolver<FactoredBodyCache> {
                                 double tolerance, int32_t cap,
                                 const std::optional<SolveContext::Clock::time_point>& deadline);
   // x = W_E^-1 rhs (the least-squares solution where rows are redundant).
-  void solve_equalities(const Eigen::VectorXd& rhs, Eigen::VectorXd& x) const;
+  void solve_equalities(const Eigen::Ref<const Eigen::VectorXd>& rhs, Eigen::Ref<Eigen::VectorXd> x);
   // out += P^-1 G_which^T x (through the cached columns).
   void add_response(const std::vector<SolverBody>& bodies, const ContactRows& rows, const std::vector<int32_t>& which,
-                    const Eigen::VectorXd& x, std::vector<Vec3List>& out);
+                    const Eigen::Ref<const Eigen::VectorXd>& x, std::vector<Vec3List>& out);
   // out -= S G_E^T x.
-  void subtract_row_forces(const std::vector<SolverBody>& bodies, const ContactRows& rows, const Eigen::VectorXd& x,
-                           std::vector<Vec3List>& out) const;
+  void subtract_row_forces(const std::vector<SolverBody>& bodies, const ContactRows& rows,
+                           const Eigen::Ref<const Eigen::VectorXd>& x, std::vector<Vec3List>& out) const;
   // out = G_E y (no bias).
-  void rows_times(const ContactRows& rows, const std::vector<Vec3List>& y, Eigen::VectorXd& out) const;
+  void rows_times(const ContactRows& rows, const std::vector<Vec3List>& y, Eigen::Ref<Eigen::VectorXd> out) const;
+  // The decomposition kept for active sets of ne rows, and those of every size up to nr made at once.
+  Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd>& equality_solver(Eigen::Index ne);
+  void prepare_equality_solvers(Eigen::Index nr);
 
   SolverSettings settings_;
   std::vector<FactoredBody> factored_;
   std::vector<PcgSolver> pcg_;
   std::vector<WarpedFactorPreconditioner> warp_;
   std::vector<const Eigen::MatrixXd*> term_columns_;  // per row term: K_f^-1 columns of its node
+  std::vector<int32_t> term_row_;                     // per row term: its row
   std::vector<Vec3> term_force_;                      // per row term: coef Q_i^T S_i d (the factor's frame)
   Eigen::MatrixXd W_;                                 // G P^-1 G^T
   std::vector<double> w_, w_prev_, lambda_next_, dlambda_, diag_;
@@ -114,16 +126,21 @@ class FactoredMicaSolver : public CachingVelocitySolver<FactoredBodyCache> {
   Eigen::MatrixXd small_M_;                           // W on the live rows
   Eigen::VectorXd small_q_, small_mu_, small_start_;
   std::vector<int32_t> small_normal_;
+  FrictionalSolution small_solution_;
+  FrictionalWorkspace small_workspace_;
   std::vector<double> warped_diag_;  // W_rr before the secant updates
   std::vector<Vec3List> rhs_;
   Eigen::VectorXd y_;
   Eigen::VectorXd secant_s_, secant_y_, secant_Ws_;  // secant_update's (no allocation once sized)
   // The active-set loop's.
   Eigen::MatrixXd W0_;  // G P^-1 G^T of the factor, without the secant updates (the projections need it exact)
-  Eigen::MatrixXd W_eq_;
-  Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> W_eq_solver_;
+  // Sized to the largest active set seen (only ever grown); a set of ne rows uses the first ne
+  // entries (ne^2 of W_eq_, column-major).
+  Eigen::VectorXd W_eq_;
+  std::vector<std::unique_ptr<Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd>>> W_eq_solvers_;  // by size
+  Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd>* W_eq_solver_ = nullptr;  // this set's
   std::vector<int32_t> eq_;
-  Eigen::VectorXd mu_, mu_neg_, mu_total_, row_scratch_;
+  Eigen::VectorXd mu_, mu_neg_, mu_total_, row_scratch_, eq_work_, eq_y_;
   std::vector<double> fixed_, lambda_prev_;
   std::vector<Vec3List> cy_, cr_, cz_, cp_, cq_, ct_, cf_;  // per body: y, r, z, p, A p, scratch, rhs
 };

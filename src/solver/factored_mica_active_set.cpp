@@ -19,6 +19,7 @@
 #include <cmath>
 
 #include "core/error.hpp"
+#include "solver/cod_solve.hpp"
 #include "solver/factored_mica.hpp"
 #include "solver/mica_solver.hpp"
 
@@ -38,6 +39,11 @@ double dot(const std::vector<Vec3List>& a, const std::vector<Vec3List>& b) {
 
 void project_free(const Projection& projection, Vec3List& y) {
   for (int32_t i : projection.nodes) y[i] = projection.S[i] * y[i];
+}
+
+// v has at least n entries (grown, never shrunk: a smaller Eigen vector would be a new block).
+void at_least(Eigen::VectorXd& v, Eigen::Index n) {
+  if (v.size() < n) v.resize(n);
 }
 
 }  // namespace
@@ -62,24 +68,45 @@ void FactoredMicaSolver::choose_equalities(const ContactRows& rows, std::vector<
     const double t = std::hypot(lambda[first], lambda[first + 1]);
     if (t < (1 - 1e-6) * rows.mu[r] * lambda[n]) eq_.push_back(int32_t(r));  // inside the disk: sticks
   }
-  const Eigen::Index ne = Eigen::Index(eq_.size());
-  W_eq_.resize(ne, ne);
+  const Eigen::Index ne = Eigen::Index(eq_.size()), nr = Eigen::Index(rows.size());
+  // Workspaces for any active set of these rows (ne <= nr), grown with the rows only.
+  at_least(W_eq_, nr * nr);
+  for (Eigen::VectorXd* v : {&mu_, &mu_neg_, &mu_total_, &row_scratch_, &eq_work_, &eq_y_}) at_least(*v, nr);
+  prepare_equality_solvers(nr);
+  Eigen::Map<Eigen::MatrixXd> W_eq(W_eq_.data(), ne, ne);
   for (Eigen::Index a = 0; a < ne; ++a)
-    for (Eigen::Index b = 0; b < ne; ++b) W_eq_(a, b) = W0_(eq_[a], eq_[b]);
+    for (Eigen::Index b = 0; b < ne; ++b) W_eq(a, b) = W0_(eq_[a], eq_[b]);
   // Rank-revealing: rows pressing on nodes that cannot all move independently are redundant.
   if (ne > 0) {
-    W_eq_solver_.setThreshold(1e-10);
-    W_eq_solver_.compute(W_eq_);
+    W_eq_solver_ = &equality_solver(ne);
+    W_eq_solver_->setThreshold(1e-10);
+    W_eq_solver_->compute(W_eq);
   }
 }
 
-void FactoredMicaSolver::solve_equalities(const Eigen::VectorXd& rhs, Eigen::VectorXd& x) const {
-  if (eq_.empty()) x.resize(0);
-  else x = W_eq_solver_.solve(rhs);
+// One decomposition per size (Eigen's would allocate its matrices afresh for another size), made
+// for every size up to the rows' count when the rows first reach it, up to kPreparedEqualitySizes
+// (their memory is ~ n^3 / 3 doubles: 5.6 MB at 128); larger sets make theirs on first use.
+constexpr Eigen::Index kPreparedEqualitySizes = 128;
+
+void FactoredMicaSolver::prepare_equality_solvers(Eigen::Index nr) {
+  for (Eigen::Index k = Eigen::Index(W_eq_solvers_.size()); k <= std::min(nr, kPreparedEqualitySizes); ++k)
+    W_eq_solvers_.push_back(std::make_unique<Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd>>(k, k));
+}
+
+Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd>& FactoredMicaSolver::equality_solver(Eigen::Index ne) {
+  if (Eigen::Index(W_eq_solvers_.size()) <= ne) W_eq_solvers_.resize(size_t(ne) + 1);
+  auto& solver = W_eq_solvers_[size_t(ne)];
+  if (!solver) solver = std::make_unique<Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd>>(ne, ne);
+  return *solver;
+}
+
+void FactoredMicaSolver::solve_equalities(const Eigen::Ref<const Eigen::VectorXd>& rhs, Eigen::Ref<Eigen::VectorXd> x) {
+  if (!eq_.empty()) cod_solve(*W_eq_solver_, rhs, x, eq_work_, eq_y_);
 }
 
 void FactoredMicaSolver::add_response(const std::vector<SolverBody>& bodies, const ContactRows& rows,
-                                      const std::vector<int32_t>& which, const Eigen::VectorXd& x,
+                                      const std::vector<int32_t>& which, const Eigen::Ref<const Eigen::VectorXd>& x,
                                       std::vector<Vec3List>& out) {
   for (size_t bi = 0; bi < bodies.size(); ++bi) {
     y_.setZero(3 * Eigen::Index(bodies[bi].node_count()));
@@ -106,7 +133,8 @@ void FactoredMicaSolver::add_response(const std::vector<SolverBody>& bodies, con
 }
 
 void FactoredMicaSolver::subtract_row_forces(const std::vector<SolverBody>& bodies, const ContactRows& rows,
-                                             const Eigen::VectorXd& x, std::vector<Vec3List>& out) const {
+                                             const Eigen::Ref<const Eigen::VectorXd>& x,
+                                             std::vector<Vec3List>& out) const {
   for (size_t a = 0; a < eq_.size(); ++a) {
     const int32_t r = eq_[a];
     for (int32_t t = rows.start[r]; t < rows.start[r + 1]; ++t) {
@@ -118,8 +146,8 @@ void FactoredMicaSolver::subtract_row_forces(const std::vector<SolverBody>& bodi
   }
 }
 
-void FactoredMicaSolver::rows_times(const ContactRows& rows, const std::vector<Vec3List>& y, Eigen::VectorXd& out) const {
-  out.resize(Eigen::Index(eq_.size()));
+void FactoredMicaSolver::rows_times(const ContactRows& rows, const std::vector<Vec3List>& y,
+                                    Eigen::Ref<Eigen::VectorXd> out) const {
   for (size_t a = 0; a < eq_.size(); ++a) {
     const int32_t r = eq_[a];
     double c = 0;
@@ -150,7 +178,9 @@ SolveReport FactoredMicaSolver::constrained_solve(std::vector<SolverBody>& bodie
     project_free(*body.projection, cy_[bi]);  // the unknown y = S (v - z)
   }
   // Onto the equalities: G_E (y + z) + bias_E = 0, through P^-1 G_E^T and W_E = G_E P^-1 G_E^T.
-  Eigen::VectorXd& gap = row_scratch_;
+  const Eigen::Index ne = Eigen::Index(eq_.size());
+  auto gap = row_scratch_.head(ne);
+  auto mu = mu_.head(ne), mu_neg = mu_neg_.head(ne), mu_total = mu_total_.head(ne);
   rows_times(rows, cy_, gap);
   for (size_t a = 0; a < eq_.size(); ++a) {
     const int32_t r = eq_[a];
@@ -163,8 +193,8 @@ SolveReport FactoredMicaSolver::constrained_solve(std::vector<SolverBody>& bodie
     }
     gap(Eigen::Index(a)) = -(gap(Eigen::Index(a)) + c);
   }
-  solve_equalities(gap, mu_);
-  add_response(bodies, rows, eq_, mu_, cy_);
+  solve_equalities(gap, mu);
+  add_response(bodies, rows, eq_, mu, cy_);
 
   SolveReport report;
   double f2 = 0;
@@ -175,24 +205,24 @@ SolveReport FactoredMicaSolver::constrained_solve(std::vector<SolverBody>& bodie
     f2 += flat(cf_[bi]).squaredNorm();
   }
   double rz = 0;
-  mu_total_.setZero(Eigen::Index(eq_.size()));
+  mu_total.setZero();
   for (;;) {
     // z = P^-1 r projected onto G_E z = 0; mu: the impulses on E the residual asks for.
     for (size_t bi = 0; bi < nb; ++bi) {
       warp_[bi].apply(cr_[bi], cz_[bi]);
       project_free(*bodies[bi].projection, cz_[bi]);
     }
-    rows_times(rows, cz_, row_scratch_);
-    solve_equalities(row_scratch_, mu_);
-    mu_neg_ = -mu_;
-    add_response(bodies, rows, eq_, mu_neg_, cz_);
+    rows_times(rows, cz_, gap);
+    solve_equalities(gap, mu);
+    mu_neg = -mu;
+    add_response(bodies, rows, eq_, mu_neg, cz_);
     // The equalities take their share of the residual, r -= S G_E^T mu, at every step (the
     // residual update of Gould, Hribar and Nocedal: without it round-off in the projection stalls
     // the residual of a solve far from its factor's system); what is left must be small.
-    mu_total_ += mu_;
-    subtract_row_forces(bodies, rows, mu_, cr_);
+    mu_total += mu;
+    subtract_row_forces(bodies, rows, mu, cr_);
     for (size_t bi = 0; bi < nb; ++bi) ct_[bi].assign(ct_[bi].size(), Vec3::Zero());
-    subtract_row_forces(bodies, rows, mu_total_, ct_);
+    subtract_row_forces(bodies, rows, mu_total, ct_);
     const double g2 = dot(cr_, cr_), scale2 = std::max({f2, dot(ct_, ct_), 1e-300});  // the equalities' load included
     report.residual = std::sqrt(g2 / scale2);
     if (!std::isfinite(g2)) fail(Errc::Numerical, "the constrained velocity solve diverged (loads or state overflow)");
@@ -229,7 +259,7 @@ SolveReport FactoredMicaSolver::constrained_solve(std::vector<SolverBody>& bodie
     for (int32_t i : p.nodes) v[i] += p.z[i];
   }
   // The residual the equalities took, f - A y = S G_E^T mu_total = -S G_E^T lambda_E.
-  for (size_t a = 0; a < eq_.size(); ++a) lambda[eq_[a]] = -mu_total_(Eigen::Index(a));
+  for (size_t a = 0; a < eq_.size(); ++a) lambda[eq_[a]] = -mu_total(Eigen::Index(a));
   return report;
 }
 

@@ -7,22 +7,17 @@
 #include <limits>
 
 #include "core/error.hpp"
+#include "solver/cod_solve.hpp"
 #include "solver/friction_cone.hpp"
 
 namespace mica {
 
 namespace {
 
-// One contact's rows and its 3x3 block of M; an absent tangent row is a decoupled row with the
-// normal's diagonal (its impulse stays zero).
-struct Block {
-  int32_t row[3];  // normal, tangent, tangent (-1: absent)
-  Mat3 W;
-  double mu;
-};
+using Block = FrictionalWorkspace::Block;
 
-std::vector<Block> blocks_of(const Eigen::MatrixXd& M, const std::vector<ConeContact>& contacts) {
-  std::vector<Block> blocks;
+void blocks_of(const Eigen::MatrixXd& M, const std::vector<ConeContact>& contacts, std::vector<Block>& blocks) {
+  blocks.clear();
   for (const ConeContact& c : contacts) {
     Block b{{c.normal, c.tangent[0], c.tangent[1]}, Mat3::Zero(), c.mu};
     for (int i = 0; i < 3; ++i)
@@ -31,7 +26,6 @@ std::vector<Block> blocks_of(const Eigen::MatrixXd& M, const std::vector<ConeCon
         else if (i == j) b.W(i, j) = M(c.normal, c.normal);
     blocks.push_back(b);
   }
-  return blocks;
 }
 
 // One sweep over the contacts, each moved a fraction omega of the way to its exact local solution
@@ -114,16 +108,30 @@ void natural_map(const Eigen::MatrixXd& M, const std::vector<Block>& blocks, con
 FrictionalSolution solve_frictional_contact(const Eigen::MatrixXd& M, const Eigen::VectorXd& q,
                                             const Eigen::VectorXd& mu, const std::vector<int32_t>& normal_index,
                                             const Eigen::VectorXd& z0, const FrictionalSettings& settings) {
-  const std::vector<ConeContact> contacts = cone_contacts(M, q, mu, normal_index, "solve_frictional_contact");
+  FrictionalWorkspace ws;
+  FrictionalSolution s;
+  solve_frictional_contact(M, q, mu, normal_index, z0, settings, ws, s);
+  return s;
+}
+
+void solve_frictional_contact(const Eigen::MatrixXd& M, const Eigen::VectorXd& q, const Eigen::VectorXd& mu,
+                              const std::vector<int32_t>& normal_index, const Eigen::VectorXd& z0,
+                              const FrictionalSettings& settings, FrictionalWorkspace& ws, FrictionalSolution& s) {
+  cone_contacts(M, q, mu, normal_index, "solve_frictional_contact", ws.contacts, ws.contact_of);
+  const std::vector<ConeContact>& contacts = ws.contacts;
   const Eigen::Index n = q.size();
   if (z0.size() != 0 && (z0.size() != n || !z0.allFinite()))
     fail(Errc::InvalidArgument, "solve_frictional_contact: the warm start needs one finite entry per row");
   if (!(settings.tolerance >= 0) || settings.max_sweeps < 0)
     fail(Errc::InvalidArgument, "solve_frictional_contact: need tolerance >= 0 and max_sweeps >= 0");
-  const std::vector<Block> blocks = blocks_of(M, contacts);
+  blocks_of(M, contacts, ws.blocks);
+  const std::vector<Block>& blocks = ws.blocks;
 
-  FrictionalSolution s;
-  s.z = z0.size() ? z0 : Eigen::VectorXd::Zero(n);
+  s.solved = s.out_of_time = false;
+  s.sweeps = s.newton_steps = 0;
+  s.error = s.scale = 0;
+  if (z0.size()) s.z = z0;
+  else s.z.setZero(n);
   for (const Block& b : blocks) {
     double t[2] = {b.row[1] >= 0 ? s.z(b.row[1]) : 0.0, b.row[2] >= 0 ? s.z(b.row[2]) : 0.0};
     project_onto_cone(b.mu, s.z(b.row[0]), t[0], t[1]);
@@ -154,9 +162,11 @@ FrictionalSolution solve_frictional_contact(const Eigen::MatrixXd& M, const Eige
   // Gauss-Seidel can with strongly coupled sliding contacts, the second half of the sweep budget
   // is damped (half way to each local solution): slower, but a contraction in practice. Either
   // way the result is checked by cone_error and said.
-  Eigen::VectorXd F(n), F_trial(n), dz(n), z_trial(n), w_trial(n);
-  Eigen::MatrixXd J(n, n);
-  Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod(n, n);
+  for (Eigen::VectorXd* v : {&ws.F, &ws.F_trial, &ws.dz, &ws.z_trial, &ws.w_trial, &ws.cod_work, &ws.cod_y}) v->resize(n);
+  ws.J.resize(n, n);
+  Eigen::VectorXd &F = ws.F, &F_trial = ws.F_trial, &dz = ws.dz, &z_trial = ws.z_trial, &w_trial = ws.w_trial;
+  Eigen::MatrixXd& J = ws.J;
+  Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd>& cod = ws.cod;
   auto out_of_time = [&] {
     s.out_of_time = settings.deadline && std::chrono::steady_clock::now() >= *settings.deadline;
     return s.out_of_time;
@@ -188,7 +198,8 @@ FrictionalSolution solve_frictional_contact(const Eigen::MatrixXd& M, const Eige
     for (int k = 0; k < 20 && newton && !s.solved && !out_of_time(); ++k) {
       natural_map(M, blocks, s.z, s.w, F, &J);
       cod.compute(J);
-      dz.noalias() = -cod.solve(F);
+      cod_solve(cod, F, dz, ws.cod_work, ws.cod_y);
+      dz = -dz;
       const double f0 = F.norm();
       bool lowered = false;
       for (double alpha = 1; alpha >= 1.0 / 256 && !lowered; alpha /= 2) {
@@ -230,8 +241,8 @@ FrictionalSolution solve_frictional_contact(const Eigen::MatrixXd& M, const Eige
                 : stalled       ? "stalled"
                                 : "sweep limit reached",
                 int(s.sweeps), int(s.newton_steps), s.error, s.scale > 0 ? s.error / s.scale : 0.0, s.scale);
+  s.message.reserve(sizeof text);  // kept: later messages fit
   s.message = text;
-  return s;
 }
 
 }  // namespace mica

@@ -37,11 +37,34 @@ struct FrictionalSolution {
   std::string message;       // what happened, for a person to read
 };
 
+// What a solve works in: kept by a caller that solves again and again (the solver loop), a solve
+// allocates nothing once the workspace and the solution have served a problem of as many rows
+// and contacts (an Eigen vector or matrix of another size is allocated afresh).
+struct FrictionalWorkspace {
+  // One contact's rows and its 3x3 block of M; an absent tangent row is a decoupled row with the
+  // normal's diagonal (its impulse stays zero).
+  struct Block {
+    int32_t row[3];  // normal, tangent, tangent (-1: absent)
+    Eigen::Matrix3d W;
+    double mu;
+  };
+  std::vector<ConeContact> contacts;
+  std::vector<int32_t> contact_of;
+  std::vector<Block> blocks;
+  Eigen::VectorXd F, F_trial, dz, z_trial, w_trial, cod_work, cod_y;
+  Eigen::MatrixXd J;
+  Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod;
+};
+
 // z0: the warm start, projected onto the cones (empty: zero). Throws Error(InvalidArgument) as
 // cone_error does, or if z0 has the wrong size or a non-finite entry. Allocates only before
 // the sweeps.
 FrictionalSolution solve_frictional_contact(const Eigen::MatrixXd& M, const Eigen::VectorXd& q,
                                             const Eigen::VectorXd& mu, const std::vector<int32_t>& normal_index,
                                             const Eigen::VectorXd& z0, const FrictionalSettings& settings);
+// The same into s, in ws (see FrictionalWorkspace).
+void solve_frictional_contact(const Eigen::MatrixXd& M, const Eigen::VectorXd& q, const Eigen::VectorXd& mu,
+                              const std::vector<int32_t>& normal_index, const Eigen::VectorXd& z0,
+                              const FrictionalSettings& settings, FrictionalWorkspace& ws, FrictionalSolution& s);
 
 }  // namespace mica

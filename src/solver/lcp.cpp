@@ -272,12 +272,21 @@ LcpSolution solve_lcp_pgs(const Eigen::MatrixXd& M, const Eigen::VectorXd& q, do
 
 std::vector<ConeContact> cone_contacts(const Eigen::MatrixXd& M, const Eigen::VectorXd& q, const Eigen::VectorXd& mu,
                                        const std::vector<int32_t>& normal_index, const char* who) {
+  std::vector<ConeContact> contacts;
+  std::vector<int32_t> contact_of;
+  cone_contacts(M, q, mu, normal_index, who, contacts, contact_of);
+  return contacts;
+}
+
+void cone_contacts(const Eigen::MatrixXd& M, const Eigen::VectorXd& q, const Eigen::VectorXd& mu,
+                   const std::vector<int32_t>& normal_index, const char* who, std::vector<ConeContact>& contacts,
+                   std::vector<int32_t>& contact_of) {
   check_problem(M, q, who);
   const Eigen::Index n = q.size();
   if (mu.size() != n || Eigen::Index(normal_index.size()) != n)
     fail(Errc::InvalidArgument, std::string(who) + ": mu and normal_index need one entry per row");
-  std::vector<ConeContact> contacts;
-  std::vector<int32_t> contact_of(size_t(n), -1);
+  contacts.clear();
+  contact_of.assign(size_t(n), -1);
   for (Eigen::Index r = 0; r < n; ++r) {
     if (!(M(r, r) > 0))
       fail(Errc::InvalidArgument, std::string(who) + ": row " + std::to_string(r) + " has no positive diagonal");
@@ -302,7 +311,6 @@ std::vector<ConeContact> cone_contacts(const Eigen::MatrixXd& M, const Eigen::Ve
     c.tangent[c.tangent[0] >= 0 ? 1 : 0] = int32_t(r);
     c.mu = mu(r);
   }
-  return contacts;
 }
 
 double cone_error(const Eigen::MatrixXd& M, const std::vector<ConeContact>& contacts, const Eigen::VectorXd& z,

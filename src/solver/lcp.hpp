@@ -64,6 +64,10 @@ struct ConeContact {
 };
 std::vector<ConeContact> cone_contacts(const Eigen::MatrixXd& M, const Eigen::VectorXd& q, const Eigen::VectorXd& mu,
                                        const std::vector<int32_t>& normal_index, const char* who);
+// The same into contacts, with contact_of as scratch (no allocation once both have the capacity).
+void cone_contacts(const Eigen::MatrixXd& M, const Eigen::VectorXd& q, const Eigen::VectorXd& mu,
+                   const std::vector<int32_t>& normal_index, const char* who, std::vector<ConeContact>& contacts,
+                   std::vector<int32_t>& contact_of);
 // cone_error on validated contacts; w = M z + q given.
 double cone_error(const Eigen::MatrixXd& M, const std::vector<ConeContact>& contacts, const Eigen::VectorXd& z,
                   const Eigen::VectorXd& w);

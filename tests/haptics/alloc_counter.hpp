@@ -8,8 +8,13 @@
 //
 // It replaces the global operator new and delete (every form) of the test binary, so include
 // it in exactly one translation unit of a binary (each tests/<concern>/test_*.cpp is its own
-// binary). Only operator new is counted; a direct malloc() is not.
+// binary). Only operator new is counted; a direct malloc() is not, unless the binary defines
+// MICA_TEST_COUNT_MALLOC before including this: then malloc and its kin (calloc, realloc,
+// posix_memalign, ...) are replaced too and every heap block counts once, whoever asks for it
+// (Eigen allocates with malloc, not new). To see who allocates: a breakpoint on
+// mica_test::note_allocation.
 #pragma once
+#include <cstddef>
 #include <cstdint>
 #include <cstdlib>
 #include <new>
@@ -31,8 +36,16 @@ inline int64_t stop_counting_allocations() {
   return allocations_counted;
 }
 
+// Called for each allocation counted (a place for a debugger's breakpoint).
+[[gnu::noinline]] inline void note_allocation() {
+  ++allocations_counted;
+  asm volatile("");
+}
+
 inline void* counted_allocation(std::size_t size, std::size_t alignment) noexcept {
-  if (counting_allocations) ++allocations_counted;
+#ifndef MICA_TEST_COUNT_MALLOC  // else malloc counts it
+  if (counting_allocations) note_allocation();
+#endif
   if (size == 0) size = 1;  // new must return a distinct pointer for size 0
   if (alignment <= alignof(std::max_align_t)) return std::malloc(size);
   void* p = nullptr;
@@ -78,3 +91,39 @@ void operator delete(void* p, const std::nothrow_t&) noexcept { std::free(p); }
 void operator delete[](void* p, const std::nothrow_t&) noexcept { std::free(p); }
 void operator delete(void* p, std::align_val_t, const std::nothrow_t&) noexcept { std::free(p); }
 void operator delete[](void* p, std::align_val_t, const std::nothrow_t&) noexcept { std::free(p); }
+
+#ifdef MICA_TEST_COUNT_MALLOC
+// glibc's own allocator under its exported internal names; the replacements count, then forward
+// (so free, malloc_usable_size and the rest of glibc see ordinary glibc blocks).
+extern "C" {
+void* __libc_malloc(std::size_t);
+void* __libc_calloc(std::size_t, std::size_t);
+void* __libc_realloc(void*, std::size_t);
+void* __libc_memalign(std::size_t, std::size_t);
+
+void* malloc(std::size_t n) noexcept {
+  if (mica_test::counting_allocations) mica_test::note_allocation();
+  return __libc_malloc(n);
+}
+void* calloc(std::size_t count, std::size_t n) noexcept {
+  if (mica_test::counting_allocations) mica_test::note_allocation();
+  return __libc_calloc(count, n);
+}
+void* realloc(void* p, std::size_t n) noexcept {
+  if (mica_test::counting_allocations) mica_test::note_allocation();
+  return __libc_realloc(p, n);
+}
+void* memalign(std::size_t alignment, std::size_t n) noexcept {
+  if (mica_test::counting_allocations) mica_test::note_allocation();
+  return __libc_memalign(alignment, n);
+}
+void* aligned_alloc(std::size_t alignment, std::size_t n) noexcept { return memalign(alignment, n); }
+int posix_memalign(void** out, std::size_t alignment, std::size_t n) noexcept {
+  if (alignment % sizeof(void*) != 0 || (alignment & (alignment - 1)) != 0) return 22;  // EINVAL
+  void* p = memalign(alignment, n);
+  if (!p) return 12;  // ENOMEM
+  *out = p;
+  return 0;
+}
+}
+#endif
