@@ -47,6 +47,8 @@ World::World(const WorldSettings& settings) : settings_(settings) {
 }
 
 World::~World() = default;
+World::World(World&&) noexcept = default;
+World& World::operator=(World&&) noexcept = default;
 
 void World::set_gravity(const Vec3& g) {
   require_finite(g, "gravity");

@@ -122,6 +122,8 @@ class World {
  public:
   explicit World(const WorldSettings& settings);
   ~World();
+  World(World&&) noexcept;  // defined where Recorder is complete
+  World& operator=(World&&) noexcept;
 
   const WorldSettings& settings() const { return settings_; }
   void set_gravity(const Vec3& g);
