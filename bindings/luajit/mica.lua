@@ -130,8 +130,9 @@ end
 
 -- Destroys the world now (ids and position views die with it), then frees the callbacks made
 -- for its devices.
+-- A replay's world (replay.world) belongs to the replay: close() leaves it to replay:close().
 function World:close()
-  if self.ptr ~= nil then
+  if self.ptr ~= nil and self.replay == nil then
     C.mica_world_destroy(ffi.gc(self.ptr, nil))
     self.ptr = nil
     for _, cb in ipairs(self.callbacks) do cb:free() end
@@ -325,6 +326,21 @@ function World:restore_state(state)
   self:check(C.mica_world_restore_state(self.ptr, state, #state))
 end
 
+-- Since 0.6: the ids of the world's live objects of one kind (C.MICA_OBJECT_BODY, _LPC, _TOOL or
+-- _DEVICE), in slot order: a uint64_t array (0-based) and its count.
+function World:ids(kind)
+  local count = ffi.new("int32_t[1]")
+  self:check(C.mica_world_get_ids(self.ptr, kind, nil, 0, count))
+  local out = ffi.new("uint64_t[?]", math.max(count[0], 1))
+  self:check(C.mica_world_get_ids(self.ptr, kind, out, count[0], count))
+  return out, count[0]
+end
+
+-- Since 0.6: records the session into a file (created or truncated), for mica.replay(): call it
+-- on a new world, before anything is added. record_stop() raises if a write failed meanwhile.
+function World:record_start(path) self:check(C.mica_world_record_start(self.ptr, path)) end
+function World:record_stop() self:check(C.mica_world_record_stop(self.ptr)) end
+
 -- The contacts of the last step: a mica_contact[?] array (0-based) and its count.
 function World:contacts()
   local n = ffi.new("int32_t[1]")
@@ -370,6 +386,45 @@ function World:create_device(fields, callbacks)
   local id = ffi.new("mica_device_id[1]")
   self:check(C.mica_device_create(self.ptr, def, id))
   return id[0]
+end
+
+-- Replay ----------------------------------------------------------------------------------
+
+local Replay = {}
+Replay.__index = Replay
+M.Replay = Replay
+
+-- Since 0.6: opens a recording (World:record_start) to replay it into a world of its own,
+-- replay.world (ids are the recorded ones; read it between steps, changing it makes the rest of
+-- the replay diverge). The replay is closed by replay:close() or, failing that, by the garbage
+-- collector; its world goes with it.
+function M.replay(path)
+  local out = ffi.new("mica_replay*[1]")
+  check(C.mica_replay_open(path, out), nil)
+  local self = setmetatable({ ptr = ffi.gc(out[0], C.mica_replay_close) }, Replay)
+  -- Not ffi.gc'd: the world is the replay's. It holds the replay, so the replay outlives it.
+  self.world = setmetatable({ ptr = C.mica_replay_world(self.ptr), callbacks = {}, replay = self }, World)
+  return self
+end
+
+-- The next recorded step (with the calls before it), checked against the recording: returns
+-- true and the step's status (a warning such as MICA_WARN_NOT_CONVERGED is returned, as by
+-- World:step), or false at the end of the recording. Raises a mica.Error: MICA_ERR_DIVERGED
+-- when the step does not reproduce the recording (the message names the step).
+function Replay:step()
+  assert(self.ptr ~= nil, "the replay is closed")
+  local stepped = ffi.new("int32_t[1]")
+  local status = check(C.mica_replay_step(self.ptr, stepped), self.world.ptr)
+  return stepped[0] ~= 0, status
+end
+
+-- Closes the replay and destroys its world now.
+function Replay:close()
+  if self.ptr ~= nil then
+    self.world.ptr = nil
+    C.mica_replay_close(ffi.gc(self.ptr, nil))
+    self.ptr = nil
+  end
 end
 
 return M

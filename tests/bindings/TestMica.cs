@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // Tests of the C# binding (bindings/csharp/com.libmica.mica/Runtime): its declarations against the
 // header manifest (the drift guard), the sphere-indent scene against the C reference, errors,
-// the SafeHandle, the log callback and a device backend written in C#.
+// the SafeHandle, the log callback, a device backend written in C#, recording and replay.
 // Environment (tests/bindings/CMakeLists.txt): MICA_MANIFEST_TSV, MICA_REFERENCE; libmica on
 // LD_LIBRARY_PATH.
 using System;
@@ -574,6 +574,152 @@ static class TestMica
         }
     }
 
+    // Recording and replay (since 0.6): a box on a fixed base pressed by a sphere, recorded.
+    const int RecordedSteps = 20;
+
+    // Records the session into `path`: the ids by kind, each step's tool force and positions.
+    static Dictionary<int, ulong[]> RecordSession(string path, List<double[]> forces, List<double[]> positions)
+    {
+        var wdef = Mica.WorldDef();
+        using (var world = new World(wdef))
+        {
+            world.RecordStart(path);
+            try
+            {
+                world.RecordStart(path);
+                Expect(false, "recording twice throws");
+            }
+            catch (MicaException e)
+            {
+                Expect(e.Status == MicaNative.MICA_ERR_WRONG_STATE, "already recording");
+            }
+            var bdef = Mica.BodyDef();
+            bdef.youngs_modulus = 2e4;
+            var body = world.CreateBox(new double[] { 0, 0, 0 }, new double[] { 0.1, 0.1, 0.1 }, new[] { 3, 3, 3 }, 5, bdef);
+            var lpc = body.AddLpc(body.SelectNodesByPlane(new double[] { 0, 0, 0 }, new double[] { 0, 1, 0 }, 1e-9, true),
+                                  Mica.LpcDef());
+            var tdef = Mica.ToolDef();
+            unsafe { tdef.radius = 0.02; tdef.position[0] = 0.05; tdef.position[1] = 0.1205; tdef.position[2] = 0.05; }
+            var tool = world.CreateTool(tdef);
+            var ids = new Dictionary<int, ulong[]>
+            {
+                { MicaNative.MICA_OBJECT_BODY, new[] { body.Id } },
+                { MicaNative.MICA_OBJECT_LPC, new[] { lpc.Id } },
+                { MicaNative.MICA_OBJECT_TOOL, new[] { tool.Id } },
+                { MicaNative.MICA_OBJECT_DEVICE, new ulong[0] },
+            };
+            foreach (var kv in ids)
+                Expect(world.GetIds(kv.Key).SequenceEqual(kv.Value), "the ids of kind " + kv.Key + " are the created ones");
+            for (int k = 1; k <= RecordedSteps; ++k)
+            {
+                tool.SetPose(new double[] { 0.05, 0.1205 - 0.0003 * k, 0.05 }); // 6 mm down over the session
+                world.Step(0.01);
+                forces.Add(tool.GetForce());
+                positions.Add(body.GetPositions());
+            }
+            Expect(forces[forces.Count - 1][1] > 0, "the tool is pressing");
+            world.RecordStop();
+            try
+            {
+                world.RecordStop();
+                Expect(false, "stopping twice throws");
+            }
+            catch (MicaException e)
+            {
+                Expect(e.Status == MicaNative.MICA_ERR_WRONG_STATE, "not recording");
+            }
+            return ids;
+        }
+    }
+
+    static bool SameBits(double[] a, double[] b)
+    {
+        return a.Select(BitConverter.DoubleToInt64Bits).SequenceEqual(b.Select(BitConverter.DoubleToInt64Bits));
+    }
+
+    static void RecordAndReplay()
+    {
+        string path = Path.GetTempFileName();
+        try
+        {
+            var forces = new List<double[]>();
+            var positions = new List<double[]>();
+            var ids = RecordSession(path, forces, positions);
+            World world;
+            using (var replay = new Replay(path))
+            {
+                world = replay.World;
+                Expect(world.GetIds(MicaNative.MICA_OBJECT_BODY).Length == 0, "the recorded calls come with the steps");
+                Body body = null;
+                Tool tool = null;
+                int k = 0;
+                while (replay.Step())
+                {
+                    Expect(k < RecordedSteps, "no more steps than recorded");
+                    if (k == 0) // the first step made the recorded creations
+                    {
+                        foreach (var kv in ids)
+                            Expect(world.GetIds(kv.Key).SequenceEqual(kv.Value), "the replay's ids of kind " + kv.Key);
+                        body = new Body(world, world.GetIds(MicaNative.MICA_OBJECT_BODY)[0]);
+                        tool = new Tool(world, world.GetIds(MicaNative.MICA_OBJECT_TOOL)[0]);
+                    }
+                    Expect(SameBits(tool.GetForce(), forces[k]), "the tool force of step " + (k + 1));
+                    Expect(SameBits(body.GetPositions(), positions[k]), "the positions of step " + (k + 1));
+                    ++k;
+                }
+                Expect(k == RecordedSteps, "the step count: " + k);
+                world.Dispose(); // the replay's world is the replay's: this leaves it alone
+                Expect(!world.IsDisposed && !replay.Step(), "the end stays the end");
+            }
+            Expect(world.IsDisposed, "disposing the replay disposes its world");
+        }
+        finally
+        {
+            File.Delete(path);
+        }
+    }
+
+    static void ReplayDiverges()
+    {
+        string path = Path.GetTempFileName();
+        try
+        {
+            RecordSession(path, new List<double[]>(), new List<double[]>());
+            // The file ends with the last step's fingerprint.
+            var bytes = File.ReadAllBytes(path);
+            bytes[bytes.Length - 1] ^= 1;
+            File.WriteAllBytes(path, bytes);
+            using (var replay = new Replay(path))
+            {
+                int k = 0;
+                try
+                {
+                    while (replay.Step()) ++k;
+                    Expect(false, "a changed fingerprint throws");
+                }
+                catch (MicaException e)
+                {
+                    Expect(e.Status == MicaNative.MICA_ERR_DIVERGED, "MICA_ERR_DIVERGED: " + e.Message);
+                    Expect(e.LibraryMessage.Contains("step " + RecordedSteps), "the message names the step: " + e.Message);
+                }
+                Expect(k == RecordedSteps - 1, "the steps before the last replay: " + k);
+            }
+        }
+        finally
+        {
+            File.Delete(path);
+        }
+        try
+        {
+            new Replay(path).Dispose();
+            Expect(false, "a missing recording throws");
+        }
+        catch (MicaException e)
+        {
+            Expect(e.Status == MicaNative.MICA_ERR_IO, "MICA_ERR_IO: " + e.Message);
+        }
+    }
+
     static int Main()
     {
         ReadManifest(Environment.GetEnvironmentVariable("MICA_MANIFEST_TSV"));
@@ -588,6 +734,8 @@ static class TestMica
         Test("a mesh file and raw ids, from another assembly", LoaderAndRawIds);
         Test("tissue regions, materials and fields", RegionsMaterialsAndFields);
         Test("System.Numerics Vector3 and Quaternion overloads", NumericsOverloads);
+        Test("a recorded session replays bit for bit, with the recorded ids", RecordAndReplay);
+        Test("a changed fingerprint diverges at its step", ReplayDiverges);
         Console.WriteLine("{0} passed, {1} failed, {2} skipped", passed, failed, skipped);
         return failed == 0 ? 0 : 1;
     }

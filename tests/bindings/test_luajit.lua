@@ -1,6 +1,7 @@
 -- SPDX-License-Identifier: Apache-2.0
 -- Tests of the LuaJIT binding (bindings/luajit): the generated cdef against the header
--- manifest (the drift guard), the sphere-indent scene against the C reference, errors, devices.
+-- manifest (the drift guard), the sphere-indent scene against the C reference, errors, devices,
+-- recording and replay.
 -- Environment (tests/bindings/CMakeLists.txt): MICA_LIBRARY, MICA_MANIFEST_TSV, MICA_REFERENCE;
 -- LUA_PATH finds mica.lua and the generated mica_cdef.lua.
 local ffi = require("ffi")
@@ -361,6 +362,96 @@ test("tissue regions, materials and fields", function()
   local want = { 7, 7, 7, 9, 9, 0 }
   for e = 0, 5 do expect(r[e] == want[e + 1], "Gmsh physical tags") end
   world:close()
+end)
+
+-- Recording and replay (since 0.6): a box on a fixed base pressed by a sphere, recorded, then
+-- replayed bit for bit; world:ids() gives the created ids; a changed fingerprint diverges.
+local RECORDED_STEPS = 20
+
+-- Records the session into `path`: returns the ids {body, lpc, tool} and each step's tool force
+-- and positions as byte strings.
+local function record_session(path)
+  local world = mica.world{ gravity = { 0, -9.81, 0 } }
+  world:record_start(path)
+  local ok, err = pcall(world.record_start, world, path)
+  expect(not ok and err.status == C.MICA_ERR_WRONG_STATE, "already recording")
+  local box = world:create_box({ 0, 0, 0 }, { 0.1, 0.1, 0.1 }, { 3, 3, 3 }, 5, { youngs_modulus = 2e4 })
+  local lpc = world:add_lpc(box, world:select_nodes_by_plane(box, { 0, 0, 0 }, { 0, 1, 0 }))
+  local tool = world:create_tool{ radius = 0.02, position = { 0.05, 0.1205, 0.05 } }
+  local ids = { [C.MICA_OBJECT_BODY] = box, [C.MICA_OBJECT_LPC] = lpc, [C.MICA_OBJECT_TOOL] = tool }
+  for kind, id in pairs(ids) do
+    local got, n = world:ids(kind)
+    expect(n == 1 and got[0] == id, "the ids of kind " .. kind .. " are the created ones")
+  end
+  local _, devices = world:ids(C.MICA_OBJECT_DEVICE)
+  expect(devices == 0, "no devices")
+  local steps = {}
+  for k = 1, RECORDED_STEPS do
+    world:set_tool_pose(tool, { 0.05, 0.1205 - 0.0003 * k, 0.05 }) -- 6 mm down over the session
+    world:step(0.01)
+    local p, count = world:positions(box)
+    steps[k] = { force = ffi.string(world:tool_force(tool), 24), positions = ffi.string(p, 24 * count) }
+  end
+  expect(world:tool_force(tool)[1] > 0, "the tool is pressing")
+  world:record_stop()
+  ok, err = pcall(world.record_stop, world)
+  expect(not ok and err.status == C.MICA_ERR_WRONG_STATE, "not recording")
+  world:close()
+  return ids, steps
+end
+
+test("a recorded session replays bit for bit, with the recorded ids", function()
+  local path = os.tmpname()
+  local ids, steps = record_session(path)
+  local replay = mica.replay(path)
+  local world = replay.world
+  local _, bodies = world:ids(C.MICA_OBJECT_BODY)
+  expect(bodies == 0, "the recorded calls come with the steps")
+  local box, tool = ids[C.MICA_OBJECT_BODY], ids[C.MICA_OBJECT_TOOL]
+  local k = 0
+  while replay:step() do
+    k = k + 1
+    if k == 1 then -- the first step made the recorded creations
+      for kind, id in pairs(ids) do
+        local got, n = world:ids(kind)
+        expect(n == 1 and got[0] == id, "the replay's ids of kind " .. kind .. " are the recorded ones")
+      end
+    end
+    expect(k <= #steps, "no more steps than recorded")
+    local p, count = world:positions(box)
+    expect(ffi.string(world:tool_force(tool), 24) == steps[k].force, "the tool force of step " .. k)
+    expect(ffi.string(p, 24 * count) == steps[k].positions, "the positions of step " .. k)
+  end
+  expect(k == RECORDED_STEPS, "the step count: " .. k)
+  world:close() -- the replay's world is the replay's: this leaves it alone
+  expect(world.ptr ~= nil and not replay:step(), "the end stays the end")
+  replay:close()
+  expect(world.ptr == nil, "closing the replay closes its world")
+  replay:close() -- twice is harmless
+  os.remove(path)
+end)
+
+test("a changed fingerprint diverges at its step", function()
+  local path = os.tmpname()
+  record_session(path)
+  -- The file ends with the last step's fingerprint.
+  local f = assert(io.open(path, "r+b"))
+  local size = f:seek("end")
+  f:seek("set", size - 1)
+  local last = f:read(1):byte()
+  f:seek("set", size - 1)
+  f:write(string.char(bit.bxor(last, 1)))
+  f:close()
+  local replay = mica.replay(path)
+  local k = 0
+  local ok, err = pcall(function() while replay:step() do k = k + 1 end end)
+  expect(not ok and err.status == C.MICA_ERR_DIVERGED and err.name:find("MICA_ERR_DIVERGED"), tostring(err))
+  expect(k == RECORDED_STEPS - 1, "the steps before the last replay: " .. k)
+  expect(err.message:find("step " .. RECORDED_STEPS), "the message names the step: " .. err.message)
+  replay:close()
+  os.remove(path)
+  ok, err = pcall(mica.replay, path)
+  expect(not ok and err.status == C.MICA_ERR_IO, "a missing recording: " .. tostring(err))
 end)
 
 print(string.format("%d passed, %d failed, %d skipped", passed, failed, skipped))

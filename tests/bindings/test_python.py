@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: Apache-2.0
 """Tests of the Python binding (bindings/python/mica): its declarations against the header
 manifest (the drift guard), the sphere-indent scene against the C reference, errors, warnings,
-view lifetime, and devices implemented in Python.
+view lifetime, devices implemented in Python, and recording and replay.
 
 Environment (set by tests/bindings/CMakeLists.txt): MICA_LIBRARY, MICA_MANIFEST,
 MICA_REFERENCE, MICA_BINDINGS_BUILD_DIR; PYTHONPATH holds bindings/python.
@@ -12,6 +12,7 @@ import json
 import os
 import subprocess
 import sys
+import tempfile
 import unittest
 import warnings
 
@@ -373,6 +374,88 @@ class Behaviour(unittest.TestCase):
         self.assertEqual(r.returncode, 0, r.stderr)
         build = os.path.dirname(os.environ["MICA_BINDINGS_BUILD_DIR"])
         self.assertEqual(os.path.realpath(r.stdout.strip()), os.path.realpath(os.path.join(build, "libmica.so.0")))
+
+
+class Recording(unittest.TestCase):
+    """World.record_start/record_stop, World.ids and Replay: a recorded session replays bit for bit."""
+
+    STEPS, DT = 20, 0.01
+
+    def record(self, path):
+        """A box on a fixed base pressed by a sphere, recorded: (ids, forces, positions) per step."""
+        with mica.World(gravity=(0, -9.81, 0)) as world:
+            world.record_start(path)
+            with self.assertRaises(mica.MicaError) as caught:
+                world.record_start(path)
+            self.assertEqual(caught.exception.status, mica.MICA_ERR_WRONG_STATE, "already recording")
+            body = world.create_box((0, 0, 0), (0.1, 0.1, 0.1), (3, 3, 3), youngs_modulus=2e4)
+            lpc = body.add_lpc(body.select_nodes_by_plane((0, 0, 0), (0, 1, 0)))
+            tool = world.create_tool(radius=0.02, position=(0.05, 0.1205, 0.05))
+            ids = {mica.MICA_OBJECT_BODY: [body.id], mica.MICA_OBJECT_LPC: [lpc.id],
+                   mica.MICA_OBJECT_TOOL: [tool.id], mica.MICA_OBJECT_DEVICE: []}
+            for kind, expected in ids.items():
+                self.assertEqual(world.ids(kind), expected, "the ids of kind %d are the created ones" % kind)
+            forces, positions = [], []
+            for k in range(1, self.STEPS + 1):
+                tool.set_pose((0.05, 0.1205 - 0.0003 * k, 0.05))  # 6 mm down over the session
+                world.step(self.DT)
+                forces.append(tool.force()[0])
+                positions.append(body.get_positions())
+            world.record_stop()
+            with self.assertRaises(mica.MicaError) as caught:
+                world.record_stop()
+            self.assertEqual(caught.exception.status, mica.MICA_ERR_WRONG_STATE, "not recording")
+        self.assertGreater(forces[-1][1], 0, "the tool is pressing")
+        return ids, np.array(forces), np.array(positions)
+
+    def test_replay_is_bit_for_bit(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "session.micarec")
+            ids, forces, positions = self.record(path)
+            with mica.Replay(path) as replay:
+                world = replay.world
+                self.assertEqual(world.ids(mica.MICA_OBJECT_BODY), [], "the recorded calls come with the steps")
+                got_forces, got_positions = [], []
+                while replay.step():
+                    if not got_forces:  # the first step made the recorded creations
+                        for kind, expected in ids.items():
+                            self.assertEqual(world.ids(kind), expected, "the replay's ids are the recorded ones")
+                        body = mica.Body(world, world.ids(mica.MICA_OBJECT_BODY)[0])
+                        tool = mica.Tool(world, world.ids(mica.MICA_OBJECT_TOOL)[0])
+                    got_forces.append(tool.force()[0])
+                    got_positions.append(body.get_positions())
+                world.close()  # the replay's world is the replay's: this does not destroy it
+                self.assertFalse(world.closed)
+                self.assertEqual(len(got_forces), self.STEPS, "the step count")
+                self.assertEqual(np.array(got_forces).tobytes(), forces.tobytes(), "tool forces")
+                self.assertEqual(np.array(got_positions).tobytes(), positions.tobytes(), "positions")
+                self.assertFalse(replay.step(), "the end stays the end")
+            self.assertTrue(replay.closed)
+            self.assertTrue(world.closed, "closing the replay closes its world")
+            with self.assertRaises(mica.MicaError):
+                world.ids(mica.MICA_OBJECT_BODY)
+
+    def test_a_changed_fingerprint_diverges_at_its_step(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "session.micarec")
+            self.record(path)
+            # The file ends with the last step's fingerprint.
+            with open(path, "r+b") as f:
+                f.seek(-1, os.SEEK_END)
+                last = f.read(1)[0]
+                f.seek(-1, os.SEEK_END)
+                f.write(bytes([last ^ 1]))
+            with mica.Replay(path) as replay:
+                steps = 0
+                with self.assertRaises(mica.MicaError) as caught:
+                    while replay.step():
+                        steps += 1
+                self.assertEqual(caught.exception.status, mica.MICA_ERR_DIVERGED)
+                self.assertEqual(steps, self.STEPS - 1, "the steps before the last replay")
+                self.assertIn("step %d" % self.STEPS, caught.exception.message)
+            with self.assertRaises(mica.MicaError) as caught:
+                mica.Replay(os.path.join(tmp, "missing.micarec"))
+            self.assertEqual(caught.exception.status, mica.MICA_ERR_IO)
 
 
 class Recorder(mica.DeviceBackend):

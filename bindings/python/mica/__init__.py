@@ -18,6 +18,9 @@ mica_world_last_error). A warning (status > 0: the call did its work) is issued 
 MicaWarning through the warnings module (filter it like any warning) and World.step()
 returns False instead of True.
 
+Recording (since 0.6): World.record_start(path) on a new world records the session, and
+mica.Replay(path) replays it step by step, checking each step against the recording.
+
 Threads: a World is used by one thread at a time; Device.poll() runs on the servo thread.
 """
 from __future__ import annotations
@@ -46,8 +49,8 @@ PathLike = Union[str, "os.PathLike[str]"]
 # Every MICA_* constant at the package level too (mica.MICA_SOLVER_MICA).
 globals().update({k: v for k, v in vars(native).items() if k.startswith("MICA_")})
 
-__all__ = ["MicaError", "MicaWarning", "World", "Body", "Tool", "Lpc", "Device", "DeviceBackend", "PositionsView",
-           "version", "world_def", "body_def", "lpc_def", "tool_def", "device_def", "native"]
+__all__ = ["MicaError", "MicaWarning", "World", "Replay", "Body", "Tool", "Lpc", "Device", "DeviceBackend",
+           "PositionsView", "version", "world_def", "body_def", "lpc_def", "tool_def", "device_def", "native"]
 
 
 class MicaError(Exception):
@@ -275,7 +278,19 @@ class World:
         handle = c_void_p()
         _check(native.mica_world_create(byref(d), byref(handle)), None, "mica_world_create")
         self._handle = handle
+        self._owner = None  # a Replay when the world is the replay's (then close() does not destroy it)
         self._view_epoch = 0  # advanced by whatever invalidates positions views (PositionsView)
+
+    @classmethod
+    def _borrowed(cls, handle: c_void_p, owner: Any) -> World:
+        # A wrapper of a world that `owner` owns (a Replay's): it keeps the owner alive, and its
+        # close() only forgets the handle.
+        world = cls.__new__(cls)
+        world._keepalive = []
+        world._handle = handle
+        world._owner = owner
+        world._view_epoch = 0
+        return world
 
     # --- lifetime
     @property
@@ -290,12 +305,20 @@ class World:
         return self._handle is None
 
     def close(self) -> None:
-        """Destroys the world and everything in it. Views and ids from it become invalid."""
-        if getattr(self, "_handle", None) is not None:
+        """Destroys the world and everything in it. Views and ids from it become invalid.
+        A replay's world (Replay.world) belongs to the replay: this does nothing, closing the
+        Replay destroys it."""
+        if getattr(self, "_owner", None) is None and getattr(self, "_handle", None) is not None:
             self._view_epoch += 1
             native.mica_world_destroy(self._handle)
             self._handle = None
             self._keepalive = []
+
+    def _forget(self) -> None:
+        # The owner (a Replay) destroyed the world: the wrapper is closed from now on.
+        self._view_epoch += 1
+        self._handle = None
+        self._owner = None
 
     def __enter__(self) -> World:
         return self
@@ -349,6 +372,25 @@ class World:
         state = bytes(state)
         self._view_epoch += 1
         self._check(native.mica_world_restore_state(self.handle, state, len(state)), "mica_world_restore_state")
+
+    def ids(self, kind: int) -> list:
+        """The ids (ints) of the live objects of one kind: MICA_OBJECT_BODY, _LPC, _TOOL or
+        _DEVICE, in slot order (creation order until one of the kind is destroyed). Since 0.6."""
+        n = c_int32()
+        self._check(native.mica_world_get_ids(self.handle, kind, None, 0, byref(n)), "mica_world_get_ids")
+        out = (ctypes.c_uint64 * max(n.value, 1))()
+        self._check(native.mica_world_get_ids(self.handle, kind, out, n.value, byref(n)), "mica_world_get_ids")
+        return list(out[:n.value])
+
+    def record_start(self, path: PathLike) -> None:
+        """Starts recording the world into `path` (created or truncated), for Replay: call it on
+        a new world, before anything is added. Each step is flushed as it ends. Since 0.6."""
+        self._check(native.mica_world_record_start(self.handle, str(path).encode()), "mica_world_record_start")
+
+    def record_stop(self) -> None:
+        """Stops recording and closes the file; raises MicaError (MICA_ERR_IO) if a write failed
+        during the recording. Closing the world also closes the file. Since 0.6."""
+        self._check(native.mica_world_record_stop(self.handle), "mica_world_record_stop")
 
     def contacts(self) -> list:
         """The contacts of the last step, a list of mica_contact."""
@@ -431,6 +473,69 @@ class World:
         out = native.mica_device_id()
         self._check(native.mica_device_create(self.handle, byref(d), byref(out)), "mica_device_create")
         return Device(self, out.value, backend)
+
+
+class Replay:
+    """A recording (World.record_start) replayed into a world of its own (mica_replay). Use it as
+    a context manager, or call close().
+
+        with mica.Replay("session.micarec") as replay:
+            tool = mica.Tool(replay.world, replay.world.ids(mica.MICA_OBJECT_TOOL)[0])
+            while replay.step():
+                force, torque, contacts = tool.force()
+
+    .world is the replay's world (ids are the recorded ones): read it between steps; changing it
+    makes the rest of the replay diverge. It belongs to the replay: its close() does nothing,
+    closing the replay closes it. A step that does not reproduce the recording raises MicaError
+    with status MICA_ERR_DIVERGED (the message names the step). Since 0.6.
+    """
+
+    def __init__(self, path: PathLike) -> None:
+        handle = c_void_p()
+        _check(native.mica_replay_open(str(path).encode(), byref(handle)), None, "mica_replay_open")
+        self._handle = handle
+        self.world = World._borrowed(c_void_p(native.mica_replay_world(handle)), self)
+
+    @property
+    def handle(self) -> c_void_p:
+        """The mica_replay* as a c_void_p; raises if the replay was closed."""
+        if self._handle is None:
+            raise MicaError(native.MICA_ERR_WRONG_STATE, "the replay is closed")
+        return self._handle
+
+    @property
+    def closed(self) -> bool:
+        return self._handle is None
+
+    def step(self) -> bool:
+        """Makes the recorded calls up to the next step, then that step, and checks its results
+        against the recording. Returns True when a step was replayed, False at the end of the
+        recording. Raises MicaError (MICA_ERR_DIVERGED, MICA_ERR_PARSE, or the error the step
+        had when recorded); a step that did not converge when recorded warns, as World.step()."""
+        handle = self.handle
+        self.world._view_epoch += 1
+        stepped = c_int32()
+        _check(native.mica_replay_step(handle, byref(stepped)), self.world.handle, "mica_replay_step")
+        return stepped.value != 0
+
+    def close(self) -> None:
+        """Closes the replay and destroys its world (views and ids from it become invalid)."""
+        if getattr(self, "_handle", None) is not None:
+            self.world._forget()
+            native.mica_replay_close(self._handle)
+            self._handle = None
+
+    def __enter__(self) -> Replay:
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    def __del__(self):
+        try:
+            self.close()
+        except Exception:  # interpreter shutdown: the module may be half torn down
+            pass
 
 
 class _Object:

@@ -36,6 +36,7 @@ MICA_ERR_BUFFER_TOO_SMALL = -13
 MICA_ERR_DEVICE = -14
 MICA_ERR_OUT_OF_MEMORY = -15
 MICA_ERR_INTERNAL = -16
+MICA_ERR_DIVERGED = -17
 
 MICA_NULL_ID = 0
 
@@ -83,6 +84,11 @@ MICA_CONTACT_TRIANGLE = 3
 MICA_CONTACT_OTHER_TOOL = 0
 MICA_CONTACT_OTHER_BODY = 1
 
+MICA_OBJECT_BODY = 1
+MICA_OBJECT_LPC = 2
+MICA_OBJECT_TOOL = 3
+MICA_OBJECT_DEVICE = 4
+
 # --- Constants (mica_device.h)
 MICA_DEVICE_CALLBACKS = 0
 MICA_DEVICE_NULL = 1
@@ -103,6 +109,7 @@ mica_lpc_id = c_uint64
 mica_tool_id = c_uint64
 mica_device_id = c_uint64
 mica_world_p = c_void_p  # opaque mica_world*
+mica_replay_p = c_void_p  # opaque mica_replay*
 
 # --- Callback types (the C calling convention of the platform)
 mica_log_fn = CFUNCTYPE(None, c_int32, c_char_p, c_void_p)
@@ -384,6 +391,14 @@ PROTOTYPES = {
     "mica_world_save_state": (mica_status, [mica_world_p, c_void_p, c_size_t]),
     "mica_world_restore_state": (mica_status, [mica_world_p, c_void_p, c_size_t]),
     "mica_world_get_contacts": (mica_status, [mica_world_p, _p(mica_contact), _i, _p(_i)]),
+    # since 0.6: ids, recording and replay
+    "mica_world_get_ids": (mica_status, [mica_world_p, _i, _p(c_uint64), _i, _p(_i)]),
+    "mica_world_record_start": (mica_status, [mica_world_p, c_char_p]),
+    "mica_world_record_stop": (mica_status, [mica_world_p]),
+    "mica_replay_open": (mica_status, [c_char_p, _p(mica_replay_p)]),
+    "mica_replay_close": (None, [mica_replay_p]),
+    "mica_replay_world": (mica_world_p, [mica_replay_p]),
+    "mica_replay_step": (mica_status, [mica_replay_p, _p(_i)]),
     "mica_world_get_stats": (mica_status, [mica_world_p, _p(mica_world_stats)]),
     "mica_stage_name": (c_char_p, [_i]),
     "mica_body_write_vtk": (mica_status, [mica_world_p, mica_body_id, c_char_p]),

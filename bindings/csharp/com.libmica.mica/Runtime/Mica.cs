@@ -16,7 +16,9 @@
 //
 // Lifetime: a World owns a WorldHandle (a SafeHandle); Dispose() destroys the world at once on
 // the calling thread, which should be the world's thread. A world never disposed is destroyed
-// by the handle's finalizer (on the finalizer thread, when nothing else can use it).
+// by the handle's finalizer (on the finalizer thread, when nothing else can use it). A Replay
+// owns a ReplayHandle; its World (the replay's world) is borrowed: disposing it does nothing,
+// disposing the Replay destroys both.
 //
 // Callbacks (the log, device backends): IL2CPP can only call back into static methods marked
 // [AOT.MonoPInvokeCallback]; instance methods and lambdas crash there. So every callback below
@@ -49,8 +51,19 @@ namespace LibMica
     public sealed class WorldHandle : SafeHandleZeroOrMinusOneIsInvalid
     {
         readonly List<GCHandle> pinned = new List<GCHandle>();
+        readonly ReplayHandle owner; // a replay's world: the replay owns it, this handle holds the replay
 
         WorldHandle() : base(true) { }
+
+        // The world of a replay: releasing this handle releases its hold on the replay, which
+        // destroys the world when the replay closes (so the world never outlives its replay).
+        internal WorldHandle(IntPtr world, ReplayHandle replay) : base(true)
+        {
+            bool added = false;
+            replay.DangerousAddRef(ref added);
+            owner = replay;
+            SetHandle(world);
+        }
 
         internal IntPtr Keep(object target) { return Adopt(GCHandle.Alloc(target)); }
 
@@ -62,12 +75,30 @@ namespace LibMica
 
         protected override bool ReleaseHandle()
         {
+            if (owner != null)
+            {
+                owner.DangerousRelease();
+                return true;
+            }
             MicaNative.mica_world_destroy(handle);
             lock (pinned)
             {
                 foreach (var h in pinned) h.Free();
                 pinned.Clear();
             }
+            return true;
+        }
+    }
+
+    /// <summary>Owns a mica_replay*: releasing it closes the replay and destroys its world (after
+    /// the replay's WorldHandle is released too: it holds the replay).</summary>
+    public sealed class ReplayHandle : SafeHandleZeroOrMinusOneIsInvalid
+    {
+        ReplayHandle() : base(true) { }
+
+        protected override bool ReleaseHandle()
+        {
+            MicaNative.mica_replay_close(handle);
             return true;
         }
     }
@@ -165,6 +196,14 @@ namespace LibMica
         public readonly WorldHandle Handle;
         /// <summary>The status of the last call made through this object (warnings are &gt; 0).</summary>
         public int LastStatus { get; private set; }
+        readonly bool borrowed; // a replay's world: Dispose() leaves it to the Replay
+
+        World(WorldHandle handle) { Handle = handle; borrowed = true; }
+
+        internal static World OfReplay(ReplayHandle replay)
+        {
+            return new World(new WorldHandle(MicaNative.mica_replay_world(replay), replay));
+        }
 
         static readonly MicaNative.mica_log_fn LogTrampoline = OnLog;
 
@@ -204,7 +243,11 @@ namespace LibMica
             }
         }
 
-        public void Dispose() { Handle.Dispose(); }
+        /// <summary>Destroys the world (ids and position views die with it). A replay's world
+        /// (Replay.World) is the replay's: this does nothing, Replay.Dispose() destroys it.</summary>
+        public void Dispose() { if (!borrowed) Handle.Dispose(); }
+
+        internal void Release() { Handle.Dispose(); }
 
         public bool IsDisposed { get { return Handle.IsClosed; } }
 
@@ -248,6 +291,29 @@ namespace LibMica
             if (state == null) throw new ArgumentNullException("state");
             Check(MicaNative.mica_world_restore_state(Handle, state, (ulong)state.Length));
         }
+
+        /// <summary>The ids of the live objects of one kind (MICA_OBJECT_BODY, _LPC, _TOOL or
+        /// _DEVICE), in slot order: creation order until one of the kind is destroyed. Since 0.6.</summary>
+        public ulong[] GetIds(int kind)
+        {
+            int n;
+            Check(MicaNative.mica_world_get_ids(Handle, kind, null, 0, out n));
+            var ids = new ulong[n];
+            if (n > 0) Check(MicaNative.mica_world_get_ids(Handle, kind, ids, n, out n));
+            return ids;
+        }
+
+        /// <summary>Starts recording the world into `path` (created or truncated), for Replay: call
+        /// it on a new world, before anything is added. Each step is flushed as it ends. Since 0.6.</summary>
+        public void RecordStart(string path)
+        {
+            if (path == null) throw new ArgumentNullException("path");
+            Check(MicaNative.mica_world_record_start(Handle, Mica.Utf8z(path)));
+        }
+
+        /// <summary>Stops recording and closes the file; throws (MICA_ERR_IO) if a write failed
+        /// during the recording. Disposing the world also closes it. Since 0.6.</summary>
+        public void RecordStop() { Check(MicaNative.mica_world_record_stop(Handle)); }
 
         /// <summary>The contacts of the last step.</summary>
         public MicaNative.mica_contact[] GetContacts()
@@ -312,6 +378,50 @@ namespace LibMica
         }
 
         public void WriteVtk(string path) { Check(MicaNative.mica_world_write_vtk(Handle, Mica.Utf8z(path))); }
+    }
+
+    /// <summary>A recording (World.RecordStart) replayed into a world of its own (since 0.6). World
+    /// is the replay's world: ids are the recorded ones (wrap them: new Tool(replay.World, id));
+    /// read it between steps, changing it makes the rest of the replay diverge. Use the replay
+    /// from one thread at a time; Dispose() closes it and destroys its world.</summary>
+    public sealed class Replay : IDisposable
+    {
+        public readonly ReplayHandle Handle;
+        public readonly World World;
+
+        /// <summary>Opens a recording; throws MicaException (MICA_ERR_IO, MICA_ERR_PARSE, ...).</summary>
+        public Replay(string path)
+        {
+            if (path == null) throw new ArgumentNullException("path");
+            int status = MicaNative.mica_replay_open(Mica.Utf8z(path), out Handle);
+            if (status < 0)
+            {
+                Handle.Dispose();
+                Mica.Check(status, null);
+            }
+            World = World.OfReplay(Handle);
+        }
+
+        /// <summary>Makes the recorded calls up to the next step, then that step, and checks its
+        /// results against the recording. Returns true when a step was replayed, false at the end
+        /// of the recording; World.LastStatus has the step's status (a warning such as
+        /// MICA_WARN_NOT_CONVERGED if it had one when recorded). Throws MicaException:
+        /// MICA_ERR_DIVERGED when the step does not reproduce the recording (the message names
+        /// the step), MICA_ERR_PARSE for a corrupt entry.</summary>
+        public bool Step()
+        {
+            int stepped;
+            World.Check(MicaNative.mica_replay_step(Handle, out stepped));
+            return stepped != 0;
+        }
+
+        public void Dispose()
+        {
+            World.Release();
+            Handle.Dispose();
+        }
+
+        public bool IsDisposed { get { return Handle.IsClosed; } }
     }
 
     /// <summary>A body of a world (a 64-bit id plus its world).</summary>

@@ -40,6 +40,7 @@ namespace LibMica
         public const int MICA_ERR_DEVICE = -14;
         public const int MICA_ERR_OUT_OF_MEMORY = -15;
         public const int MICA_ERR_INTERNAL = -16;
+        public const int MICA_ERR_DIVERGED = -17;
 
         public const ulong MICA_NULL_ID = 0;
 
@@ -86,6 +87,11 @@ namespace LibMica
         public const int MICA_CONTACT_TRIANGLE = 3;
         public const int MICA_CONTACT_OTHER_TOOL = 0;
         public const int MICA_CONTACT_OTHER_BODY = 1;
+
+        public const int MICA_OBJECT_BODY = 1;
+        public const int MICA_OBJECT_LPC = 2;
+        public const int MICA_OBJECT_TOOL = 3;
+        public const int MICA_OBJECT_DEVICE = 4;
 
         // --- Constants (mica_device.h)
         public const int MICA_DEVICE_CALLBACKS = 0;
@@ -513,6 +519,30 @@ namespace LibMica
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
         public static extern int mica_world_get_contacts(WorldHandle world, [In, Out] mica_contact[] @out, int capacity,
                                                          out int out_count);
+
+        // Since 0.6: ids, recording and replay. mica_replay* is a ReplayHandle (it closes the
+        // replay); the replay's world comes back as an IntPtr that World.Borrowed wraps.
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern int mica_world_get_ids(WorldHandle world, int kind, ulong[] @out, int capacity,
+                                                    out int out_count);
+
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern int mica_world_record_start(WorldHandle world, byte[] path);
+
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern int mica_world_record_stop(WorldHandle world);
+
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern int mica_replay_open(byte[] path, out ReplayHandle out_replay);
+
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern void mica_replay_close(IntPtr replay);
+
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern IntPtr mica_replay_world(ReplayHandle replay);
+
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern int mica_replay_step(ReplayHandle replay, out int out_stepped);
 
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
         public static extern int mica_world_get_stats(WorldHandle world, ref mica_world_stats @out);
