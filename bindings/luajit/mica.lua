@@ -335,7 +335,9 @@ function World:contacts()
   return out, n[0]
 end
 
--- A device whose callbacks are Lua functions: `callbacks` has read_state(state) and
+-- A device from mica_device_def fields: { tool = tool } drives a tool, { lpc = grab } (since 0.6)
+-- moves a grab's handle and renders its reaction, the force on the hand. With `callbacks`, a device
+-- whose callbacks are Lua functions: `callbacks` has read_state(state) and
 -- write_force(force, torque), optionally open(), close(), info(out); each returns nothing
 -- (success) or a mica_status. An error inside one becomes MICA_ERR_DEVICE.
 -- LuaJIT callbacks run only on the thread of this Lua state: call mica.C.mica_device_poll()

@@ -154,7 +154,10 @@ class World {
   Tool& tool(Id id) { return tools_.get(id, "tool"); }
   const Tool& tool(Id id) const { return tools_.get(id, "tool"); }
   void set_tool_pose(Id id, const Vec3& position, const Eigen::Quaterniond& orientation);
-  // Devices: added and removed only while no servo loop runs.
+  // Devices: added and removed only while no servo loop runs. A device drives a tool or a grasp
+  // (a constraint with a handle that follows no tool), not both; check_device_target throws as
+  // add_device would for the ids of `settings` (StaleId, InvalidArgument), changing nothing.
+  void check_device_target(const DeviceSettings& settings) const;
   Id add_device(std::unique_ptr<Device> device, const DeviceSettings& settings);
   void remove_device(Id id);
   DeviceLink& device(Id id) { return devices_.get(id, "device"); }
@@ -198,6 +201,7 @@ class World {
   void advance(double h);
   StepContext begin_step(double h);
   void follow_devices();
+  ForceModel grasp_force_model(const DeviceLink& link, const Lpc& grasp) const;
   void collide(StepContext& ctx);
   bool bounds_overlap(const SurfaceView& a, const SurfaceView& b) const;
   // Bodies placed overlapping (overlaps.cpp).
