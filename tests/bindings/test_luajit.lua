@@ -259,7 +259,7 @@ test("a device driving a grasp (mica_device_def.lpc, since 0.6)", function()
   world:check(C.mica_device_destroy(world.ptr, device))
   world:check(C.mica_lpc_remove(world.ptr, grasp))
   local tool = world:create_tool{ radius = 0.01, position = { 0, 0.3, 0 } }
-  local other = world:grab(body, { 0.025, 0.1, 0 }, 0.001)
+  local other = world:grab(body, { 0.025, 0.1, 0 }, 0.01)
   local ok, err = pcall(world.create_device, world, { tool = tool, lpc = other })
   expect(not ok and err.status == C.MICA_ERR_INVALID_ARGUMENT, "a tool or a grasp, not both")
   world:close()

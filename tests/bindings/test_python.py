@@ -454,7 +454,7 @@ class Devices(unittest.TestCase):
             grasp.remove()
             # A device drives a tool or a grasp, not both.
             tool = world.create_tool(radius=0.01, position=(0, 0.3, 0))
-            other = body.grab((0.025, 0.1, 0), 0.001)
+            other = body.grab((0.025, 0.1, 0), 0.01)
             with self.assertRaises(mica.MicaError) as e:
                 world.create_device(tool=tool, grasp=other)
             self.assertEqual(e.exception.status, mica.MICA_ERR_INVALID_ARGUMENT)
