@@ -26,13 +26,13 @@ def main(csv_path: str, png_path: str) -> None:
         return [float(r[name]) for r in rows]
 
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(12, 4.5), dpi=110, sharex=True)
-    ax1.plot(t, col("hand1_fy_N"), color="tab:blue", lw=1.5, label="rendered $F_y$ (device, 1 kHz)")
-    ax1.plot(t, col("grasp_fy_N"), color="tab:blue", lw=1, ls="--", label="grasp reaction $F_y$ (step, 100 Hz)")
-    ax1.plot(t, col("hand1_fx_N"), color="tab:orange", lw=1.5, label="rendered $F_x$ (device, 1 kHz)")
-    ax1.plot(t, col("grasp_fx_N"), color="tab:orange", lw=1, ls="--", label="grasp reaction $F_x$ (step, 100 Hz)")
+    ax1.plot(t, col("hand1_fy_N"), color="tab:blue", lw=1.5, label="rendered $F_y$ (servo output, sampled each step)")
+    ax1.plot(t, col("grasp_fy_N"), color="tab:blue", lw=1, ls="--", label="grasp reaction $F_y$ (simulation step, 100 Hz)")
+    ax1.plot(t, col("hand1_fx_N"), color="tab:orange", lw=1.5, label="rendered $F_x$ (servo output, sampled each step)")
+    ax1.plot(t, col("grasp_fx_N"), color="tab:orange", lw=1, ls="--", label="grasp reaction $F_x$ (simulation step, 100 Hz)")
     ax1.set_title("Hand 1: grasps the top face, pulls up and toward -x")
-    ax2.plot(t, col("hand2_fy_N"), color="tab:green", lw=1.5, label="rendered $F_y$ (device, 1 kHz)")
-    ax2.plot(t, col("tool_fy_N"), color="tab:green", lw=1, ls="--", label="sphere tool force $F_y$ (step, 100 Hz)")
+    ax2.plot(t, col("hand2_fy_N"), color="tab:green", lw=1.5, label="rendered $F_y$ (servo output, sampled each step)")
+    ax2.plot(t, col("tool_fy_N"), color="tab:green", lw=1, ls="--", label="sphere tool force $F_y$ (simulation step, 100 Hz)")
     ax2.set_title("Hand 2: presses a sphere into the top face")
     for ax in (ax1, ax2):
         ax.axhline(0, color="k", lw=0.5)
