@@ -70,6 +70,7 @@ std::unique_ptr<mica::Device> make_device(const mica_device_def& d) {
 mica::DeviceSettings translate(const mica_device_def& d) {
   mica::DeviceSettings s;
   s.tool = d.tool;
+  s.lpc = d.lpc;
   s.scale = d.scale;
   s.offset = vec3(d.offset, "def->offset");
   s.rotation = quaternion(d.rotation, "def->rotation");
@@ -102,7 +103,7 @@ MICA_API mica_status mica_device_create(mica_world* world, const mica_device_def
     require(out_device, "out_device");
     const mica_device_def d = read_def(def, device_defaults(), "def");
     const mica::DeviceSettings settings = translate(d);
-    if (d.tool) world->world.tool(d.tool);  // a stale tool fails before the device is opened
+    world->world.check_device_target(settings);  // a stale or unfit tool or grasp fails before the device is opened
     *out_device = world->world.add_device(make_device(d), settings);
     return MICA_OK;
   });

@@ -182,10 +182,11 @@ function World:create_tool(fields)
 end
 
 -- Runs a buffer-protocol call (size query, then fill): returns an int32_t array and its count.
-local function read_indices(self, call)
+-- (`width` indices per item: 4 for tets; default 1.)
+local function read_indices(self, call, width)
   local count = ffi.new("int32_t[1]")
   self:check(call(nil, 0, count))
-  local out = ffi.new("int32_t[?]", math.max(count[0], 1))
+  local out = ffi.new("int32_t[?]", math.max((width or 1) * count[0], 1))
   self:check(call(out, count[0], count))
   return out, count[0]
 end
@@ -210,7 +211,7 @@ end
 
 -- Since 0.6: a body's tets (int32_t[4 * t], 0-based) and the region of each (int32_t[t]).
 function World:tets(body)
-  return read_indices(self, function(out, cap, count) return C.mica_body_get_tets(self.ptr, body, out, cap, count) end)
+  return read_indices(self, function(out, cap, count) return C.mica_body_get_tets(self.ptr, body, out, cap, count) end, 4)
 end
 function World:tet_regions(body)
   return read_indices(self, function(out, cap, count)
@@ -351,7 +352,9 @@ function World:contacts()
   return out, n[0]
 end
 
--- A device whose callbacks are Lua functions: `callbacks` has read_state(state) and
+-- A device from mica_device_def fields: { tool = tool } drives a tool, { lpc = grab } (since 0.6)
+-- moves a grab's handle and renders its reaction, the force on the hand. With `callbacks`, a device
+-- whose callbacks are Lua functions: `callbacks` has read_state(state) and
 -- write_force(force, torque), optionally open(), close(), info(out); each returns nothing
 -- (success) or a mica_status. An error inside one becomes MICA_ERR_DEVICE.
 -- LuaJIT callbacks run only on the thread of this Lua state: call mica.C.mica_device_poll()

@@ -376,7 +376,9 @@ MICA_API mica_status mica_body_create_box(mica_world* world, const mica_body_def
  *  @param world the world.
  *  @param body the body.
  *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` or a required pointer is NULL);
- *          MICA_ERR_STALE_ID (`body` is null, of another kind or destroyed). */
+ *          MICA_ERR_STALE_ID (`body` is null, of another kind or destroyed); MICA_ERR_WRONG_STATE
+ *          (a device drives a grasp on the body, mica_device_def.lpc: destroy the device first;
+ *          since 0.6). */
 MICA_API mica_status mica_body_destroy(mica_world* world, mica_body_id body);
 
 /** Counts of a body's nodes, tets and surface triangles. The world's thread (the one thread using
@@ -718,7 +720,8 @@ MICA_API mica_status mica_add_lpc(mica_world* world, mica_body_id body, const in
  *  @param world the world.
  *  @param lpc the constraint.
  *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` or a required pointer is NULL);
- *          MICA_ERR_STALE_ID (`lpc` is null, of another kind or destroyed). */
+ *          MICA_ERR_STALE_ID (`lpc` is null, of another kind or destroyed); MICA_ERR_WRONG_STATE
+ *          (a device drives the grasp, mica_device_def.lpc: destroy the device first; since 0.6). */
 MICA_API mica_status mica_lpc_remove(mica_world* world, mica_lpc_id lpc);
 
 /** Changes the prescribed velocity of a constraint's constrained components (and drops any targets
@@ -769,7 +772,8 @@ MICA_API mica_status mica_lpc_grab(mica_world* world, mica_body_id body, const d
  *  @param orientation unit quaternion (w, x, y, z).
  *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` or a required pointer is NULL);
  *          MICA_ERR_STALE_ID (`lpc` is null, of another kind or destroyed); MICA_ERR_WRONG_STATE
- *          (the constraint has no handle, or its handle follows a tool); MICA_ERR_INVALID_ARGUMENT
+ *          (the constraint has no handle, or its handle follows a tool or, since 0.6, a device:
+ *          mica_device_def.lpc); MICA_ERR_INVALID_ARGUMENT
  *          (a value not finite, a zero quaternion). */
 MICA_API mica_status mica_lpc_set_handle_pose(mica_world* world, mica_lpc_id lpc, const double position[3],
                                               const double orientation[4]);
@@ -790,7 +794,7 @@ MICA_API mica_status mica_lpc_get_nodes(const mica_world* world, mica_lpc_id lpc
 
 /** Reaction force of a constraint group in the last step: the force on whoever holds the constraint
  *  (the user's hand in a grasp). Lifting a grasped region up against gravity gives a downward
- *  force. A node held by several groups is counted once: each group C_g gets the share
+ *  force; a device driving the grasp (mica_device_def.lpc) renders this force. A node held by several groups is counted once: each group C_g gets the share
  *  C_g (sum of the node's groups' C)^+ of its reaction (two groups fixing it get half each), so
  *  the groups' reactions add up to what holds the body. The world's thread (the one thread
  *  using the world at a time).

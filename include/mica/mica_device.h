@@ -3,7 +3,9 @@
  * @file mica_device.h
  * @brief libmica: haptic devices, the 1 kHz servo path, force filtering and safety.
  *
- * A device drives a tool of the world and renders the force the tissue puts on that tool.
+ * A device drives a tool of the world and renders the force the tissue puts on that tool, or
+ * (since 0.6) moves the handle of a grasp and renders the force the held tissue puts on the hand.
+ * Several devices may share a world, each on its own servo thread.
  * The simulation thread calls mica_step() at 10-100 Hz; the servo thread calls
  * mica_device_poll() at 1 kHz (or lets mica_device_start() run it). The two exchange data
  * without locks: the servo path never allocates, locks, blocks or makes a system call.
@@ -117,6 +119,16 @@ typedef struct mica_device_def {
   double hand_mass;          /**< kg, simulated hand; default 0.1 */
   double hand_stiffness;     /**< N/m, pull toward the trajectory; default 200 */
   double hand_damping;       /**< N s/m; default 5 */
+  /** The grasp whose handle follows the device (Since 0.6): a constraint from mica_lpc_grab()
+   *  without a tool (or one given targets by mica_lpc_set_targets(): they become offsets from the
+ *  device's pose); MICA_NULL_ID (default) for
+   *  none. A device drives a tool or a grasp, not both. Each step moves the handle to the device's
+   *  newest pose (absolute, like a tool: start the device where the grab was made, or map it there
+   *  with `offset`), and the device renders the force the held tissue puts on the hand: the
+   *  grasp's mica_lpc_get_reaction() (pulling tissue up, the hand is pulled down), modelled between
+   *  steps as F0 - k (x - x0) with k the tissue's stiffness along the handle's last move, within
+   *  [0, the device's nominal stiffness] (docs/haptics.md). */
+  mica_lpc_id lpc;
 } mica_device_def;
 
 /** Fills `def` with defaults, writing only its first `struct_size` bytes. Thread: any.
@@ -136,7 +148,8 @@ static inline mica_device_def mica_device_def_default(void) {
 }
 
 /** Creates and opens a device. Thread: the world's; other threads may meanwhile read the world's
- *  other devices with mica_device_get_stats, mica_device_get_info and mica_device_poll.
+ *  other devices with mica_device_get_stats, mica_device_get_info and mica_device_poll (each
+ *  device's servo loop, its own thread, runs on while another device is created).
  *  @param world the world.
  *  @param def the device (mica_device_def_default(), then changed).
  *  @param out_device receives the device's id.

@@ -168,6 +168,7 @@ void DeviceLink::publish(const ForceModel& model) {
   ForceModel& slot = model_.write_slot();
   slot = model;
   slot.published_at = now();
+  last_published_ = slot;
   model_.publish();
 }
 

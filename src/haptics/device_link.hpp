@@ -37,6 +37,7 @@ constexpr int32_t kMaxFilterWindow = 10000;
 
 struct DeviceSettings {
   uint64_t tool = 0;  // the tool id the device drives, 0 for none
+  uint64_t lpc = 0;   // or the grasp (a constraint with a handle) whose handle it moves, 0 for none
   double scale = 1;   // scene = rotation * (scale * device) + offset
   Vec3 offset = Vec3::Zero();
   Eigen::Quaterniond rotation = Eigen::Quaterniond::Identity();
@@ -76,6 +77,8 @@ class DeviceLink {
   // model of the step just taken.
   bool latest_pose(ScenePose& out);
   void publish(const ForceModel& model);
+  // Simulation thread: the model publish() last sent (step -1 before the first).
+  const ForceModel& last_published() const { return last_published_; }
 
   // The world's thread: the servo loop on libmica's own 1 kHz thread or the backend's scheduler.
   void start();
@@ -107,6 +110,7 @@ class DeviceLink {
   DeviceInfo info_;
   TripleBuffer<ForceModel> model_;
   TripleBuffer<ScenePose> pose_;
+  ForceModel last_published_;  // simulation thread only
   MovingAverage filter_;
   ForceSafety safety_;
   ServoThread thread_;

@@ -11,7 +11,7 @@ Vec3 ForceModel::evaluate(const Vec3& x, ForceMode mode) const noexcept {
   if (mode != ForceMode::LocalModel) return f0;
   // Tissue only pushes: once the linear model turns against f0 the contact has opened.
   const Vec3 f = f0 + H * (x - x0);
-  return f.dot(f0) > 0 ? f : Vec3::Zero();
+  return holds || f.dot(f0) > 0 ? f : Vec3::Zero();
 }
 
 Vec3 coupling_force(const Vec3& x_device, const Vec3& v_device, const Vec3& x_tool, const Vec3& v_tool,

@@ -25,12 +25,13 @@ struct ForceModel {
   Vec3 x0 = Vec3::Zero();   // m, the tool position the step used
   double published_at = 0;  // s, when the step published this (the clock the safety stage uses)
   bool in_contact = false;  // the tool touched something in that step (drives the filter's reset)
+  bool holds = false;       // a grasp: the tissue pulls as well as pushes (no release at the sign change)
   int64_t step = -1;        // the step that published it; -1: nothing published yet
 
   // The force at tool position x: f0 + H (x - x0) for LocalModel, f0 for Hold. Coupling is not a
   // function of the position alone (see coupling_force()); any mode but LocalModel holds f0.
-  // LocalModel: f0 + H (x - x0), or zero once that turns against f0 (contact opens: tissue only
-  // pushes); Hold and Coupling: f0.
+  // LocalModel: f0 + H (x - x0), or, for a contact (not `holds`), zero once that turns against f0
+  // (contact opens: tissue only pushes); Hold and Coupling: f0.
   Vec3 evaluate(const Vec3& x, ForceMode mode) const noexcept;
 };
 

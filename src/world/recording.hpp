@@ -114,20 +114,20 @@ inline void take(ByteReader& in, Tool& t) {
 }
 
 inline void put(ByteWriter& out, const DeviceSettings& s) {
-  put(out, s.tool), put(out, s.scale), put(out, s.offset), put(out, s.rotation), put(out, int32_t(s.mode));
+  put(out, s.tool), put(out, s.lpc), put(out, s.scale), put(out, s.offset), put(out, s.rotation), put(out, int32_t(s.mode));
   put(out, s.filter_window), put(out, s.filter_restart_on_contact), put(out, s.safety);
   put(out, s.coupling_stiffness), put(out, s.coupling_damping);
 }
 inline void take(ByteReader& in, DeviceSettings& s) {
   int32_t mode = 0;
-  take(in, s.tool), take(in, s.scale), take(in, s.offset), take(in, s.rotation), take(in, mode);
+  take(in, s.tool), take(in, s.lpc), take(in, s.scale), take(in, s.offset), take(in, s.rotation), take(in, mode);
   take(in, s.filter_window), take(in, s.filter_restart_on_contact), take(in, s.safety);
   take(in, s.coupling_stiffness), take(in, s.coupling_damping);
   s.mode = ForceMode(mode);
 }
 
-inline void put(ByteWriter& out, const AdoptedPose& p) { put(out, p.tool), put(out, p.position), put(out, p.orientation); }
-inline void take(ByteReader& in, AdoptedPose& p) { take(in, p.tool), take(in, p.position), take(in, p.orientation); }
+inline void put(ByteWriter& out, const AdoptedPose& p) { put(out, p.target), put(out, p.position), put(out, p.orientation); }
+inline void take(ByteReader& in, AdoptedPose& p) { take(in, p.target), take(in, p.position), take(in, p.orientation); }
 inline void put(ByteWriter& out, const std::vector<AdoptedPose>& poses) {
   put(out, uint64_t(poses.size()));
   for (const AdoptedPose& p : poses) put(out, p);

@@ -152,34 +152,61 @@ void World::advance(double h) {
 }
 
 void World::follow_devices() {
+  // A tool, or a grasp's handle, takes the pose (the handle only while it has one: a handle the
+  // host dropped with mica_lpc_set_velocity is not brought back).
+  auto adopt = [&](Id target, const Vec3& position, const Eigen::Quaterniond& orientation) {
+    if (id_kind(target) == IdKind::Tool) {
+      Tool& t = tool(target);
+      t.position = position;
+      t.orientation = orientation;
+    } else if (Lpc* c = lpcs_.find(target); c && c->handle) {
+      c->handle->position = position;
+      c->handle->orientation = orientation;
+    }
+  };
   adopted_.clear();  // keeps its capacity
   if (replayed_) {  // a replay: the recorded poses stand in for the devices
-    for (const AdoptedPose& p : *replayed_) {
-      Tool& t = tool(p.tool);
-      t.position = p.position;
-      t.orientation = p.orientation;
-    }
+    for (const AdoptedPose& p : *replayed_) adopt(p.target, p.position, p.orientation);
     adopted_ = *replayed_;
     return;
   }
-  // Each device's newest pose moves its tool before the step (the servo thread wrote it).
+  // Each device's newest pose moves its tool or its grasp's handle before the step (the servo
+  // thread wrote it).
   devices_.for_each([&](Id, DeviceLink& link) {
     ScenePose pose;
+    const Id target = link.settings().tool ? link.settings().tool : link.settings().lpc;
     // (The servo path publishes only finite unit poses; checked again: a tool never gets NaN.)
-    if (link.settings().tool && link.latest_pose(pose) && pose.position.allFinite() &&
-        pose.orientation.coeffs().allFinite() && std::fabs(pose.orientation.norm() - 1) < 1e-6) {
-      Tool& t = tool(link.settings().tool);
-      t.position = pose.position;
-      t.orientation = pose.orientation;
-      if (recorder_) adopted_.push_back(AdoptedPose{link.settings().tool, pose.position, pose.orientation});
-    }
+    if (!target || !link.latest_pose(pose) || !pose.position.allFinite() || !pose.orientation.coeffs().allFinite() ||
+        !(std::fabs(pose.orientation.norm() - 1) < 1e-6))
+      return;
+    adopt(target, pose.position, pose.orientation);
+    if (recorder_) adopted_.push_back(AdoptedPose{target, pose.position, pose.orientation});
   });
+}
+
+ForceModel World::grasp_force_model(const DeviceLink& link, const Lpc& grasp) const {
+  ForceModel model;
+  model.f0 = grasp.reaction;  // the force the held tissue puts on the hand
+  model.x0 = grasp.handle ? grasp.handle->position : link.last_published().x0;
+  model.in_contact = true;
+  model.holds = true;
+  // H = -k I, k the secant stiffness the tissue showed along the handle's last move (dF = -k dx),
+  // within [0, the device's nominal stiffness]: stable to render, and zero when the tissue gave
+  // way; a move below kGraspSecantStep keeps the last estimate (the reaction's own step-to-step
+  // change would swamp it).
+  constexpr double kGraspSecantStep = 1e-5;  // m
+  const ForceModel& last = link.last_published();
+  double k = last.holds ? -last.H(0, 0) : 0;
+  const Vec3 dx = model.x0 - last.x0;
+  if (last.holds && dx.norm() >= kGraspSecantStep)
+    k = std::clamp(-dx.dot(model.f0 - last.f0) / dx.squaredNorm(), 0.0, link.info().nominal_stiffness);
+  model.H = -k * Mat3::Identity();
+  return model;
 }
 
 void World::publish_force_models() {
   devices_.for_each([&](Id, DeviceLink& link) {
     ForceModel model;
-    model.step = stats_.step_count;
     if (const Tool* t = link.settings().tool ? tools_.find(link.settings().tool) : nullptr) {
       model.f0 = t->force;
       model.x0 = t->position;
@@ -187,7 +214,10 @@ void World::publish_force_models() {
       // The device can render only so stiff a spring: cap the model's stiffness at its nominal one.
       const double k = t->stiffness.norm(), k_max = link.info().nominal_stiffness;
       model.H = k > k_max ? Mat3(t->stiffness * (k_max / k)) : t->stiffness;
+    } else if (const Lpc* c = link.settings().lpc ? lpcs_.find(link.settings().lpc) : nullptr) {
+      model = grasp_force_model(link, *c);
     }
+    model.step = stats_.step_count;
     link.publish(model);
   });
 }

@@ -13,6 +13,15 @@ namespace {
 void require_finite(const Vec3& v, const std::string& what) {
   if (!v.allFinite()) fail(Errc::InvalidArgument, what + " must be finite");
 }
+
+// Like a tool, a grasp a device moves outlives the device: destroying it first keeps the device
+// from moving a handle that is gone.
+template <class Devices>
+void refuse_if_driven(const Devices& devices, Id lpc) {
+  devices.for_each([&](Id, const DeviceLink& link) {
+    if (link.settings().lpc == lpc) fail(Errc::WrongState, "a device drives this grasp: destroy the device first");
+  });
+}
 }  // namespace
 
 void validate(const WorldSettings& s) {
@@ -103,6 +112,7 @@ void World::remove_body(Id id) {
   lpcs_.for_each([&](Id lpc, const Lpc& c) {
     if (c.body == id) doomed.push_back(lpc);
   });
+  for (Id lpc : doomed) refuse_if_driven(devices_, lpc);
   for (Id lpc : doomed) lpcs_.erase(lpc);
   solver_->forget(body(id).key);  // its factors (one may be in the making on the body's pattern) first
   bodies_.erase(id);
@@ -194,8 +204,20 @@ Id World::add_tool(const Tool& tool) {
   return id;
 }
 
-Id World::add_device(std::unique_ptr<Device> device, const DeviceSettings& settings) {
+void World::check_device_target(const DeviceSettings& settings) const {
+  if (settings.tool && settings.lpc)
+    fail(Errc::InvalidArgument, "a device drives a tool or a grasp, not both: set one of tool and lpc to 0");
   if (settings.tool) tool(settings.tool);  // throws for a stale tool id
+  if (!settings.lpc) return;
+  const Lpc& c = lpc(settings.lpc);  // throws for a stale constraint id
+  if (!c.handle)
+    fail(Errc::InvalidArgument, "the constraint has no handle for the device to move: make it with a grab (or set its targets)");
+  if (c.handle->tool)
+    fail(Errc::InvalidArgument, "the grasp's handle follows a tool: drive that tool with the device instead");
+}
+
+Id World::add_device(std::unique_ptr<Device> device, const DeviceSettings& settings) {
+  check_device_target(settings);
   if (!(settings.scale > 0) || !std::isfinite(settings.scale)) fail(Errc::InvalidArgument, "the workspace scale must be finite and > 0");
   require_finite(settings.offset, "the workspace offset");
   if (!settings.rotation.coeffs().allFinite() || !(settings.rotation.norm() > 1e-12))
@@ -296,6 +318,9 @@ void World::set_handle_pose(Id id, const Vec3& position, const Eigen::Quaternion
   Lpc& c = lpcs_.get(id, "constraint");
   if (!c.handle) fail(Errc::WrongState, "the constraint has no handle: create it with a grab or set its targets");
   if (c.handle->tool) fail(Errc::WrongState, "the handle follows a tool: move the tool instead");
+  devices_.for_each([&](Id, const DeviceLink& link) {
+    if (link.settings().lpc == id) fail(Errc::WrongState, "a device moves this handle: move the device instead");
+  });
   require_finite(position, "the handle position");
   if (!orientation.coeffs().allFinite() || !(orientation.norm() > 1e-12))
     fail(Errc::InvalidArgument, "the handle orientation must be a finite non-zero quaternion");
@@ -318,6 +343,7 @@ std::vector<Id> World::ids(IdKind kind) const {
 
 void World::remove_lpc(Id id) {
   const Lpc& c = lpcs_.get(id, "constraint");
+  refuse_if_driven(devices_, id);
   Body* b = bodies_.find(c.body);
   lpcs_.erase(id);
   if (recorder_) recorder_->write(RecordKind::RemoveLpc, id);

@@ -105,10 +105,10 @@ struct BodyOverlap {
   double reach = 0;     // m: how deep body contacts look for that node (the other body's surface edge, or the margin)
 };
 
-// The pose a device gave its tool at the start of a step (World::follow_devices): what a
-// recording keeps of the device, and what its replay hands the step instead.
+// The pose a device gave its tool or grasp handle at the start of a step (World::follow_devices):
+// what a recording keeps of the device, and what its replay hands the step instead.
 struct AdoptedPose {
-  Id tool = 0;
+  Id target = 0;  // a tool or a constraint
   Vec3 position = Vec3::Zero();
   Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();
 };
@@ -167,7 +167,10 @@ class World {
   Tool& tool(Id id) { return tools_.get(id, "tool"); }
   const Tool& tool(Id id) const { return tools_.get(id, "tool"); }
   void set_tool_pose(Id id, const Vec3& position, const Eigen::Quaterniond& orientation);
-  // Devices: added and removed only while no servo loop runs.
+  // Devices: added and removed only while no servo loop runs. A device drives a tool or a grasp
+  // (a constraint with a handle that follows no tool), not both; check_device_target throws as
+  // add_device would for the ids of `settings` (StaleId, InvalidArgument), changing nothing.
+  void check_device_target(const DeviceSettings& settings) const;
   Id add_device(std::unique_ptr<Device> device, const DeviceSettings& settings);
   void remove_device(Id id);
   DeviceLink& device(Id id) { return devices_.get(id, "device"); }
@@ -227,6 +230,7 @@ class World {
   void advance(double h);
   StepContext begin_step(double h);
   void follow_devices();
+  ForceModel grasp_force_model(const DeviceLink& link, const Lpc& grasp) const;
   void collide(StepContext& ctx);
   bool bounds_overlap(const SurfaceView& a, const SurfaceView& b) const;
   // Bodies placed overlapping (overlaps.cpp).

@@ -720,6 +720,42 @@ static class TestMica
         }
     }
 
+    // Since 0.6 (mica_device_def.lpc): the stylus, held at y = 0.1 m, moves the handle of a grab
+    // made 5 mm lower and so lifts the top face; it renders the grasp's reaction, the force on the
+    // hand: down, toward the tissue.
+    static void DeviceDrivesAGrasp()
+    {
+        try { Mica.DeviceDef(); }
+        catch (EntryPointNotFoundException) { throw new Skip("the loaded libmica has no device functions yet"); }
+        var wdef = Mica.WorldDef();
+        unsafe { wdef.gravity[1] = 0; }
+        using (var world = new World(wdef))
+        {
+            var body = world.CreateBox(new[] { -0.05, 0, -0.05 }, new[] { 0.05, 0.1, 0.05 }, new[] { 4, 4, 4 }, 5, Mica.BodyDef());
+            var bottom = body.SelectNodesByPlane(new double[] { 0, 0, 0 }, new double[] { 0, 1, 0 }, 1e-9, true);
+            var fixedBase = body.AddLpc(bottom, Mica.LpcDef());
+            var grasp = body.Grab(new[] { 0, 0.095, 0 }, 0.006);
+            var stylus = new Stylus();
+            var device = world.CreateGraspDevice(Mica.DeviceDef(), grasp, stylus);
+            var state = new MicaNative.mica_device_state();
+            var force = new double[3];
+            for (int k = 0; k < 20; ++k)
+            {
+                Expect(device.Poll(ref state, force) >= 0, "poll");
+                world.Step(0.01);
+            }
+            Expect(device.Poll(ref state, force) >= 0, "poll");
+            var reaction = grasp.GetReaction();
+            var held = fixedBase.GetReaction();
+            Expect(reaction[1] < 0 && force[1] < 0, "pulled down toward the tissue: reaction " + reaction[1] + " N, rendered " + force[1] + " N");
+            Expect(Math.Abs(held[1] + reaction[1]) <= 0.05 * Math.Abs(reaction[1]), "the base holds the block against the grasp");
+            try { grasp.Remove(); Expect(false, "a driven grasp was removed"); }
+            catch (MicaException e) { Expect(e.Status == MicaNative.MICA_ERR_WRONG_STATE, "MICA_ERR_WRONG_STATE"); }
+            device.Destroy();
+            grasp.Remove();
+        }
+    }
+
     static int Main()
     {
         ReadManifest(Environment.GetEnvironmentVariable("MICA_MANIFEST_TSV"));
@@ -731,6 +767,7 @@ static class TestMica
         Test("errors, the log callback and the SafeHandle", Errors);
         Test("sphere indent matches C to 1e-9", SphereIndent);
         Test("a device backend in C#", DeviceBackendInCSharp);
+        Test("a device driving a grasp", DeviceDrivesAGrasp);
         Test("a mesh file and raw ids, from another assembly", LoaderAndRawIds);
         Test("tissue regions, materials and fields", RegionsMaterialsAndFields);
         Test("System.Numerics Vector3 and Quaternion overloads", NumericsOverloads);

@@ -230,6 +230,42 @@ test("a device with Lua callbacks", function()
   world:close()
 end)
 
+test("a device driving a grasp (mica_device_def.lpc, since 0.6)", function()
+  if not pcall(function() return C.mica_device_create end) then return "skip" end
+  local world = mica.world{ gravity = { 0, 0, 0 }, solver = C.MICA_SOLVER_MICA }
+  local body = world:create_box({ -0.05, 0, -0.05 }, { 0.05, 0.1, 0.05 }, { 4, 4, 4 })
+  local bottom, n = world:select_nodes_by_plane(body, { 0, 0, 0 }, { 0, 1, 0 })
+  local base = world:add_lpc(body, bottom, n)
+  local grasp = world:grab(body, { 0, 0.1, 0 }, 0.001)
+  local reads = 0
+  local device = world:create_device({ lpc = grasp }, {
+    read_state = function(state) -- held 5 mm above the grab: it lifts the top face
+      reads = reads + 1
+      state.position[1] = 0.105
+      state.orientation[0] = 1
+      state.timestamp = reads * 0.001
+    end,
+    write_force = function() end,
+  })
+  local force = ffi.new("double[3]")
+  for _ = 1, 20 do
+    world:check(C.mica_device_poll(world.ptr, device, nil, force))
+    world:check(C.mica_step(world.ptr, 0.01))
+  end
+  world:check(C.mica_device_poll(world.ptr, device, nil, force))
+  local reaction, holder = world:lpc_reaction(grasp), world:lpc_reaction(base)
+  expect(reaction[1] < 0 and force[1] < 0, "the grasped tissue pulls the hand down, and the device renders it")
+  expect(math.abs(holder[1] + reaction[1]) <= 0.05 * math.abs(reaction[1]), "the base holds the block against the grasp")
+  expect(C.mica_lpc_remove(world.ptr, grasp) == C.MICA_ERR_WRONG_STATE, "a driven grasp stays while its device lives")
+  world:check(C.mica_device_destroy(world.ptr, device))
+  world:check(C.mica_lpc_remove(world.ptr, grasp))
+  local tool = world:create_tool{ radius = 0.01, position = { 0, 0.3, 0 } }
+  local other = world:grab(body, { 0.025, 0.1, 0 }, 0.01)
+  local ok, err = pcall(world.create_device, world, { tool = tool, lpc = other })
+  expect(not ok and err.status == C.MICA_ERR_INVALID_ARGUMENT, "a tool or a grasp, not both")
+  world:close()
+end)
+
 test("loaders, grasp and constraint helpers", function()
   local world = mica.world{ gravity = { 0, -9.81, 0 } }
   local mesh = os.getenv("MICA_SOURCE_DIR") .. "/tests/data/cube_v22.msh"

@@ -511,6 +511,37 @@ class Devices(unittest.TestCase):
             self.assertEqual(backend.closed, 1)
             self.assertIsNone(backend.error)
 
+    def test_device_drives_a_grasp(self):
+        # Since 0.6 (mica_device_def.lpc): a stylus held 5 mm above a grab on the top face lifts it;
+        # the device renders the grasp's reaction, the force on the hand: down, toward the tissue,
+        # against the fixed base's up.
+        with mica.World(gravity=(0, 0, 0), solver=mica.MICA_SOLVER_MICA) as world:
+            body = world.create_box((-0.05, 0, -0.05), (0.05, 0.1, 0.05), (4, 4, 4))
+            base = body.add_lpc(body.select_nodes_by_plane((0, 0, 0), (0, 1, 0)))
+            grasp = body.grab((0, 0.1, 0), 0.001)
+            backend = Recorder((0, 0.105, 0))
+            device = world.create_device(backend=backend, grasp=grasp)
+            self.assertEqual(native.mica_device_def().lpc, 0)
+            for _ in range(20):
+                device.poll()
+                world.step(0.01)
+            state, force = device.poll()
+            reaction = grasp.reaction()
+            self.assertLess(reaction[1], 0)
+            self.assertLess(force[1], 0)
+            self.assertAlmostEqual(base.reaction()[1], -reaction[1], delta=0.05 * abs(reaction[1]))
+            with self.assertRaises(mica.MicaError) as e:
+                grasp.remove()
+            self.assertEqual(e.exception.status, mica.MICA_ERR_WRONG_STATE)
+            device.destroy()
+            grasp.remove()
+            # A device drives a tool or a grasp, not both.
+            tool = world.create_tool(radius=0.01, position=(0, 0.3, 0))
+            other = body.grab((0.025, 0.1, 0), 0.01)
+            with self.assertRaises(mica.MicaError) as e:
+                world.create_device(tool=tool, grasp=other)
+            self.assertEqual(e.exception.status, mica.MICA_ERR_INVALID_ARGUMENT)
+
     def test_failing_backend_sends_zero(self):
         class Broken(Recorder):
             def read_state(self, state):

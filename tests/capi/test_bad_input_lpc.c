@@ -1,7 +1,10 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /* Bad input to capi/lpc.cpp through the C ABI: linear projective constraints, their def, their
- * nodes, stale constraint ids, reactions. The checks are in bad_input_util.h. */
+ * nodes, stale constraint ids, reactions; and grasps driven by a device (mica_device_def.lpc,
+ * since 0.6). The checks are in bad_input_util.h. */
 #include "bad_input_util.h"
+
+#include <mica/mica_device.h>
 
 static const int32_t kTwoNodes[2] = {1, 2};
 
@@ -207,12 +210,92 @@ static void test_stale_lpc_ids(void** state) {
   EXPECT_FAIL(fx, MICA_ERR_STALE_ID, mica_lpc_remove(fx->world, fx->lpc), hex_id(fx->lpc, hex, sizeof hex));
 }
 
+/* ------------------------------------------------------------------------------------------ */
+/* A device driving a grasp (mica_device_def.lpc)                                              */
+
+/* Made by setup_driven in the fixture world: a grab a (null) device drives, a tool and a grab
+ * following it (forceps). */
+static mica_lpc_id g_grab, g_forceps;
+static mica_tool_id g_tool;
+static mica_device_id g_device;
+
+static mica_status create_device(bad_call* c, const mica_device_def* d) {
+  mica_device_id out = 0;
+  return id_unwritten(c, "out_device", &out, mica_device_create(c->fx->world, d, &out));
+}
+static mica_status device_with_tool_and_lpc(bad_call* c) {
+  mica_device_def d = mica_device_def_default();
+  d.lpc = g_grab;
+  d.tool = g_tool;
+  return create_device(c, &d);
+}
+/* Ids that name no live constraint (MICA_NULL_ID is "no grasp", not stale). */
+static mica_status device_with_stale_lpc(bad_call* c) {
+  const mica_lpc_id bad[5] = {c->fx->dead_lpc, c->fx->body, c->fx->dead_body, 0x0200000100000063u, UINT64_MAX};
+  hex_id(bad[c->i], c->needle[0], sizeof c->needle[0]);
+  mica_device_def d = mica_device_def_default();
+  d.lpc = bad[c->i];
+  return create_device(c, &d);
+}
+static mica_status device_on_lpc_without_handle(bad_call* c) {
+  mica_device_def d = mica_device_def_default();
+  d.lpc = c->fx->lpc;
+  return create_device(c, &d);
+}
+static mica_status device_on_forceps(bad_call* c) {
+  mica_device_def d = mica_device_def_default();
+  d.lpc = g_forceps;
+  return create_device(c, &d);
+}
+static mica_status remove_driven_grab(bad_call* c) { return mica_lpc_remove(c->fx->world, g_grab); }
+static mica_status destroy_body_of_driven_grab(bad_call* c) { return mica_body_destroy(c->fx->world, c->fx->body); }
+static mica_status move_driven_handle(bad_call* c) {
+  const double p[3] = {0.3, 0.1, 0.1}, q[4] = {1, 0, 0, 0};
+  return mica_lpc_set_handle_pose(c->fx->world, g_grab, p, q);
+}
+
+static const bad_case kDrivenCases[] = {
+    {"mica_device_create: both tool and lpc", device_with_tool_and_lpc, MICA_ERR_INVALID_ARGUMENT, "not both"},
+    {"mica_device_create: stale lpc", device_with_stale_lpc, MICA_ERR_STALE_ID, NULL, 5},
+    {"mica_device_create: lpc without a handle", device_on_lpc_without_handle, MICA_ERR_INVALID_ARGUMENT, "no handle"},
+    {"mica_device_create: lpc whose handle follows a tool", device_on_forceps, MICA_ERR_INVALID_ARGUMENT,
+     "follows a tool"},
+    {"mica_lpc_remove: a device drives it", remove_driven_grab, MICA_ERR_WRONG_STATE, "destroy the device first"},
+    {"mica_body_destroy: a device drives a grasp on it", destroy_body_of_driven_grab, MICA_ERR_WRONG_STATE,
+     "destroy the device first"},
+    {"mica_lpc_set_handle_pose: a device moves it", move_driven_handle, MICA_ERR_WRONG_STATE, "move the device"},
+};
+
+static int setup_driven(void** state) {
+  if (setup(state) != 0) return -1;
+  fixture* fx = *state;
+  const mica_tool_def td = mica_tool_def_default();
+  if (mica_tool_create(fx->world, &td, &g_tool) != MICA_OK) return -1;
+  if (mica_lpc_grab(fx->world, fx->body, kHi, 1e-3, MICA_NULL_ID, &g_grab) != MICA_OK) return -1;
+  if (mica_lpc_grab(fx->world, fx->body, kHi, 1e-3, g_tool, &g_forceps) != MICA_OK) return -1;
+  mica_device_def dd = mica_device_def_default();
+  dd.lpc = g_grab;
+  return mica_device_create(fx->world, &dd, &g_device) == MICA_OK ? 0 : -1;
+}
+
+/* Once the device is gone the grasp goes as any other (and the tool, which a DIRECT world would
+ * refuse to step with). */
+static int teardown_driven(void** state) {
+  fixture* fx = *state;
+  const int bad = mica_device_destroy(fx->world, g_device) != MICA_OK || mica_lpc_remove(fx->world, g_grab) != MICA_OK ||
+                  mica_lpc_remove(fx->world, g_forceps) != MICA_OK || mica_tool_destroy(fx->world, g_tool) != MICA_OK;
+  return teardown(state) == 0 && !bad ? 0 : -1;
+}
+
+static void test_driven_grasps(void** state) { RUN_BAD_CASES((fixture*)*state, kDrivenCases); }
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test_setup_teardown(test_null_pointers, setup, teardown),
       cmocka_unit_test_setup_teardown(test_bad_lpc_def, setup, teardown),
       cmocka_unit_test_setup_teardown(test_bad_nodes, setup, teardown),
       cmocka_unit_test_setup_teardown(test_stale_lpc_ids, setup, teardown),
+      cmocka_unit_test_setup_teardown(test_driven_grasps, setup_driven, teardown_driven),
   };
   return cmocka_run_group_tests(tests, group_setup, group_teardown);
 }

@@ -22,6 +22,8 @@
 #define FIRST_LPC END_OF(mica_lpc_def, velocity)
 #define FIRST_TOOL END_OF(mica_tool_def, reserved0)
 #define FIRST_DEVICE END_OF(mica_device_def, hand_damping)
+/* The 0.5.0 device def ended with hand_damping (lpc came in 0.6). */
+#define DEVICE_0_5 END_OF(mica_device_def, hand_damping)
 /* The 0.3.0 world def ended with mica_sweep and reserved3 (now threads). */
 #define WORLD_0_3 END_OF(mica_world_def, threads)
 
@@ -40,6 +42,8 @@ static void test_first_sizes_are_the_released_ones(void** state) {
   assert_int_equal(FIRST_LPC, 80);
   assert_int_equal(FIRST_TOOL, 160);
   assert_int_equal(FIRST_DEVICE, 200);
+  assert_int_equal(DEVICE_0_5, 200);
+  assert_int_equal(sizeof(mica_device_def), 208);
 }
 
 /* init at `size` into a buffer of 0xcd: returns the status; *written counts the bytes changed
@@ -168,6 +172,28 @@ static void test_older_header_gets_the_library_defaults(void** state) {
   assert_true(c.stats.solver_iterations != a.stats.solver_iterations);
 }
 
+/* A device def from a 0.5 caller: only its 200 bytes are read, so what lies where 0.6 has `lpc`
+ * (here an id no world ever made) is not looked at and the device drives nothing; the same bytes
+ * read as a 0.6 def name a stale grasp. */
+static void test_device_from_0_5_header(void** state) {
+  (void)state;
+  union {
+    mica_device_def d;
+    unsigned char bytes[sizeof(mica_device_def) + 16];
+  } dev;
+  memset(&dev, 0xcd, sizeof dev);
+  assert_int_equal(mica_device_def_init(&dev.d, DEVICE_0_5), MICA_OK);
+  mica_world_def wd = mica_world_def_default();
+  mica_world* world = NULL;
+  assert_int_equal(mica_world_create(&wd, &world), MICA_OK);
+  mica_device_id device = MICA_NULL_ID;
+  assert_int_equal(mica_device_create(world, &dev.d, &device), MICA_OK);
+  assert_int_equal(mica_device_destroy(world, device), MICA_OK);
+  dev.d.struct_size = sizeof dev.d;
+  assert_int_equal(mica_device_create(world, &dev.d, &device), MICA_ERR_STALE_ID);
+  mica_world_destroy(world);
+}
+
 /* 0.3's reserved3 became threads in 0.4: a 0.3 def's value there is not a thread count. */
 static void test_world_0_3_reserved_slot(void** state) {
   (void)state;
@@ -226,6 +252,7 @@ int main(void) {
       cmocka_unit_test(test_init_accepts_every_released_size),
       cmocka_unit_test(test_world_from_an_older_header),
       cmocka_unit_test(test_world_0_3_reserved_slot),
+      cmocka_unit_test(test_device_from_0_5_header),
       cmocka_unit_test(test_older_header_gets_the_library_defaults),
       cmocka_unit_test(test_header_versions),
       cmocka_unit_test(test_create_names_a_refused_size),

@@ -18,10 +18,11 @@ typedef struct {
   mica_world* world;
   mica_body_id body;
   mica_tool_id tool;
+  mica_lpc_id base;
 } scene;
 
 static scene make_scene(double youngs_modulus) {
-  scene s = {NULL, 0, 0};
+  scene s = {NULL, 0, 0, 0};
   mica_world_def wd = mica_world_def_default();
   wd.gravity[1] = 0;
   wd.solver = MICA_SOLVER_MICA;
@@ -38,8 +39,7 @@ static scene make_scene(double youngs_modulus) {
   const double o[3] = {0, -0.1, 0}, up[3] = {0, 1, 0};
   assert_int_equal(mica_body_select_nodes_by_plane(s.world, s.body, o, up, 1e-9, 1, base, 64, &n), MICA_OK);
   const mica_lpc_def fixed = mica_lpc_def_default();
-  mica_lpc_id lpc;
-  assert_int_equal(mica_add_lpc(s.world, s.body, base, n, &fixed, &lpc), MICA_OK);
+  assert_int_equal(mica_add_lpc(s.world, s.body, base, n, &fixed, &s.base), MICA_OK);
   mica_tool_def td = mica_tool_def_default();
   td.radius = 0.015;
   td.position[0] = 0.004;
@@ -241,12 +241,76 @@ static void test_callback_device(void** state) {
   mica_world_destroy(s.world);
 }
 
+/* A virtual hand driving a grasp (mica_device_def.lpc, since 0.6): it grasps the top face at
+ * (-0.01, 0, -0.01) and aims 1 cm above it. In lockstep (16 polls per 16 ms step) until hand and
+ * block are at rest; then, with the hand still:
+ * - the device renders what the grasped tissue puts on the hand, the grasp's reaction (the
+ *   filter has settled: within 1%), pointing down (the tissue pulls the lifting hand back);
+ * - the reaction is the force on the holder: with no gravity the grasp and the fixed base hold
+ *   the block between them, their reactions cancel (to 1%, the block's leftover motion);
+ * - the hand rests where its arm's pull balances the rendered force: k (target - x) + F = 0;
+ * - the grasp cannot be removed under its device, and can once the device is gone. */
+static const double kGraspAt[3] = {-0.01, 0, -0.01};
+static void lift(double t, double p[3], void* user) {
+  (void)user;
+  p[0] = kGraspAt[0];
+  p[1] = kGraspAt[1] + 0.01 * (t < 0.5 ? t / 0.5 : 1);
+  p[2] = kGraspAt[2];
+}
+
+static void test_grasp_renders_its_reaction(void** state) {
+  (void)state;
+  scene s = make_scene(5e3);
+  mica_lpc_id grasp;
+  assert_int_equal(mica_lpc_grab(s.world, s.body, kGraspAt, 0.021, MICA_NULL_ID, &grasp), MICA_OK);
+  mica_device_def dd = mica_device_def_default();
+  dd.backend = MICA_DEVICE_SIMULATED;
+  dd.simulated_kind = MICA_SIMULATED_HAND;
+  dd.trajectory = lift;
+  dd.lpc = grasp;
+  /* Lockstep polls come microseconds apart in wall time, which the rate limit measures: lifted
+   * here so the force follows the steps (the limit itself is tests/haptics' business). */
+  dd.max_force_rate = 1e7;
+  mica_device_id device;
+  assert_int_equal(mica_device_create(s.world, &dd, &device), MICA_OK);
+  mica_device_info info = {sizeof info};
+  assert_int_equal(mica_device_get_info(s.world, device, &info), MICA_OK);
+  double f[3] = {0, 0, 0}, reaction[3] = {0, 0, 0}, base[3] = {0, 0, 0};
+  mica_device_state hand = {sizeof hand};
+  for (int k = 0; k < 250; ++k) { /* 4 s */
+    for (int p = 0; p < 16; ++p) assert_true(mica_device_poll(s.world, device, &hand, f) >= 0);
+    assert_true(mica_step(s.world, 0.016) >= 0);
+    assert_int_equal(mica_lpc_get_reaction(s.world, grasp, reaction), MICA_OK);
+    if (getenv("MICA_TEST_TRACE"))
+      print_message("step %d hand y %.5f rendered y %.4f grasp reaction y %.4f\n", k, hand.position[1], f[1],
+                    reaction[1]);
+  }
+  /* Still: the filter's window (20 polls) sees one model, the hand has stopped. */
+  for (int p = 0; p < 40; ++p) assert_true(mica_device_poll(s.world, device, &hand, f) >= 0);
+  assert_int_equal(mica_lpc_get_reaction(s.world, s.base, base), MICA_OK);
+  const double r = sqrt(reaction[0] * reaction[0] + reaction[1] * reaction[1] + reaction[2] * reaction[2]);
+  print_message("hand at y %.5f m (speed %.2e m/s); rendered (%.4f, %.4f, %.4f) N; grasp reaction (%.4f, %.4f, %.4f) "
+                "N; base reaction y %.4f N\n",
+                hand.position[1], hand.velocity[1], f[0], f[1], f[2], reaction[0], reaction[1], reaction[2], base[1]);
+  assert_true(reaction[1] < -0.1 && r < info.max_force); /* pulled down, below the clamp: rendered whole */
+  for (int k = 0; k < 3; ++k) assert_true(fabs(f[k] - reaction[k]) < 0.01 * r);
+  for (int k = 0; k < 3; ++k) assert_true(fabs(base[k] + reaction[k]) < 0.01 * r);
+  double target[3];
+  lift(1.0, target, NULL);
+  for (int k = 0; k < 3; ++k) assert_true(fabs(dd.hand_stiffness * (target[k] - hand.position[k]) + f[k]) < 0.01 * r);
+  assert_int_equal(mica_lpc_remove(s.world, grasp), MICA_ERR_WRONG_STATE);
+  assert_int_equal(mica_device_destroy(s.world, device), MICA_OK);
+  assert_int_equal(mica_lpc_remove(s.world, grasp), MICA_OK);
+  mica_world_destroy(s.world);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_callback_device),
       cmocka_unit_test(test_closed_loop_soft),
       cmocka_unit_test(test_closed_loop_stiff),
       cmocka_unit_test(test_servo_thread_beside_simulation),
+      cmocka_unit_test(test_grasp_renders_its_reaction),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -452,12 +452,17 @@ class World:
 
     def create_device(self, backend: Optional[DeviceBackend] = None, tool: Optional[Tool] = None,
                       trajectory: Optional[Callable[[float], Vec3]] = None,
-                      definition: Optional[native.mica_device_def] = None, **fields: Any) -> Device:
-        """A haptic device driving `tool`. `backend` is a DeviceBackend (its methods become the
-        callback table) or None for the def's backend (MICA_DEVICE_NULL by default);
-        `trajectory` is a callable t -> (x, y, z) for a simulated device."""
+                      definition: Optional[native.mica_device_def] = None, grasp: Optional["Lpc"] = None,
+                      **fields: Any) -> Device:
+        """A haptic device driving `tool`, or (since 0.6) `grasp`, a grab's Lpc whose handle follows
+        the device (mica_device_def.lpc: it renders the grasp's reaction, the force on the hand).
+        `backend` is a DeviceBackend (its methods become the callback table) or None for the def's
+        backend (MICA_DEVICE_NULL by default); `trajectory` is a callable t -> (x, y, z) for a
+        simulated device."""
         d = _fill(definition if definition is not None else device_def(), fields)
         d.tool = _id_of(tool)
+        if grasp is not None:
+            d.lpc = _id_of(grasp)
         table = None
         if backend is not None:
             table = backend._table()

@@ -308,6 +308,7 @@ class mica_device_def(Structure):
         ("hand_mass", c_double),
         ("hand_stiffness", c_double),
         ("hand_damping", c_double),
+        ("lpc", mica_lpc_id),  # since 0.6
     ]
 
 

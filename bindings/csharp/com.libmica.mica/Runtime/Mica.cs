@@ -362,9 +362,25 @@ namespace LibMica
 
         /// <summary>A device driving `tool`: with a backend, its methods are the callback table;
         /// without, the def's own backend (MICA_DEVICE_NULL by default).</summary>
-        public unsafe Device CreateDevice(MicaNative.mica_device_def def, Tool tool, DeviceBackend backend = null)
+        public Device CreateDevice(MicaNative.mica_device_def def, Tool tool, DeviceBackend backend = null)
         {
             def.tool = tool != null ? tool.Id : MicaNative.MICA_NULL_ID;
+            return CreateDeviceWith(def, backend);
+        }
+
+        /// <summary>A device moving the handle of `grasp` (a Grab without a tool; since 0.6,
+        /// mica_device_def.lpc): it renders the grasp's reaction, the force the held tissue puts on
+        /// the hand.</summary>
+        public Device CreateGraspDevice(MicaNative.mica_device_def def, Lpc grasp, DeviceBackend backend = null)
+        {
+            if (grasp == null) throw new ArgumentNullException("grasp");
+            def.tool = MicaNative.MICA_NULL_ID;
+            def.lpc = grasp.Id;
+            return CreateDeviceWith(def, backend);
+        }
+
+        private unsafe Device CreateDeviceWith(MicaNative.mica_device_def def, DeviceBackend backend)
+        {
             var table = new MicaNative.mica_device_callbacks();
             if (backend != null)
             {

@@ -322,6 +322,7 @@ namespace LibMica
             public double hand_mass;
             public double hand_stiffness;
             public double hand_damping;
+            public ulong lpc; // since 0.6: the grasp whose handle follows the device
         }
 
         [StructLayout(LayoutKind.Sequential)]
