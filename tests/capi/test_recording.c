@@ -3,7 +3,8 @@
  *  - a 5 s haptic session (a simulated hand on its own 1 kHz servo thread driving a sphere into a
  *    soft block, a grab dragged by the host, node forces, the grab released) replays into a fresh
  *    world with every step's positions and tool force bit for bit;
- *  - a session with a saved state restored halfway (the device polled by the test) replays alike;
+ *  - a session with a saved state restored halfway (the device polled by the test) replays alike,
+ *    and so does one where the device drives a grasp;
  *  - a changed fingerprint is reported as MICA_ERR_DIVERGED at its step, a recording cut inside an
  *    entry replays up to the entry before, and bad files and calls get their statuses. */
 #define _POSIX_C_SOURCE 200809L
@@ -215,6 +216,49 @@ static void test_restored_state_replays_bit_for_bit(void** state) {
   remove(path);
 }
 
+/* The hand's target for a grasp: up 5 mm over the first 0.3 s, from the top face. */
+static void lift(double t, double p[3], void* user) {
+  (void)user;
+  p[0] = -0.04;
+  p[1] = 0.005 * (t < 0.3 ? t / 0.3 : 1.0);
+  p[2] = -0.04;
+}
+
+static void test_grasp_device_session_replays_bit_for_bit(void** state) {
+  (void)state;
+  const char* path = "test_recording_grasp.micarec";
+  box_scene s;
+  mica_world* w = new_recorded_world(path, &s);
+  const int32_t steps = 40;
+  trace t = {0, s.nodes, malloc((size_t)steps * (size_t)s.nodes * 3 * sizeof(double)),
+             malloc((size_t)steps * 3 * sizeof(double))};
+  const double corner[3] = {-0.04, 0.0, -0.04};
+  mica_lpc_id grasp;
+  OK(w, mica_lpc_grab(w, s.body, corner, 0.015, MICA_NULL_ID, &grasp));
+  mica_device_def dd = mica_device_def_default();
+  dd.backend = MICA_DEVICE_SIMULATED;
+  dd.trajectory = lift;
+  dd.lpc = grasp;
+  mica_device_id device;
+  OK(w, mica_device_create(w, &dd, &device));
+  double lifted = 0;
+  for (int32_t k = 0; k < steps; ++k) {
+    for (int i = 0; i < 10; ++i) mica_device_poll(w, device, NULL, NULL); /* the servo, by hand */
+    OK(w, mica_step(w, kDt));
+    trace_step(w, &s, &t);
+    double reaction[3];
+    OK(w, mica_lpc_get_reaction(w, grasp, reaction));
+    lifted = fmax(lifted, fabs(reaction[1]));
+  }
+  assert_true(lifted > 0.01); /* the device's grasp pulled on the tissue */
+  OK(w, mica_world_record_stop(w));
+  mica_world_destroy(w);
+  assert_int_equal(replay_and_compare(path, &s, &t), steps);
+  free(t.x);
+  free(t.force);
+  remove(path);
+}
+
 static long file_size(const char* path) {
   FILE* f = fopen(path, "rb");
   assert_non_null(f);
@@ -347,6 +391,7 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_haptic_session_replays_bit_for_bit),
       cmocka_unit_test(test_restored_state_replays_bit_for_bit),
+      cmocka_unit_test(test_grasp_device_session_replays_bit_for_bit),
       cmocka_unit_test(test_divergence_and_truncation_are_reported),
       cmocka_unit_test(test_bad_calls_and_files),
   };
