@@ -18,12 +18,7 @@
 
 #include "bench_common.h"
 #include "box_scene.h"
-
-static double now_s(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
+#include "wall_clock.h"
 
 static void press(double t, double p[3], void* user) {
   (void)user;

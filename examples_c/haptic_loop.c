@@ -18,6 +18,7 @@
 #include <mica/mica.h>
 
 #include "box_scene.h"
+#include "wall_clock.h"
 #include "cli.h"
 #include <mica/mica_device.h>
 
@@ -34,19 +35,6 @@ typedef struct {
   double t[MAX_SAMPLES], raw[MAX_SAMPLES], filtered[MAX_SAMPLES];
   long failures;
 } loop;
-
-static double now_s(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static void sleep_until(double deadline) {
-  const double wait = deadline - now_s();
-  if (wait <= 0) return;
-  struct timespec ts = {(time_t)wait, (long)((wait - floor(wait)) * 1e9)};
-  nanosleep(&ts, NULL);
-}
 
 /* The stylus goes 1.5 cm down into the block over 0.5 s, holds 0.5 s, and lifts off. */
 static void press(double t, double p[3], void* user) {

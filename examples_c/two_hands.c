@@ -23,25 +23,13 @@
 #include <mica/mica_device.h>
 
 #include "box_scene.h"
+#include "wall_clock.h"
 #include "cli.h"
 
 #ifndef SIM_HZ
 #define SIM_HZ 100
 #endif
 #define MAX_ROWS 100000
-
-static double now_s(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static void sleep_until(double deadline) {
-  const double wait = deadline - now_s();
-  if (wait <= 0) return;
-  struct timespec ts = {(time_t)wait, (long)((wait - floor(wait)) * 1e9)};
-  nanosleep(&ts, NULL);
-}
 
 /* The grasp's centre on the top face (y = 0) and the sphere's point of first touch. */
 static const double kGrasp[3] = {-0.025, 0, 0};

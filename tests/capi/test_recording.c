@@ -24,31 +24,11 @@
 #include <mica/mica_device.h>
 
 #include "box_scene.h"
+#include "wall_clock.h"
 
-#define OK(w, call)                                                                               \
-  do {                                                                                            \
-    const mica_status s_ = (call);                                                                \
-    if (s_ != MICA_OK && s_ != MICA_WARN_NOT_CONVERGED) {                                         \
-      print_error("%s:%d: %s: %s\n  %s\n", __FILE__, __LINE__, #call, mica_status_string(s_),     \
-                  mica_world_last_error(w));                                                      \
-      fail();                                                                                     \
-    }                                                                                             \
-  } while (0)
+#include "capi_ok.h"
 
 static const double kDt = 0.01;
-
-static double now_s(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static void sleep_until(double deadline) {
-  const double wait = deadline - now_s();
-  if (wait <= 0) return;
-  struct timespec ts = {(time_t)wait, (long)((wait - (double)(time_t)wait) * 1e9)};
-  nanosleep(&ts, NULL);
-}
 
 /* The hand's target: down 12 mm into the block over 2 s, then sideways (`user`: NULL, or a
  * factor on the time to press faster). */

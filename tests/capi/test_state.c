@@ -18,15 +18,7 @@
 
 #include <mica/mica.h>
 
-#define OK(w, call)                                                                               \
-  do {                                                                                            \
-    const mica_status s_ = (call);                                                                \
-    if (s_ != MICA_OK && s_ != MICA_WARN_NOT_CONVERGED) {                                         \
-      print_error("%s:%d: %s: %s\n  %s\n", __FILE__, __LINE__, #call, mica_status_string(s_),     \
-                  mica_world_last_error(w));                                                      \
-      fail();                                                                                     \
-    }                                                                                             \
-  } while (0)
+#include "capi_ok.h"
 
 static const double kDt = 0.01;
 
