@@ -456,6 +456,7 @@ void World::restore_state(const uint8_t* data, size_t size) {
   });
   k = 0;
   devices_.for_each([&](Id, DeviceLink& link) { link.set_filter_state(device_data[k++]); });
+  publish_force_models();  // the servo path renders the restored step's force model, not the last one run
   if (recorder_) recorder_->write(RecordKind::RestoreState, std::vector<uint8_t>(data, data + size));
 }
 

@@ -17,6 +17,7 @@
 #include <string.h>
 
 #include <mica/mica.h>
+#include <mica/mica_device.h>
 
 #include "capi_ok.h"
 
@@ -388,6 +389,72 @@ static void check_contact_sum(int32_t shape, double friction, int32_t solver) {
   mica_world_destroy(w);
 }
 
+/* A stylus the test moves: down 0.04 mm a poll from y0 (scene = device: scale 1, no offset). */
+typedef struct {
+  double y0;
+  int polls;
+  double t;
+} stylus;
+
+static mica_status read_stylus(void* user, mica_device_state* out) {
+  stylus* s = user;
+  out->position[0] = 0.03;
+  out->position[1] = s->y0 - 4e-5 * s->polls++;
+  out->position[2] = 0.05;
+  out->timestamp = (s->t += 0.001); /* the device's clock never goes back */
+  return MICA_OK;
+}
+
+static mica_status drop_force(void* user, const double force[3], const double torque[3]) {
+  (void)user, (void)force, (void)torque;
+  return MICA_OK;
+}
+
+/* Polls 10 times and steps, `steps` times, keeping every force the device was sent. */
+static void poll_and_step(mica_world* w, mica_device_id device, int steps, double* sent) {
+  for (int k = 0; k < steps; ++k) {
+    for (int i = 0; i < 10; ++i) assert_true(mica_device_poll(w, device, NULL, sent + 3 * (10 * k + i)) >= 0);
+    OK(w, mica_step(w, kDt));
+  }
+}
+
+/* The device's filter (moving average) and rate limit are in the state: restored, the same stylus
+ * motion renders the same forces, poll for poll, as after the save. */
+static void test_device_filter_restores(void** st) {
+  (void)st;
+  scene s = make_scene(MICA_SOLVER_MICA, 3, 1);
+  stylus pen = {0.1 + 0.02 + 0.0005, 0, 0};
+  mica_device_callbacks cb = {sizeof cb, 0, &pen, NULL, NULL, NULL, read_stylus, drop_force};
+  mica_device_def dd = mica_device_def_default();
+  dd.backend = MICA_DEVICE_CALLBACKS;
+  dd.callbacks = &cb;
+  dd.tool = s.tool;
+  dd.max_force_rate = 1e9; /* the rate limit and the stall fade read the wall clock: out of the way */
+  dd.stall_timeout = 100;
+  mica_device_id device;
+  OK(s.world, mica_device_create(s.world, &dd, &device));
+  enum { kSteps = 6 };
+  double warmup[3 * 10 * 10], first[3 * 10 * kSteps], second[3 * 10 * kSteps];
+  poll_and_step(s.world, device, 10, warmup); /* the stylus reaches the block and presses in */
+  size_t bytes = 0;
+  OK(s.world, mica_world_state_size(s.world, &bytes));
+  void* saved = malloc(bytes);
+  OK(s.world, mica_world_save_state(s.world, saved, bytes));
+  const int polls = pen.polls;
+  poll_and_step(s.world, device, kSteps, first);
+  OK(s.world, mica_world_restore_state(s.world, saved, bytes));
+  pen.polls = polls; /* the stylus moves as it did after the save */
+  poll_and_step(s.world, device, kSteps, second);
+  assert_memory_equal(first, second, sizeof first);
+  /* The filter had something to restore: the rendered force was growing through the save. */
+  print_message("rendered after the save: %.4f N, %d polls later %.4f N, the same after the restore\n", first[1],
+                10 * kSteps, first[3 * 10 * kSteps - 2]);
+  assert_true(fabs(first[1]) > 0.01 && fabs(first[3 * 10 * kSteps - 2]) > fabs(first[1]) + 0.01);
+  free(saved);
+  OK(s.world, mica_device_destroy(s.world, device));
+  mica_world_destroy(s.world);
+}
+
 static void test_contacts_sum_to_tool_force(void** st) {
   (void)st;
   const int32_t shapes[2] = {MICA_TOOL_SPHERE, MICA_TOOL_BOX};
@@ -406,6 +473,7 @@ int main(void) {
       cmocka_unit_test(test_replay_default_solver),
       cmocka_unit_test(test_replay_direct_solver),
       cmocka_unit_test(test_restore_refusals),
+      cmocka_unit_test(test_device_filter_restores),
       cmocka_unit_test(test_contacts_sum_to_tool_force),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
