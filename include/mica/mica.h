@@ -966,11 +966,57 @@ MICA_API mica_status mica_world_save_state(const mica_world* world, void* buffer
  *          MICA_ERR_OUT_OF_MEMORY. */
 MICA_API mica_status mica_world_restore_state(mica_world* world, const void* buffer, size_t bytes);
 
-/** Object kinds of mica_world_get_ids() (since 0.6). */
-#define MICA_OBJECT_BODY 1
-#define MICA_OBJECT_LPC 2
-#define MICA_OBJECT_TOOL 3
-#define MICA_OBJECT_DEVICE 4
+#define MICA_CONTACT_NODE 1     /**< the body's point is a node (weights[0] = 1) */
+#define MICA_CONTACT_EDGE 2     /**< a point of a surface edge: two nodes and their weights */
+#define MICA_CONTACT_TRIANGLE 3 /**< a point of a surface triangle: three nodes, barycentric weights */
+#define MICA_CONTACT_OTHER_TOOL 0 /**< the other side is a tool */
+#define MICA_CONTACT_OTHER_BODY 1 /**< the other side is a body (dynamic or static) */
+
+/** One contact of the last step. The body's point is pushed along +normal; the other side feels
+ *  the opposite. Impulses are over the step (N s): the force is impulse / dt. */
+typedef struct mica_contact {
+  uint32_t struct_size;    /**< set by the caller in out[0] (the array's stride): sizeof(mica_contact) */
+  int32_t kind;            /**< MICA_CONTACT_NODE, _EDGE or _TRIANGLE: the body's point */
+  mica_body_id body;       /**< the body */
+  int32_t nodes[3];        /**< the point's nodes (node_count = kind; unused ones -1) */
+  int32_t other_kind;      /**< MICA_CONTACT_OTHER_TOOL or MICA_CONTACT_OTHER_BODY */
+  double weights[3];       /**< the nodes' weights (barycentric, sum 1; unused ones 0) */
+  uint64_t other;          /**< the tool's id (mica_tool_id) or the other body's (mica_body_id) */
+  int32_t other_nodes[3];  /**< another dynamic body: its triangle's nodes; -1 for a tool or a static body */
+  int32_t reserved0;       /**< zero */
+  double other_weights[3]; /**< their barycentric weights; 0 when unused */
+  double point[3];         /**< m, the contact point where it was detected */
+  double normal[3];        /**< unit, separates the body from the other side (points towards the body) */
+  double gap;              /**< m, signed distance at the start of the step (negative: penetrating) */
+  double normal_impulse;   /**< N s, >= 0: the impulse on the body along `normal` */
+  double tangent_impulse[3]; /**< N s, the friction impulse on the body (perpendicular to `normal`; 0 without friction) */
+  double friction;         /**< the Coulomb coefficient of the contact */
+} mica_contact;
+
+/** The contacts of the last step. With out == NULL only *out_count is written (the size query).
+ *  The impulse on the body is normal * normal_impulse + tangent_impulse; summed over a tool's
+ *  contacts and divided by -dt it is mica_tool_get_force() (within round-off). The world's thread
+ *  (the one thread using the world at a time).
+ *  @param world the world (not changed).
+ *  @param out the caller's array, out[0].struct_size set to sizeof(mica_contact) (its stride), or
+ *         NULL to ask for the count only.
+ *  @param capacity the array's size in contacts.
+ *  @param out_count receives the count (may be NULL when `out` is not).
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` is NULL, or both `out` and `out_count`);
+ *          MICA_ERR_INVALID_ARGUMENT (`capacity` < 0); MICA_ERR_STRUCT_SIZE (out[0].struct_size
+ *          is not a size this library knows); MICA_ERR_BUFFER_TOO_SMALL (`capacity` below the count:
+ *          nothing copied, `*out_count` = the count needed). */
+MICA_API mica_status mica_world_get_contacts(const mica_world* world, mica_contact* out, int32_t capacity,
+                                             int32_t* out_count);
+/** @} */
+
+/** @name Object ids (since 0.6)
+ *  @{ */
+
+#define MICA_OBJECT_BODY 1   /**< mica_world_get_ids(): bodies (since 0.6) */
+#define MICA_OBJECT_LPC 2    /**< mica_world_get_ids(): constraints (since 0.6) */
+#define MICA_OBJECT_TOOL 3   /**< mica_world_get_ids(): tools (since 0.6) */
+#define MICA_OBJECT_DEVICE 4 /**< mica_world_get_ids(): devices (since 0.6) */
 
 /** The ids of the world's live objects of one kind (since 0.6): what a tool that did not build the
  *  world (an inspector, the replay tool) needs to read it. In slot order: creation order until an
@@ -985,6 +1031,7 @@ MICA_API mica_status mica_world_restore_state(mica_world* world, const void* buf
  *          (`capacity` below the count: nothing copied, `*out_count` = the count needed). */
 MICA_API mica_status mica_world_get_ids(const mica_world* world, int32_t kind, uint64_t* out, int32_t capacity,
                                         int32_t* out_count);
+/** @} */
 
 /** @name Recording and replay (since 0.6)
  *  A recording keeps what the host fed a world - every call that changes it (bodies with their
@@ -1055,50 +1102,6 @@ MICA_API mica_world* mica_replay_world(const mica_replay* replay);
  *          which step); MICA_ERR_PARSE (a corrupt entry; a recording cut off inside an entry ends at
  *          the entry before). Messages: mica_world_last_error(mica_replay_world(replay)). */
 MICA_API mica_status mica_replay_step(mica_replay* replay, int32_t* out_stepped);
-/** @} */
-
-#define MICA_CONTACT_NODE 1     /**< the body's point is a node (weights[0] = 1) */
-#define MICA_CONTACT_EDGE 2     /**< a point of a surface edge: two nodes and their weights */
-#define MICA_CONTACT_TRIANGLE 3 /**< a point of a surface triangle: three nodes, barycentric weights */
-#define MICA_CONTACT_OTHER_TOOL 0 /**< the other side is a tool */
-#define MICA_CONTACT_OTHER_BODY 1 /**< the other side is a body (dynamic or static) */
-
-/** One contact of the last step. The body's point is pushed along +normal; the other side feels
- *  the opposite. Impulses are over the step (N s): the force is impulse / dt. */
-typedef struct mica_contact {
-  uint32_t struct_size;    /**< set by the caller in out[0] (the array's stride): sizeof(mica_contact) */
-  int32_t kind;            /**< MICA_CONTACT_NODE, _EDGE or _TRIANGLE: the body's point */
-  mica_body_id body;       /**< the body */
-  int32_t nodes[3];        /**< the point's nodes (node_count = kind; unused ones -1) */
-  int32_t other_kind;      /**< MICA_CONTACT_OTHER_TOOL or MICA_CONTACT_OTHER_BODY */
-  double weights[3];       /**< the nodes' weights (barycentric, sum 1; unused ones 0) */
-  uint64_t other;          /**< the tool's id (mica_tool_id) or the other body's (mica_body_id) */
-  int32_t other_nodes[3];  /**< another dynamic body: its triangle's nodes; -1 for a tool or a static body */
-  int32_t reserved0;       /**< zero */
-  double other_weights[3]; /**< their barycentric weights; 0 when unused */
-  double point[3];         /**< m, the contact point where it was detected */
-  double normal[3];        /**< unit, separates the body from the other side (points towards the body) */
-  double gap;              /**< m, signed distance at the start of the step (negative: penetrating) */
-  double normal_impulse;   /**< N s, >= 0: the impulse on the body along `normal` */
-  double tangent_impulse[3]; /**< N s, the friction impulse on the body (perpendicular to `normal`; 0 without friction) */
-  double friction;         /**< the Coulomb coefficient of the contact */
-} mica_contact;
-
-/** The contacts of the last step. With out == NULL only *out_count is written (the size query).
- *  The impulse on the body is normal * normal_impulse + tangent_impulse; summed over a tool's
- *  contacts and divided by -dt it is mica_tool_get_force() (within round-off). The world's thread
- *  (the one thread using the world at a time).
- *  @param world the world (not changed).
- *  @param out the caller's array, out[0].struct_size set to sizeof(mica_contact) (its stride), or
- *         NULL to ask for the count only.
- *  @param capacity the array's size in contacts.
- *  @param out_count receives the count (may be NULL when `out` is not).
- *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` is NULL, or both `out` and `out_count`);
- *          MICA_ERR_INVALID_ARGUMENT (`capacity` < 0); MICA_ERR_STRUCT_SIZE (out[0].struct_size
- *          is not a size this library knows); MICA_ERR_BUFFER_TOO_SMALL (`capacity` below the count:
- *          nothing copied, `*out_count` = the count needed). */
-MICA_API mica_status mica_world_get_contacts(const mica_world* world, mica_contact* out, int32_t capacity,
-                                             int32_t* out_count);
 /** @} */
 
 /** @name Statistics
