@@ -1037,8 +1037,8 @@ MICA_API mica_status mica_world_get_ids(const mica_world* world, int32_t kind, u
  *  A recording keeps what the host fed a world - every call that changes it (bodies with their
  *  meshes, materials, constraints, grabs, tools, devices, poses, targets, node forces, positions,
  *  restored states) and every step with the poses its devices gave their tools or grasp handles -
- *  so that a fresh world replays the session bit for bit: to score a training session afterwards, or to attach to
- *  a bug report. What a device did between steps (the servo path's forces) is not recorded: the
+ *  so that a fresh world replays the session bit for bit: to score a training session afterwards,
+ *  or to attach to a bug report. What a device did between steps (the servo path's forces) is not recorded: the
  *  steps do not depend on it. A world with a time budget (mica_world_def.time_budget_ms) may not
  *  replay bit for bit: its steps depend on the clock. A recording is for this libmica on this kind
  *  of machine (native byte order), like a saved state. The tool `mica_replay` (examples_c) replays
