@@ -7,14 +7,6 @@
 
 namespace mica {
 
-namespace {
-struct EntryHeader {
-  uint32_t kind;
-  uint32_t reserved;
-  uint64_t size;  // bytes of the payload that follows
-};
-}  // namespace
-
 Recorder::Recorder(const std::string& path, const WorldSettings& settings) : path_(path) {
   file_ = std::fopen(path.c_str(), "wb");
   if (!file_) fail(Errc::Io, "cannot open '" + path + "' to record into: " + std::strerror(errno));
@@ -35,7 +27,7 @@ Recorder::~Recorder() {
 
 void Recorder::append(RecordKind kind, const std::vector<uint8_t>& payload) {
   if (!file_ || !error_.empty()) return;
-  const EntryHeader head{uint32_t(kind), 0, payload.size()};
+  const RecordEntryHeader head{uint32_t(kind), 0, payload.size()};
   const bool ok = std::fwrite(&head, sizeof head, 1, file_) == 1 &&
                   std::fwrite(payload.data(), 1, payload.size(), file_) == payload.size() &&
                   // A step ends an entry group: flushed, so a crash of the host keeps every step before it.

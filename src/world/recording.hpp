@@ -28,6 +28,13 @@ constexpr uint32_t kRecordingVersion = 1;
 // Byte order and the size of a double: a recording is replayed where such values read back alike.
 constexpr uint32_t kRecordingLayout = 0x01020304u ^ uint32_t(sizeof(double) << 24);
 
+// What precedes each entry's payload in the file.
+struct RecordEntryHeader {
+  uint32_t kind;      // RecordKind
+  uint32_t reserved;  // zero
+  uint64_t size;      // bytes of the payload that follows
+};
+
 // Writes the entries to a file. A write that fails is kept as the recording's error and ends the
 // recording (the world's calls go on succeeding); stop() reports it.
 class Recorder {

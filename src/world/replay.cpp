@@ -14,12 +14,6 @@ namespace mica {
 
 namespace {
 
-struct EntryHeader {  // as recording.cpp writes it
-  uint32_t kind;
-  uint32_t reserved;
-  uint64_t size;
-};
-
 template <class... A>
 void take_all(ByteReader& in, A&... values) {
   int unused[] = {0, (take(in, values), 0)...};
@@ -63,8 +57,8 @@ void Replay::diverged(const std::string& what) const {
 }
 
 bool Replay::next_step(World& world) {
-  while (bytes_.size() - at_ >= sizeof(EntryHeader)) {
-    EntryHeader head;
+  while (bytes_.size() - at_ >= sizeof(RecordEntryHeader)) {
+    RecordEntryHeader head;
     std::memcpy(&head, bytes_.data() + at_, sizeof head);
     // A host that died mid-entry leaves a partial last entry: its replay ends at the last whole one.
     if (head.size > bytes_.size() - at_ - sizeof head) break;
