@@ -11,6 +11,7 @@ std::vector<mica_contact> contacts_of(const mica::World& w) {
   const std::vector<mica::Contact>& contacts = w.contacts();
   const mica::ContactRows& rows = w.contact_rows();
   const std::vector<double>& lambda = w.impulses();
+  const mica::Vec3List& curvature = w.curvature_impulses();
   std::vector<mica_contact> out(contacts.size());
   for (size_t k = 0; k < contacts.size(); ++k) {
     const mica::Contact& c = contacts[k];
@@ -27,6 +28,7 @@ std::vector<mica_contact> contacts_of(const mica::World& w) {
       r.other_weights[j] = j < c.b.count ? c.b.weights[j] : 0.0;
       r.point[j] = c.point[j];
       r.normal[j] = c.normal[j];
+      r.curvature_impulse[j] = k < curvature.size() ? curvature[k][j] : 0.0;
     }
     r.gap = c.gap;
     r.friction = c.friction;

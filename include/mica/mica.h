@@ -991,10 +991,14 @@ typedef struct mica_contact {
   double normal_impulse;   /**< N s, >= 0: the impulse on the body along `normal` */
   double tangent_impulse[3]; /**< N s, the friction impulse on the body (perpendicular to `normal`; 0 without friction) */
   double friction;         /**< the Coulomb coefficient of the contact */
+  double curvature_impulse[3]; /**< N s, the impulse on the body of the contact's curvature term: a
+                                    rounded tool on a triangle adds the turn of the contact normal
+                                    within the step to the implicit system (docs/solvers.md); 0 for
+                                    other contacts */
 } mica_contact;
 
 /** The contacts of the last step. With out == NULL only *out_count is written (the size query).
- *  The impulse on the body is normal * normal_impulse + tangent_impulse; summed over a tool's
+ *  The impulse on the body is normal * normal_impulse + tangent_impulse + curvature_impulse; summed over a tool's
  *  contacts and divided by -dt it is mica_tool_get_force() (within round-off). The world's thread
  *  (the one thread using the world at a time).
  *  @param world the world (not changed).

@@ -123,8 +123,9 @@ void collide_tool(const Tool& tool, int32_t tool_index, uint64_t tool_key, const
   tool_core(tool, core);
   // A contact of the body point p; pair is the feature pair's id (the contact's key).
   auto emit = [&](uint64_t pair, const BodyPoint& p, const Vec3& normal, const Vec3& point, double gap) -> Contact& {
-    out.push_back(Contact{contact_key(tool_key, body.key, pair), tool_index, p, BodyPoint{}, normal, point, gap,
-                          tool.friction, tool_point_velocity(tool, point)});
+    out.push_back(Contact{contact_key(tool_key, body.key, pair), p, BodyPoint{}, normal, point, gap, tool.friction,
+                          tool_point_velocity(tool, point)});
+    out.back().tool = tool_index;
     out.back().other = tool_key;
     return out.back();
   };
@@ -265,7 +266,7 @@ void collide_bodies(const SurfaceView& a, const SurfaceView& b, double margin_at
     // The normal separates a's node from b: along d outside, against it inside.
     Vec3 normal = n.distance > 1e-12 ? Vec3((inside ? -d : d) / n.distance) : n.outward.normalized();
     if (!normal.allFinite()) normal = n.face;  // a node on a collapsed feature: the face has to do
-    Contact c{contact_key(a.key, b.key, uint64_t(node)), -1, node_point(a.index, node), BodyPoint{}, normal, p, gap,
+    Contact c{contact_key(a.key, b.key, uint64_t(node)), node_point(a.index, node), BodyPoint{}, normal, p, gap,
               friction, Vec3::Zero()};
     if (b.index >= 0) c.b = triangle_point(b.index, (*b.triangles)[n.tri], n.point.weights);  // a static b is an obstacle
     c.other = b.key;

@@ -12,16 +12,17 @@
 namespace mica {
 
 // A point of a body: a node (one weight of 1) or a point of a surface triangle (barycentric).
+// BodyPoint and Contact have no padding: saved states copy them as bytes (state_io.cpp pins it).
 struct BodyPoint {
   int32_t body = -1;  // index in the step's dynamic-body list
   int32_t count = 0;
   std::array<int32_t, 3> nodes{};
+  int32_t unused = 0;
   std::array<double, 3> weights{};
 };
 
 struct Contact {
   uint64_t key;      // persistent while the same features touch: warm starts
-  int32_t tool;      // index in the step's tool list, or -1 between two bodies
   BodyPoint a;       // pushed along +normal
   BodyPoint b;       // between two bodies: pushed along -normal (count 0 for tools)
   Vec3 normal;       // unit, the direction that separates a from the other side
@@ -29,6 +30,7 @@ struct Contact {
   double gap;        // m, signed distance at the start of the step (negative: penetrating)
   double friction;   // Coulomb coefficient, 0 for none
   Vec3 other_velocity = Vec3::Zero();  // m/s: a tool's velocity at the point (friction sticks to it)
+  int32_t tool = -1;  // index in the step's tool list, or -1 between two bodies
   // A tool's contact between a feature of its core and of a body triangle (core_features.hpp):
   // the triangle, and the core's corner (against the triangle) or edge (against a triangle edge,
   // the body point's two nodes); -1 for a node's contact and between bodies.

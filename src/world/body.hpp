@@ -79,6 +79,15 @@ struct BodyScratch {
   Vec3List f_int, f_ext, b, v_next, x_next;
   std::vector<Mat3> constrained_sum;  // per node, sum of I - S over its constraint groups (reactions)
   Projection projection;
+  // The contact-curvature terms this step put into A (World::add_contact_stiffness): the contact's
+  // index, its h^2 F K_c over the triangle's corners, and the point of the tool's core the contact
+  // force passes through (its line of action). compute_forces hands their impulse to the tool.
+  struct CurvatureTerm {
+    int32_t contact;
+    Eigen::Matrix<double, 9, 9> K;
+    Vec3 core_point;
+  };
+  std::vector<CurvatureTerm> curvature_terms;  // cleared each step, keeps its capacity
 
   // What A was built for; a linear body reuses it while unchanged.
   SystemKey matrix_key{0, -1, -1};

@@ -30,7 +30,7 @@ namespace mica {
 namespace {
 
 constexpr char kMagic[8] = {'M', 'I', 'C', 'A', 'S', 'T', 'A', 'T'};
-constexpr uint32_t kFormatVersion = 1;
+constexpr uint32_t kFormatVersion = 2;  // 2: the contacts' curvature impulses
 // Byte order and the size of a double: a state is read back only where it was written.
 constexpr uint32_t kLayout = 0x01020304u ^ uint32_t(sizeof(double) << 24);
 
@@ -50,6 +50,7 @@ struct StateShape {
   struct BodyShape {
     int32_t nodes, tets;
     uint8_t is_static, corotational;
+    uint8_t unused[2] = {};
   };
   std::vector<BodyShape> bodies;
   std::vector<int32_t> tools;                       // ToolShape
@@ -129,9 +130,22 @@ struct BodyData {
 struct ToolData {
   Vec3 position, previous_position, velocity, angular_velocity, force, torque;
   Eigen::Quaterniond orientation, previous_orientation;
-  int32_t contact_count;
   Mat3 stiffness;
+  int32_t contact_count;
+  int32_t unused = 0;
 };
+
+// A state copies these structs as bytes: a padding byte would be uninitialised, and two saves of
+// one state could differ in it. Each size is the sum of its fields'.
+static_assert(sizeof(StateShape::BodyShape) == 2 * 4 + 4 * 1, "BodyShape has padding");
+static_assert(sizeof(ToolData) == 6 * sizeof(Vec3) + 2 * sizeof(Eigen::Quaterniond) + sizeof(Mat3) + 2 * 4,
+              "ToolData has padding");
+static_assert(sizeof(BodyPoint) == 6 * 4 + 3 * 8, "BodyPoint has padding");
+static_assert(sizeof(Contact) == 8 + 2 * sizeof(BodyPoint) + 3 * sizeof(Vec3) + 2 * 8 + 4 * 4 + 8, "Contact has padding");
+static_assert(sizeof(RowTerm) == 2 * 4 + 8, "RowTerm has padding");
+static_assert(sizeof(StageStats) == 2 * 4 + 3 * 8, "StageStats has padding");
+static_assert(sizeof(WorldStats) == 8 + kStageCount * sizeof(StageStats) + 2 * 8 + 4 + 2 * 1 + 2 * 1,
+              "WorldStats has padding");
 
 struct LpcData {
   Vec3 velocity, reaction;
@@ -190,6 +204,7 @@ std::vector<uint8_t> World::save_state() const {
   out.put_vector(rows_.contact);
   out.put_vector(rows_.key);
   out.put_vector(lambda_);
+  out.put_vector(curvature_impulse_);
   out.put_vector(step_bodies_);
   out.put_vector(step_tools_);
   out.put_vector(overlapping_);
@@ -213,7 +228,7 @@ std::vector<uint8_t> World::save_state() const {
   });
   tools_.for_each([&](Id, const Tool& t) {
     out.put(ToolData{t.position, t.previous_position, t.velocity, t.angular_velocity, t.force, t.torque,
-                     t.orientation, t.previous_orientation, t.contact_count, t.stiffness});
+                     t.orientation, t.previous_orientation, t.stiffness, t.contact_count});
   });
   lpcs_.for_each([&](Id, const Lpc& c) {
     out.put(c.velocity);
@@ -289,6 +304,7 @@ void World::restore_state(const uint8_t* data, size_t size) {
   std::vector<Contact> contacts;
   ContactRows rows;
   std::vector<double> lambda;
+  Vec3List curvature_impulse;
   std::vector<Id> step_bodies, step_tools;
   std::vector<std::pair<Id, Id>> overlapping;
   in.get_vector(contacts, "the contacts");
@@ -301,6 +317,7 @@ void World::restore_state(const uint8_t* data, size_t size) {
   in.get_vector(rows.contact, "the contact rows");
   in.get_vector(rows.key, "the contact rows");
   in.get_vector(lambda, "the contact impulses");
+  in.get_vector(curvature_impulse, "the contact impulses");
   in.get_vector(step_bodies, "the step's bodies");
   in.get_vector(step_tools, "the step's tools");
   in.get_vector(overlapping, "the overlapping bodies");
@@ -309,6 +326,7 @@ void World::restore_state(const uint8_t* data, size_t size) {
   require(rows.start.size() == nr + 1 && rows.bias.size() == nr && rows.normal_of.size() == nr && rows.mu.size() == nr &&
               rows.contact.size() == nr && rows.key.size() == nr && lambda.size() == nr,
           "the contact rows disagree in length");
+  require(curvature_impulse.size() == contacts.size(), "the contacts disagree in length");
   for (Id id : step_bodies) require(bodies_.find(id) && bodies_.find(id)->is_dynamic(), "a step body is not in this world");
   for (Id id : step_tools) require(tools_.find(id) != nullptr, "a step tool is not in this world");
   for (size_t r = 0; r < nr; ++r)
@@ -409,6 +427,7 @@ void World::restore_state(const uint8_t* data, size_t size) {
   contacts_.swap(contacts);
   rows_ = std::move(rows);
   lambda_.swap(lambda);
+  curvature_impulse_.swap(curvature_impulse);
   step_bodies_.swap(step_bodies);
   step_tools_.swap(step_tools);
   overlapping_.swap(overlapping);

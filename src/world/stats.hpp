@@ -14,19 +14,22 @@ constexpr int kStageCount = int(Stage::Count);
 
 struct StageStats {
   int32_t runs_last_step = 0;
+  int32_t unused = 0;
   int64_t runs_total = 0;
   double ms_last_step = 0;
   double ms_total = 0;
 };
 
+// StageStats and WorldStats have no padding: saved states copy them as bytes (state_io.cpp).
 struct WorldStats {
   int64_t step_count = 0;
   std::array<StageStats, kStageCount> stages{};
-  int32_t solver_iterations = 0;
   double solver_residual = 0;
+  double ms_last_step = 0;
+  int32_t solver_iterations = 0;
   bool converged = true;
   bool out_of_time = false;  // a solve stopped at WorldSettings::time_budget_ms
-  double ms_last_step = 0;
+  uint8_t unused[2] = {};
 };
 
 // Runs a stage if the plan holds it, timing it into the stats.

@@ -117,6 +117,7 @@ void World::advance(double h) {
   if (!plan.collide) contacts_.clear();  // nothing to collide: drop last step's contacts
   rows_.clear();
   lambda_.clear();
+  curvature_impulse_.assign(contacts_.size(), Vec3::Zero());  // compute_forces fills the rounded tools'
   stage.run(Stage::Loads, plan.loads, [&] {
     for (Body* b : ctx.dynamic)
       if (needs_loads(*b)) apply_loads(*b);
@@ -254,7 +255,9 @@ void World::add_contact_stiffness(const StepContext& ctx, Body& b) const {
   MICA_ASSERT(index >= 0, "the elements stage assembles dynamic bodies only");
   thread_local ToolCore core;  // kept: a step allocates nothing here
   int32_t core_of = -1;
-  for (const Contact& c : contacts_) {
+  b.curvature_terms.clear();
+  for (size_t k = 0; k < contacts_.size(); ++k) {
+    const Contact& c = contacts_[k];
     if (c.tool < 0 || (c.core_corner < 0 && c.core_edge < 0) || c.a.body != index) continue;
     const auto last = warm_start_.find(ContactRows::normal_row_key(c.key));
     if (last == warm_start_.end() || !(last->second > 0)) continue;
@@ -264,6 +267,16 @@ void World::add_contact_stiffness(const StepContext& ctx, Body& b) const {
     Mat9 K;
     if (!contact_curvature(core, c, t, b.x, K)) continue;
     K *= ctx.h * last->second;  // h^2 F
+    // A rounded core's contact force passes through its core feature's closest point.
+    Vec3 core_point;
+    if (c.core_corner >= 0) {
+      core_point = core.corners[size_t(c.core_corner)];
+    } else {
+      const auto& e = core.edges[size_t(c.core_edge)];
+      const Vec3 &p = core.corners[size_t(e[0])], d = core.corners[size_t(e[1])] - p;
+      core_point = p + std::clamp((c.point - p).dot(d) / d.squaredNorm(), 0.0, 1.0) * d;
+    }
+    b.curvature_terms.push_back({int32_t(k), K, core_point});
     for (int r = 0; r < 3; ++r)
       for (int s = 0; s < 3; ++s) b.A[size_t(b.fem.pattern.find(t[r], t[s]))] += K.block<3, 3>(3 * r, 3 * s);
     // A linear body keeps A between steps: this one is not its plain matrix any more.
@@ -410,6 +423,21 @@ void World::compute_forces(const StepContext& ctx) {
         t.stiffness -= rows_.direction[r] * rows_.direction[r].transpose() / (h * h * row_diagonal[r]);
     }
   }
+  // The curvature terms in A push the triangles' corners by -h^2 F K_c v+ (add_contact_stiffness):
+  // a contact force too, which the tool feels the other way round.
+  for (Body* b : ctx.dynamic)
+    for (const Body::CurvatureTerm& term : b->curvature_terms) {
+      const Contact& c = contacts_[size_t(term.contact)];
+      const Tri& tri = b->surface[size_t(c.triangle)];
+      Vec3 impulse = Vec3::Zero();
+      for (int r = 0; r < 3; ++r)
+        for (int s = 0; s < 3; ++s) impulse -= term.K.block<3, 3>(3 * r, 3 * s) * b->v_next[size_t(tri[s])];
+      curvature_impulse_[size_t(term.contact)] = impulse;
+      Tool& t = *ctx.tools[size_t(c.tool)];
+      const Vec3 f = -impulse / h;
+      t.force += f;
+      t.torque += (term.core_point - t.position).cross(f);
+    }
   // Constraints: the impulse r = (I - S)(A v - b - G^T lambda) holds the body; whoever holds
   // the constraint (the user's hand) feels the opposite force, -r / h. A node held by several
   // groups gives each group C_g its share C_g (sum_h C_h)^+ r, so that the shares add up to r

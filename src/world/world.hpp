@@ -186,6 +186,8 @@ class World {
   const std::vector<Contact>& contacts() const { return contacts_; }
   const ContactRows& contact_rows() const { return rows_; }
   const std::vector<double>& impulses() const { return lambda_; }  // per contact row, N s
+  // Per contact, the impulse on its body of the contact-curvature term (rounded tools; else 0), N s.
+  const Vec3List& curvature_impulses() const { return curvature_impulse_; }
   // The ids behind the last step's indices: Contact::a.body / b.body index step_bodies(),
   // Contact::tool indexes step_tools().
   const std::vector<Id>& step_bodies() const { return step_bodies_; }
@@ -271,6 +273,7 @@ class World {
   std::vector<Contact> contacts_;
   ContactRows rows_;                                // the rows of G
   std::vector<double> lambda_;                      // impulse per row, N s
+  Vec3List curvature_impulse_;                      // per contact: its curvature term's impulse, N s
   std::vector<Id> step_bodies_, step_tools_;        // the last step's dynamic bodies and tools, by index
   std::unordered_map<uint64_t, double> warm_start_; // impulses by row key
   struct {  // relinearise: the energy (J) the steps since it last went down added, net

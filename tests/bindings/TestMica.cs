@@ -384,7 +384,7 @@ static class TestMica
                 foreach (var c in contacts)
                 {
                     var k = c;
-                    sum += k.normal[1] * k.normal_impulse + k.tangent_impulse[1];
+                    sum += k.normal[1] * k.normal_impulse + k.tangent_impulse[1] + k.curvature_impulse[1];
                 }
             }
             Expect(Math.Abs(sum / 0.01 + force[1]) <= 1e-12 * Math.Abs(force[1]) * contacts.Length,

@@ -342,7 +342,10 @@ test("node state, saved state and contacts", function()
   local force = world:tool_force(tool)
   expect(count > 0 and force[1] > 0, "the tool is pressing")
   local sum = 0
-  for c = 0, count - 1 do sum = sum + contacts[c].normal[1] * contacts[c].normal_impulse + contacts[c].tangent_impulse[1] end
+  for c = 0, count - 1 do
+    local k = contacts[c]
+    sum = sum + k.normal[1] * k.normal_impulse + k.tangent_impulse[1] + k.curvature_impulse[1]
+  end
   expect(math.abs(sum / 0.01 + force[1]) <= 1e-12 * math.abs(force[1]) * count, "the contacts sum to the tool force")
   ok, err = pcall(world.restore_state, world, state:sub(1, #state - 1))
   expect(not ok and err.status == C.MICA_ERR_PARSE, "a truncated state raises MICA_ERR_PARSE")

@@ -324,7 +324,8 @@ class Behaviour(unittest.TestCase):
             impulse = np.zeros(3)
             for c in world.contacts():
                 self.assertEqual(c.other_kind, mica.MICA_CONTACT_OTHER_TOOL)
-                impulse += np.array(c.normal) * c.normal_impulse + np.array(c.tangent_impulse)
+                impulse += (np.array(c.normal) * c.normal_impulse + np.array(c.tangent_impulse)
+                            + np.array(c.curvature_impulse))
             np.testing.assert_allclose(impulse / 0.01, -fb[-1], rtol=1e-12, atol=1e-12 * np.abs(fb[-1]).sum())
             # A truncated state is refused.
             with self.assertRaises(mica.MicaError) as caught:

@@ -54,8 +54,9 @@ struct SolverProblem {
     const Vec3 normal = Vec3(0.1, -1, 0.05).normalized(), c(0.05, 0.1012, 0.05);
     for (int32_t i = 0; i < n; ++i) {
       if (fem.rest[i].y() < 0.1 - 1e-9) continue;
-      Contact ct{uint64_t(1000 + i), 0, node_point(0, i), BodyPoint{}, normal, x[i], normal.dot(x[i] - c),
+      Contact ct{uint64_t(1000 + i), node_point(0, i), BodyPoint{}, normal, x[i], normal.dot(x[i] - c),
                  friction, Vec3(0.03, 0, 0.01)};
+      ct.tool = 0;
       contacts.push_back(ct);
     }
     rows.build(contacts, kH, 1.0);

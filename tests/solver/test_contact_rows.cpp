@@ -14,7 +14,8 @@ constexpr double kMaxRecovery = 1.0;  // m/s
 // A node contact with a tool whose point moves at `tool_speed` along -n (towards the node when > 0).
 Contact tool_contact(double gap, double tool_speed) {
   const Vec3 n = Vec3(1, 2, -2).normalized();
-  Contact c{1, 0, node_point(0, 0), BodyPoint{}, n, Vec3::Zero(), gap, 0.0, Vec3::Zero()};
+  Contact c{1, node_point(0, 0), BodyPoint{}, n, Vec3::Zero(), gap, 0.0, Vec3::Zero()};
+  c.tool = 0;
   c.other_velocity = tool_speed * n + Vec3(0.3, 0, 0.15).cross(n);  // plus some sliding, which must not matter
   return c;
 }

@@ -73,8 +73,9 @@ struct Scene {
       for (int32_t i : t.nodes) {
         const Vec3 normal = t.sphere ? Vec3((p.x[i] - t.centre).normalized()) : t.normal;
         const double gap = t.sphere ? (p.x[i] - t.centre).norm() - t.radius : normal.dot(p.x[i] - t.centre);
-        p.contacts.push_back(Contact{uint64_t(1000 * (k + 1) + i), int32_t(k), node_point(0, i), BodyPoint{}, normal,
-                                     p.x[i], gap, kMu, t.velocity});
+        p.contacts.push_back(
+            Contact{uint64_t(1000 * (k + 1) + i), node_point(0, i), BodyPoint{}, normal, p.x[i], gap, kMu, t.velocity});
+        p.contacts.back().tool = int32_t(k);
       }
     }
     p.rows.build(p.contacts, SolverProblem::kH, 1.0);

@@ -234,6 +234,7 @@ class mica_contact(Structure):
         ("normal_impulse", c_double),
         ("tangent_impulse", c_double * 3),
         ("friction", c_double),
+        ("curvature_impulse", c_double * 3),
     ]
 
 

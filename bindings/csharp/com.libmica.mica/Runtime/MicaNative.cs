@@ -233,6 +233,7 @@ namespace LibMica
             public double normal_impulse;
             public fixed double tangent_impulse[3];
             public double friction;
+            public fixed double curvature_impulse[3];
         }
 
         [StructLayout(LayoutKind.Sequential)]
