@@ -24,13 +24,13 @@ void LaggedFactor::factor(Slot& slot, const BlockPattern& pattern, const BlockVa
   ++factorizations_;
 }
 
-LaggedFactor::Slot& LaggedFactor::writable_active() {
-  const bool saved = active_.get() == saved_.active || (active_.get() == saved_.pending && saved_.job.valid());
-  if (!open_ || !saved) return *active_;
+LaggedFactor::Slot& LaggedFactor::writable(std::unique_ptr<Slot>& slot) {
+  const bool saved = slot.get() == saved_.active || (slot.get() == saved_.pending && saved_.job.valid());
+  if (!open_ || !saved) return *slot;
   std::unique_ptr<Slot>& keep = kept_[0] ? kept_[1] : kept_[0];
-  keep = std::move(active_);
-  active_ = spare_ ? std::move(spare_) : std::make_unique<Slot>();
-  return *active_;
+  keep = std::move(slot);
+  slot = spare_ ? std::move(spare_) : std::make_unique<Slot>();
+  return *slot;
 }
 
 void LaggedFactor::clear_columns() {
@@ -45,7 +45,7 @@ void LaggedFactor::refactor_now(const BlockPattern& pattern, const BlockValues& 
                                 const std::vector<Mat3>* node_rotation) {
   clear_columns();
   try {
-    factor(writable_active(), pattern, A, projection, node_rotation);
+    factor(writable(active_), pattern, A, projection, node_rotation);
   } catch (...) {
     key_ = Key{};  // the factor in use is gone: the next update factors again
     throw;
@@ -85,7 +85,7 @@ void LaggedFactor::update(const FemModel& fem, const Key& key, const BlockValues
     }
     launch_staged_ = false;
     // throws on failure: the key stays, the next step retries
-    factor(writable_active(), fem.pattern, A, projection, node_rotation);
+    factor(writable(active_), fem.pattern, A, projection, node_rotation);
     key_ = key;
     launched_at_ = step_;  // the next refresh starts from a later step
     clear_columns();
@@ -94,9 +94,9 @@ void LaggedFactor::update(const FemModel& fem, const Key& key, const BlockValues
   if (interval <= 0) return;
   if (job_.valid() && step_ - launched_at_ >= interval) adopt();
   if (!job_.valid() && !launch_staged_ && step_ > launched_at_) {
-    // The copies the worker factors: *pending_ is free (or the factor adopted just now, whose
-    // copies are no longer needed; its factor and rotations are kept until the job starts).
-    Slot& slot = *pending_;
+    // The copies the worker factors: *pending_ is free, or holds the factor replaced just now
+    // (in a step that may be undone, that one moves aside: writable).
+    Slot& slot = writable(pending_);
     if (!slot.direct.analyzed()) slot.direct.analyze(fem.pattern);
     slot.A = A;
     slot.projection = projection;

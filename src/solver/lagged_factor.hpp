@@ -93,7 +93,9 @@ class LaggedFactor {
               const std::vector<Mat3>* node_rotation);
   void adopt();
   void launch(const BlockPattern& pattern);  // the background factorization of *pending_
-  Slot& writable_active();  // active_, or in a step between begin() and its end a slot in its place
+  // `slot` (active_ or pending_), or, in a step between begin() and its end, a spare in its place
+  // when begin() saw it in use or in flight: rollback() puts that one back as it was.
+  Slot& writable(std::unique_ptr<Slot>& slot);
   void clear_columns();
   static void save_slot(const Slot& slot, ByteWriter& out);
   static void load_slot(Slot& slot, ByteReader& in, const BlockPattern& pattern);

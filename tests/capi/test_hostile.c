@@ -405,13 +405,15 @@ static void test_failed_step_leaves_the_device_tool(void** state) {
   mica_world_destroy(b.w);
 }
 
-/* The factored sweep with a background refresh: the failed step shifts no schedule. */
+/* The factored sweep with a background refresh: the failed step shifts no schedule, and the
+ * state saved after it restores into a fresh world that then steps as the original does. */
 static void test_failed_step_keeps_the_factor_schedule(void** state) {
   (void)state;
   for (int interval = 1; interval <= 3; ++interval) {
-    twin a, b;
+    twin a, b, c;
     make_twin(&a, MICA_SOLVER_MICA, MICA_SWEEP_FACTORED, interval, 0, 1e4);
     make_twin(&b, MICA_SOLVER_MICA, MICA_SWEEP_FACTORED, interval, 0, 1e4);
+    c.w = NULL;
     for (int k = 0; k < 14; ++k) {
       const double p[3] = {0.003, 0.01 - 0.002 - 0.001 * k, 0.002}, q[4] = {1, 0, 0, 0};
       assert_int_equal(mica_tool_set_pose(a.w, a.tool, p, q), MICA_OK);
@@ -419,13 +421,28 @@ static void test_failed_step_keeps_the_factor_schedule(void** state) {
       if (k == 4 || k == 7 || k == 8) {
         fail_a_step(&a, 1);
         fail_a_step(&b, 0);
+        /* c: a fresh world given a's state saved after the failed step. */
+        size_t bytes = 0;
+        assert_int_equal(mica_world_state_size(a.w, &bytes), MICA_OK);
+        void* saved = malloc(bytes);
+        assert_int_equal(mica_world_save_state(a.w, saved, bytes), MICA_OK);
+        if (c.w) mica_world_destroy(c.w);
+        make_twin(&c, MICA_SOLVER_MICA, MICA_SWEEP_FACTORED, interval, 0, 1e4);
+        assert_int_equal(mica_world_restore_state(c.w, saved, bytes), MICA_OK);
+        free(saved);
       }
+      if (c.w) assert_int_equal(mica_tool_set_pose(c.w, c.tool, p, q), MICA_OK);
       assert_true(mica_step(a.w, 0.01) >= 0);
       assert_true(mica_step(b.w, 0.01) >= 0);
       assert_same(&a, &b); /* 0.4: 1.9e-13 m apart after the refresh that the failed step shifted */
+      if (c.w) {
+        assert_true(mica_step(c.w, 0.01) >= 0);
+        assert_same(&a, &c); /* 0.6: a failed step that adopted a refresh left another system in the state */
+      }
     }
     mica_world_destroy(a.w);
     mica_world_destroy(b.w);
+    mica_world_destroy(c.w);
   }
 }
 

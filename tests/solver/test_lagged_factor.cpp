@@ -7,6 +7,7 @@
 #include <cstring>
 #include <thread>
 
+#include "solver/lagged_factor.hpp"
 #include "test_util.hpp"
 
 using namespace mica;
@@ -130,8 +131,35 @@ static void test_long_solve_refactors(void**) {
   assert_true(soon.iterations < never.iterations);
 }
 
+// A step undone (begin, update, rollback) leaves the factor as it was, down to what a saved state
+// holds: here the step adopts the refreshed factor and stages the next refresh in the slot it
+// freed (before the fix, that slot's copy of its system was overwritten, and a state saved after
+// the undone step held another system than the one its factor was made from).
+static void test_rollback_leaves_the_saved_factor(void**) {
+  Twist t = make_twist(1);
+  for (int k = 0; k < 3; ++k) step(t);
+  const Body& b = t.world->body(t.body);
+  const LaggedFactor::Key key{0.01, 0, 0, 0};
+  LaggedFactor factor;
+  factor.update(b.fem, key, b.A, b.projection, &b.R, 1);  // factors now, then refreshes every step
+  step(t);
+  factor.update(b.fem, key, b.A, b.projection, &b.R, 1);  // launches a refresh
+  step(t);
+  ByteWriter before;
+  factor.save(before);
+  BlockValues other = b.A;
+  for (Mat3& block : other) block *= 1.5;  // another system, to tell the copies apart
+  factor.begin();
+  factor.update(b.fem, key, other, b.projection, &b.R, 1);  // adopts, and stages the next refresh
+  factor.rollback();
+  ByteWriter after;
+  factor.save(after);
+  assert_true(before.bytes() == after.bytes());
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_rollback_leaves_the_saved_factor),
       cmocka_unit_test(test_results_do_not_depend_on_timing),
       cmocka_unit_test(test_refresh_saves_iterations),
       cmocka_unit_test(test_long_solve_refactors),
