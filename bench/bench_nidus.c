@@ -87,6 +87,7 @@ static long status_kb(const char* key) {
 typedef struct {
   double median, p95, max, mean, iterations, mem_create_b_per_tet, mem_step_b_per_tet, force;
   double reversals; /* fraction of contact nodes' velocity changes that reverse from step to step */
+  double stage_ms[MICA_STAGE_COUNT]; /* mean wall-clock ms per timed step in each stage */
   int32_t nodes, tets, capped, contacts;
 } figures;
 
@@ -134,6 +135,7 @@ static int press(mica_world* world, mica_body_id body, mica_tool_id tool, const 
     st.struct_size = sizeof st;
     CHECK(mica_world_get_stats(world, &st));
     ms[k - warmup] = elapsed;
+    for (int g = 0; g < MICA_STAGE_COUNT; ++g) out->stage_ms[g] += st.stages[g].ms_last_step / steps;
     iterations += st.solver_iterations;
     if (!st.converged) ++out->capped;
   }
@@ -241,6 +243,13 @@ static int nidus(const char* path, const mica_world_def* wd, int steps, int warm
   printf("mean ms/step          %.3f\n", fig.mean);
   printf("iterations/step       %.1f (mean over timed steps; %d stopped at the cap)\n", fig.iterations, fig.capped);
   printf("tool force            %.4f N, %d contacts at the end\n", fig.force, fig.contacts);
+  /* Where a step's time goes (the step's own stage timers; the re-linearisation's check counts in rotations). */
+  static const char* stage_names[MICA_STAGE_COUNT] = {"loads", "rotations", "elements", "damping", "constraints",
+                                                      "solve", "integrate", "collide", "forces"};
+  printf("mean ms/step by stage");
+  for (int g = 0; g < MICA_STAGE_COUNT; ++g)
+    if (fig.stage_ms[g] >= 0.0005) printf(" %s %.3f", stage_names[g], fig.stage_ms[g]);
+  printf("\n");
   printf("velocity reversals    %.1f %% of the contact nodes' velocity changes (issue: at most 25 %%; 0.4: 73 %%)\n",
          100 * fig.reversals);
   printf("memory, body creation %.0f B/tet (VmRSS %ld -> %ld kB)\n", fig.mem_create_b_per_tet, rss0, rss1);

@@ -13,6 +13,24 @@ DirectSolver::~DirectSolver() {
 }
 
 void DirectSolver::solve_raw(const Eigen::Ref<const Eigen::MatrixXd>& B, Eigen::MatrixXd& X) {
+  if (B.cols() != 1 || !by_hand_.bound()) return solve_raw_cholmod(B, X);
+  X.resize(B.rows(), 1);
+  by_hand_.solve(B.data(), X.data());
+}
+
+void DirectSolver::solve_one(const Eigen::Ref<const Eigen::VectorXd>& b, Eigen::VectorXd& x, bool single) {
+  x.resize(b.size());
+  if (single && by_hand_.single()) {
+    by_hand_.solve_single(b.data(), x.data());
+  } else if (by_hand_.bound()) {
+    by_hand_.solve(b.data(), x.data());
+  } else {
+    solve_raw_cholmod(b, y_flat_);
+    x = y_flat_.col(0);
+  }
+}
+
+void DirectSolver::solve_raw_cholmod(const Eigen::Ref<const Eigen::MatrixXd>& B, Eigen::MatrixXd& X) {
   cholmod_dense b{};  // a view of B (CHOLMOD reads it only)
   b.nrow = size_t(B.rows());
   b.ncol = size_t(B.cols());
@@ -61,10 +79,12 @@ void DirectSolver::factorize(const ProjectedSystem& sys) {
   const double* source = projected_[0].data();
   double* values = lower_.valuePtr();
   for (size_t q = 0; q < value_source_.size(); ++q) values[q] = source[value_source_[q]];
+  by_hand_.unbind();
   llt_.factorize(lower_);
   ++factorizations_;
   if (llt_.info() != Eigen::Success)
     fail(Errc::Numerical, "the system matrix is not positive definite (CHOLMOD factorization failed)");
+  by_hand_.bind(llt_.factor(), keep_single_);  // false (cholmod_solve2 then) for a factor of another kind
 }
 
 SolveReport DirectSolver::solve(const ProjectedSystem& sys, const Vec3List& b, Vec3List& v) {

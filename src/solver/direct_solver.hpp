@@ -8,6 +8,7 @@
 #include <memory>
 
 #include "solver/projected_system.hpp"
+#include "solver/supernodal_solve.hpp"
 
 namespace mica {
 
@@ -25,10 +26,18 @@ class DirectSolver : public LinearSolver {
   // Both solves use the last factorization.
   SolveReport solve(const ProjectedSystem& sys, const Vec3List& b, Vec3List& v) override;
   SolveReport solve_homogeneous(const ProjectedSystem& sys, const Vec3List& f, Vec3List& y) override;
-  // X = (S A S + I - S)^-1 B for any right-hand sides (no projection applied to B), through
-  // cholmod_solve2 with workspaces kept between calls: no allocation once X has its size and the
-  // workspaces have grown to the widest B.
+  // X = (S A S + I - S)^-1 B for any right-hand sides (no projection applied to B): one by the
+  // hand-written supernodal solve, several through cholmod_solve2 with workspaces kept between
+  // calls. No allocation once X has its size and the workspaces have grown to the widest B.
   void solve_raw(const Eigen::Ref<const Eigen::MatrixXd>& B, Eigen::MatrixXd& X);
+  // The same through cholmod_solve2 only (the reference the hand-written solve is tested against).
+  void solve_raw_cholmod(const Eigen::Ref<const Eigen::MatrixXd>& B, Eigen::MatrixXd& X);
+  // With keep_single set (before factorize), each factorization also keeps a single-precision
+  // copy of the factor.
+  void set_keep_single(bool keep) { keep_single_ = keep; }
+  // x = (S A S + I - S)^-1 b for one right-hand side; with `single` and a single-precision copy,
+  // solved with the copy (a preconditioner's solve), else as solve_raw.
+  void solve_one(const Eigen::Ref<const Eigen::VectorXd>& b, Eigen::VectorXd& x, bool single);
   int64_t factorizations() const { return factorizations_; }
 
  private:
@@ -42,6 +51,8 @@ class DirectSolver : public LinearSolver {
     cholmod_factor* factor() const { return m_cholmodFactor; }
   };
   Factor llt_;
+  SupernodalSolve by_hand_;  // bound to llt_'s factor after each factorization
+  bool keep_single_ = false;
   cholmod_dense *x_ = nullptr, *y_ = nullptr, *e_ = nullptr;  // cholmod_solve2's solution and workspaces
   Vec3List rhs_, tmp_, check_;
   Eigen::MatrixXd y_flat_;

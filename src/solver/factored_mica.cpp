@@ -84,20 +84,41 @@ void FactoredMicaSolver::start_compliance(const std::vector<SolverBody>& bodies,
   rows.project(lambda);  // the warm start onto the cones
 }
 
+bool FactoredMicaSolver::body_response(size_t bi, const ContactRows& rows, const std::vector<double>& w) {
+  const Eigen::Index n = Eigen::Index(factored_[bi].factor->node_count());
+  if (Eigen::Index(node_term_.size()) < n) {
+    node_term_.resize(size_t(n), -1);
+    node_force_.resize(size_t(n));
+  }
+  // The forces summed per node first: a node's columns (3n x 3, read from memory) are read once
+  // however many rows press on it (a contact's normal and tangent rows share their nodes).
+  touched_.clear();
+  for (size_t r = 0; r < rows.size(); ++r) {
+    if (w[r] == 0) continue;
+    for (int32_t t = rows.start[r]; t < rows.start[r + 1]; ++t) {
+      if (rows.terms[t].body != int32_t(bi)) continue;
+      const int32_t i = rows.terms[t].node;
+      if (node_term_[i] < 0) {
+        node_term_[i] = t;
+        node_force_[i].setZero();
+        touched_.push_back(i);
+      }
+      node_force_[i] += term_force_[t] * w[r];
+    }
+  }
+  if (touched_.empty()) return false;
+  y_.setZero(3 * n);
+  for (int32_t i : touched_) {
+    y_.noalias() += *term_columns_[node_term_[i]] * node_force_[i];
+    node_term_[i] = -1;
+  }
+  return true;
+}
+
 void FactoredMicaSolver::apply_impulse_change(std::vector<SolverBody>& bodies, const ContactRows& rows,
                                               const std::vector<double>& dlambda) {
   for (size_t bi = 0; bi < bodies.size(); ++bi) {
-    y_.setZero(3 * Eigen::Index(bodies[bi].node_count()));
-    bool any = false;
-    for (size_t r = 0; r < rows.size(); ++r) {
-      if (dlambda[r] == 0) continue;
-      for (int32_t t = rows.start[r]; t < rows.start[r + 1]; ++t)
-        if (rows.terms[t].body == int32_t(bi)) {
-          y_.noalias() += *term_columns_[t] * (term_force_[t] * dlambda[r]);
-          any = true;
-        }
-    }
-    if (!any) continue;
+    if (!body_response(bi, rows, dlambda)) continue;
     Vec3List& v = *bodies[bi].v;
     const FactoredBody& f = factored_[bi];
     for (int32_t i = 0; i < bodies[bi].node_count(); ++i)
@@ -249,6 +270,7 @@ SolveReport FactoredMicaSolver::solve(const SolveContext& ctx, std::vector<Solve
   double l_scale = 0;
   int32_t outer = 0;
   double previous_inner_tolerance = 1;
+  double tighten = 1;  // without contact rows: how much tighter than the tolerance the solves must aim
   bool velocities_solved = false;
   while (report.iterations < settings.max_iterations) {
     if (deadline && outer > 0 && Clock::now() >= *deadline) {
@@ -267,7 +289,7 @@ SolveReport FactoredMicaSolver::solve(const SolveContext& ctx, std::vector<Solve
     // Velocities for the current impulses: A v = b + G^T lambda on the free directions. While the
     // impulses still move, a hundredth of their last change is accuracy enough (inexact Newton);
     // near the end the solves aim a little below the tolerance, so the outer test is not starved.
-    const double final_tolerance = 0.3 * settings.tolerance;
+    const double final_tolerance = 0.3 * settings.tolerance * tighten;
     const double inner_tolerance =
         outer == 1 || nr == 0 || report.impulse_change < 30 * settings.tolerance
             ? final_tolerance
@@ -292,7 +314,15 @@ SolveReport FactoredMicaSolver::solve(const SolveContext& ctx, std::vector<Solve
     if (report.out_of_time) break;
     if (nr == 0) {
       if (!velocities_solved && may_refactor) continue;  // stopped where refactoring pays: refactor, go on
-      report.converged = velocities_solved;
+      // A solve's tolerance is relative to its right-hand side S (b - A z), which a prescribed
+      // motion z of a stiff body can make far larger than the terms the momentum balances (A v,
+      // b): the momentum decides, and a solve short of it goes on with a tighter aim.
+      report.momentum_residual = momentum_residual(bodies);
+      report.converged = velocities_solved && report.momentum_residual <= settings.tolerance;
+      if (velocities_solved && !report.converged && report.momentum_residual > 0 && tighten > 1e-12) {
+        tighten *= std::max(1e-6, 0.3 * settings.tolerance / report.momentum_residual);
+        continue;
+      }
       break;
     }
     // Anticipate the row velocities and solve the small complementarity problem on W.

@@ -101,6 +101,9 @@ class FactoredMicaSolver : public CachingVelocitySolver<FactoredBodyCache> {
                                 const std::optional<SolveContext::Clock::time_point>& deadline);
   // x = W_E^-1 rhs (the least-squares solution where rows are redundant).
   void solve_equalities(const Eigen::Ref<const Eigen::VectorXd>& rhs, Eigen::Ref<Eigen::VectorXd> x);
+  // y_ = K_f^-1 G^T w on body bi for row weights w (the factor's frame, through the cached
+  // columns); false when no row with a weight has a term on the body.
+  bool body_response(size_t bi, const ContactRows& rows, const std::vector<double>& w);
   // out += P^-1 G_which^T x (through the cached columns).
   void add_response(const std::vector<SolverBody>& bodies, const ContactRows& rows, const std::vector<int32_t>& which,
                     const Eigen::Ref<const Eigen::VectorXd>& x, std::vector<Vec3List>& out);
@@ -131,6 +134,11 @@ class FactoredMicaSolver : public CachingVelocitySolver<FactoredBodyCache> {
   std::vector<double> warped_diag_;  // W_rr before the secant updates
   std::vector<Vec3List> rhs_;
   Eigen::VectorXd y_;
+  // body_response's: the row weights, and the rows' forces summed per node (node_term_: the node's
+  // first term, -1 untouched); grown, never shrunk.
+  std::vector<double> row_weight_;
+  Vec3List node_force_;
+  std::vector<int32_t> node_term_, touched_;
   Eigen::VectorXd secant_s_, secant_y_, secant_Ws_;  // secant_update's (no allocation once sized)
   // The active-set loop's.
   Eigen::MatrixXd W0_;  // G P^-1 G^T of the factor, without the secant updates (the projections need it exact)
@@ -143,6 +151,7 @@ class FactoredMicaSolver : public CachingVelocitySolver<FactoredBodyCache> {
   Eigen::VectorXd mu_, mu_neg_, mu_total_, row_scratch_, eq_work_, eq_y_;
   std::vector<double> fixed_, lambda_prev_;
   std::vector<Vec3List> cy_, cr_, cz_, cp_, cq_, ct_, cf_;  // per body: y, r, z, p, A p, scratch, rhs
+  std::vector<Vec3List> cz_last_;                           // per body: the last z (the flexible beta)
 };
 
 }  // namespace mica

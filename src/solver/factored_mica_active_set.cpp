@@ -108,19 +108,10 @@ void FactoredMicaSolver::solve_equalities(const Eigen::Ref<const Eigen::VectorXd
 void FactoredMicaSolver::add_response(const std::vector<SolverBody>& bodies, const ContactRows& rows,
                                       const std::vector<int32_t>& which, const Eigen::Ref<const Eigen::VectorXd>& x,
                                       std::vector<Vec3List>& out) {
+  row_weight_.assign(rows.size(), 0.0);  // keeps its capacity
+  for (size_t a = 0; a < which.size(); ++a) row_weight_[size_t(which[a])] = x(Eigen::Index(a));
   for (size_t bi = 0; bi < bodies.size(); ++bi) {
-    y_.setZero(3 * Eigen::Index(bodies[bi].node_count()));
-    bool any = false;
-    for (size_t a = 0; a < which.size(); ++a) {
-      if (x(Eigen::Index(a)) == 0) continue;
-      const int32_t r = which[a];
-      for (int32_t t = rows.start[r]; t < rows.start[r + 1]; ++t)
-        if (rows.terms[t].body == int32_t(bi)) {
-          y_.noalias() += *term_columns_[t] * (term_force_[t] * x(Eigen::Index(a)));
-          any = true;
-        }
-    }
-    if (!any) continue;
+    if (!body_response(bi, rows, row_weight_)) continue;
     const FactoredBody& f = factored_[bi];
     Vec3List& o = out[bi];
     for (int32_t i = 0; i < bodies[bi].node_count(); ++i) {
@@ -162,7 +153,7 @@ SolveReport FactoredMicaSolver::constrained_solve(std::vector<SolverBody>& bodie
                                                   const std::optional<SolveContext::Clock::time_point>& deadline) {
   using Clock = SolveContext::Clock;
   const size_t nb = bodies.size();
-  for (std::vector<Vec3List>* v : {&cy_, &cr_, &cz_, &cp_, &cq_, &ct_, &cf_}) v->resize(nb);
+  for (std::vector<Vec3List>* v : {&cy_, &cr_, &cz_, &cp_, &cq_, &ct_, &cf_, &cz_last_}) v->resize(nb);
   // The fixed impulses: every row but the equalities.
   fixed_ = lambda;
   for (int32_t r : eq_) fixed_[r] = 0;
@@ -170,7 +161,7 @@ SolveReport FactoredMicaSolver::constrained_solve(std::vector<SolverBody>& bodie
   for (size_t bi = 0; bi < nb; ++bi) {
     const SolverBody& body = bodies[bi];
     const size_t n = size_t(body.node_count());
-    for (std::vector<Vec3List>* v : {&cy_, &cr_, &cz_, &cp_, &cq_, &ct_, &cf_}) (*v)[bi].resize(n);
+    for (std::vector<Vec3List>* v : {&cy_, &cr_, &cz_, &cp_, &cq_, &ct_, &cf_, &cz_last_}) (*v)[bi].resize(n);
     rhs_[bi] = *body.b;
     for (size_t i = 0; i < n; ++i) rhs_[bi][i] += (*body.contact_impulse)[i];
     body.projected().right_hand_side(rhs_[bi], cf_[bi], ct_[bi]);  // S (b + G_F^T lambda_F - A z)
@@ -236,11 +227,15 @@ SolveReport FactoredMicaSolver::constrained_solve(std::vector<SolverBody>& bodie
     if (report.iterations == 0) {
       cp_ = cz_;
     } else {
-      const double beta = rz_new / rz;
+      // Polak-Ribiere's beta (flexible CG, Notay 2000): the preconditioner solves in single
+      // precision, which is not quite the same linear map at every step, and Fletcher-Reeves'
+      // rz_new / rz then stalls near float's precision (1.2e-7 on test_friction_physics).
+      const double beta = (rz_new - dot(cr_, cz_last_)) / rz;
       for (size_t bi = 0; bi < nb; ++bi)
         for (size_t i = 0; i < cp_[bi].size(); ++i) cp_[bi][i] = cz_[bi][i] + beta * cp_[bi][i];
     }
     rz = rz_new;
+    for (size_t bi = 0; bi < nb; ++bi) cz_last_[bi] = cz_[bi];
     for (size_t bi = 0; bi < nb; ++bi) bodies[bi].projected().apply(cp_[bi], cq_[bi], ct_[bi]);
     const double pq = dot(cp_, cq_);
     if (!(pq > 0)) break;  // breakdown: not positive definite on the equalities' null space

@@ -268,10 +268,10 @@ void LaggedFactor::load(ByteReader& in, const BlockPattern& pattern) {
   }
 }
 
-void LaggedFactor::solve(const Vec3List& in, Vec3List& out) const {
-  active_->direct.solve_raw(flat(in), x_);
+void LaggedFactor::solve(const Vec3List& in, Vec3List& out, bool single) const {
+  active_->direct.solve_one(flat(in), x_, single);
   out.resize(in.size());
-  flat(out) = x_.col(0);
+  flat(out) = x_;
 }
 
 void LaggedFactor::prepare_columns(const std::vector<int32_t>& nodes) {
@@ -298,13 +298,13 @@ void WarpedFactorPreconditioner::bind(LaggedFactor* factor, const std::vector<Ma
 
 void WarpedFactorPreconditioner::apply(const Vec3List& r, Vec3List& z) {
   if (turn_.empty()) {
-    factor_->solve(r, z);
+    factor_->solve(r, z, true);
     return;
   }
   const size_t n = r.size();
   rotated_.resize(n);
   for (size_t i = 0; i < n; ++i) rotated_[i] = turn_[i].transpose() * r[i];
-  factor_->solve(rotated_, z);
+  factor_->solve(rotated_, z, true);
   for (size_t i = 0; i < n; ++i) z[i] = turn_[i] * z[i];
 }
 

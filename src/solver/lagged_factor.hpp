@@ -48,8 +48,9 @@ class LaggedFactor {
   // dropped at adoption as older than this one.
   void refactor_now(const BlockPattern& pattern, const BlockValues& A, const Projection& projection,
                     const std::vector<Mat3>* node_rotation);
-  // out = K_f^-1 in (the factor's frame, no warping).
-  void solve(const Vec3List& in, Vec3List& out) const;
+  // out = K_f^-1 in (the factor's frame, no warping); with `single`, from the factor's single-
+  // precision copy (a preconditioner's solve: relative error ~1e-7).
+  void solve(const Vec3List& in, Vec3List& out, bool single = false) const;
   // Computes the columns of K_f^-1 of all these nodes not yet cached, in one solve (many
   // right-hand sides cost far less than one solve each with a supernodal factor).
   void prepare_columns(const std::vector<int32_t>& nodes);
@@ -83,6 +84,7 @@ class LaggedFactor {
 
  private:
   struct Slot {
+    Slot() { direct.set_keep_single(true); }  // the preconditioner solves in single precision
     DirectSolver direct;
     BlockValues A;            // the system factored (a copy: the worker factors it; a saved state keeps it)
     Projection projection;
@@ -123,7 +125,7 @@ class LaggedFactor {
   int64_t step_ = 0, launched_at_ = -1;
   int64_t factorizations_ = 0;
   int32_t node_count_ = 0;
-  mutable Eigen::MatrixXd x_;
+  mutable Eigen::VectorXd x_;
   Eigen::MatrixXd units_, batch_;  // prepare_columns' right-hand sides and solutions
   std::vector<int32_t> missing_;
   std::unordered_map<int32_t, Eigen::MatrixXd> columns_;
@@ -134,6 +136,8 @@ class WarpedFactorPreconditioner : public Preconditioner {
  public:
   // Takes the turns Q of the factor now in use; bind again after the factor changes.
   void bind(LaggedFactor* factor, const std::vector<Mat3>* node_rotation);
+  // In single precision, from the factor's copy: three quarters of the time of a double solve
+  // pair on the nidus (bench_factor); the solvers' residuals and projections stay in double.
   void apply(const Vec3List& r, Vec3List& z) override;
 
  private:

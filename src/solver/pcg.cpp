@@ -9,7 +9,7 @@
 namespace mica {
 
 void PcgWorkspace::resize(size_t n) {
-  for (Vec3List* v : {&r, &z, &p, &q, &tmp, &rhs}) v->resize(n);
+  for (Vec3List* v : {&r, &z, &z_last, &p, &q, &tmp, &rhs}) v->resize(n);
   inv_diag.resize(n);
 }
 
@@ -68,10 +68,13 @@ SolveReport PcgSolver::iterate(const ProjectedSystem& sys, Vec3List& y) {
     if (report.iterations == 0) {
       ws.p = ws.z;
     } else {
-      const double beta = rz_new / rz;
+      // Polak-Ribiere: (r_k.z_k - r_k.z_k-1) / r_k-1.z_k-1 (Notay 2000's flexible CG); the same
+      // as Fletcher-Reeves' r_k.z_k / r_k-1.z_k-1 for a fixed linear preconditioner.
+      const double beta = (rz_new - dot(ws.r, ws.z_last)) / rz;
       for (int32_t i = 0; i < n; ++i) ws.p[i] = ws.z[i] + beta * ws.p[i];
     }
     rz = rz_new;
+    ws.z_last = ws.z;
     sys.apply(ws.p, ws.q, ws.tmp);
     const double pq = dot(ws.p, ws.q);
     if (!(pq > 0)) break;  // breakdown: the operator is not positive definite here

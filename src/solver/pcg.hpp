@@ -8,7 +8,7 @@
 namespace mica {
 
 struct PcgWorkspace {
-  Vec3List r, z, p, q, tmp, rhs;
+  Vec3List r, z, z_last, p, q, tmp, rhs;
   std::vector<Mat3> inv_diag;
   void resize(size_t n);  // allocates only when n changes
 };
@@ -23,7 +23,8 @@ class Preconditioner {
 
 // Projected PCG as a LinearSolver: stops when ||P y - rhs|| <= tolerance ||rhs||, after
 // max_iterations, or at the deadline (if one is set). Block-Jacobi preconditioned unless given
-// another preconditioner.
+// another preconditioner, which may round (a single-precision factor): the search directions
+// take Polak-Ribiere's beta (flexible CG), which such a preconditioner does not stall.
 class PcgSolver : public LinearSolver {
  public:
   using Clock = std::chrono::steady_clock;
