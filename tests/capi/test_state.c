@@ -32,12 +32,14 @@ typedef struct {
 } scene;
 
 /* A 0.1 m cube (3x3x3 cells) fixed at y = 0 under gravity, a 2 cm sphere pressing its top near one
- * side and a grab on the opposite top corner. cells_x changes the world's shape. */
-static scene make_scene(int32_t solver, int32_t cells_x, int with_tool) {
+ * side and a grab on the opposite top corner. cells_x changes the world's shape; refactor_interval
+ * > 0 refreshes the factored sweep's factor in the background. */
+static scene make_scene(int32_t solver, int32_t cells_x, int with_tool, int32_t refactor_interval) {
   scene s;
   memset(&s, 0, sizeof s);
   mica_world_def wd = mica_world_def_default();
   wd.solver = solver;
+  wd.refactor_interval = refactor_interval;
   OK(NULL, mica_world_create(&wd, &s.world));
   mica_body_def bd = mica_body_def_default();
   bd.youngs_modulus = 2e4;
@@ -119,8 +121,8 @@ static void assert_same_run(const scene* s, const record* a, const record* b, in
   assert_memory_equal(a->reaction, b->reaction, sizeof(double) * 3 * (size_t)steps);
 }
 
-static void check_replay(int32_t solver) {
-  scene s = make_scene(solver, 3, 1);
+static void check_replay(int32_t solver, int32_t refactor_interval) {
+  scene s = make_scene(solver, 3, 1, refactor_interval);
   record before = run(&s, 0, 50);
   size_t bytes = 0;
   void* state = save(&s, &bytes);
@@ -132,7 +134,7 @@ static void check_replay(int32_t solver) {
   assert_same_run(&s, &first, &again, 50);
 
   /* Into a fresh world built the same way. */
-  scene fresh = make_scene(solver, 3, 1);
+  scene fresh = make_scene(solver, 3, 1, refactor_interval);
   OK(fresh.world, mica_world_restore_state(fresh.world, state, bytes));
   record replay = run(&fresh, 50, 50);
   assert_same_run(&s, &first, &replay, 50);
@@ -153,18 +155,21 @@ static void check_replay(int32_t solver) {
 
 static void test_replay_default_solver(void** st) {
   (void)st;
-  check_replay(mica_world_def_default().solver);
+  check_replay(mica_world_def_default().solver, 0);
+  /* Saved with a refreshed factor in flight (every 3 steps: step 50 is between two), whose worker
+   * also makes the contact nodes' columns. */
+  check_replay(mica_world_def_default().solver, 3);
 }
 
 static void test_replay_direct_solver(void** st) {
   (void)st;
-  check_replay(MICA_SOLVER_DIRECT);
+  check_replay(MICA_SOLVER_DIRECT, 0);
 }
 
 /* A state is refused, with the world unchanged, by a world of another shape and when truncated. */
 static void test_restore_refusals(void** st) {
   (void)st;
-  scene s = make_scene(MICA_SOLVER_MICA, 3, 1);
+  scene s = make_scene(MICA_SOLVER_MICA, 3, 1, 0);
   record r = run(&s, 0, 5);
   size_t bytes = 0;
   void* state = save(&s, &bytes);
@@ -176,11 +181,11 @@ static void test_restore_refusals(void** st) {
     mica_status expected;
     const char* phrase;
   } cases[] = {
-      {"more cells", make_scene(MICA_SOLVER_MICA, 4, 1), bytes, MICA_ERR_INVALID_ARGUMENT, "nodes"},
-      {"no tool", make_scene(MICA_SOLVER_MICA, 3, 0), bytes, MICA_ERR_INVALID_ARGUMENT, "tool"},
-      {"another solver", make_scene(MICA_SOLVER_DIRECT, 3, 1), bytes, MICA_ERR_INVALID_ARGUMENT, "solver"},
-      {"truncated by one byte", make_scene(MICA_SOLVER_MICA, 3, 1), bytes - 1, MICA_ERR_PARSE, "truncated"},
-      {"only the header's start", make_scene(MICA_SOLVER_MICA, 3, 1), 16, MICA_ERR_PARSE, "truncated"},
+      {"more cells", make_scene(MICA_SOLVER_MICA, 4, 1, 0), bytes, MICA_ERR_INVALID_ARGUMENT, "nodes"},
+      {"no tool", make_scene(MICA_SOLVER_MICA, 3, 0, 0), bytes, MICA_ERR_INVALID_ARGUMENT, "tool"},
+      {"another solver", make_scene(MICA_SOLVER_DIRECT, 3, 1, 0), bytes, MICA_ERR_INVALID_ARGUMENT, "solver"},
+      {"truncated by one byte", make_scene(MICA_SOLVER_MICA, 3, 1, 0), bytes - 1, MICA_ERR_PARSE, "truncated"},
+      {"only the header's start", make_scene(MICA_SOLVER_MICA, 3, 1, 0), 16, MICA_ERR_PARSE, "truncated"},
   };
   for (size_t c = 0; c < sizeof cases / sizeof cases[0]; ++c) {
     const scene* t = &cases[c].target;
@@ -221,7 +226,7 @@ static void test_restore_refusals(void** st) {
 /* Positions and velocities set read back exactly. */
 static void test_set_get_round_trip(void** st) {
   (void)st;
-  scene s = make_scene(MICA_SOLVER_MICA, 3, 1);
+  scene s = make_scene(MICA_SOLVER_MICA, 3, 1, 0);
   const size_t n = 3 * (size_t)s.nodes;
   double* x = malloc(sizeof(double) * n);
   double* v = malloc(sizeof(double) * n);
@@ -429,7 +434,7 @@ static void poll_and_step(mica_world* w, mica_device_id device, int steps, doubl
  * motion renders the same forces, poll for poll, as after the save. */
 static void test_device_filter_restores(void** st) {
   (void)st;
-  scene s = make_scene(MICA_SOLVER_MICA, 3, 1);
+  scene s = make_scene(MICA_SOLVER_MICA, 3, 1, 0);
   stylus pen = {0.1 + 0.02 + 0.0005, 0, 0};
   mica_device_callbacks cb = {sizeof cb, 0, &pen, NULL, NULL, NULL, read_stylus, drop_force};
   mica_device_def dd = mica_device_def_default();
