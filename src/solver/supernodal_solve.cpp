@@ -27,7 +27,7 @@ bool SupernodalSolve::bind(const cholmod_factor* L, bool single) {
     t_single_.resize(below);
     // Kept only where single precision holds: float's 6e-8 grows with the condition of the
     // system (a nearly incompressible, very stiff body's is far too large), and a preconditioner
-    // that wrong misleads the solves. Probed on one fixed vector, in double and in single.
+    // that far off misleads the solves. Probed on one fixed vector, in double and in single.
     Eigen::VectorXd probe(n), in_double(n), in_single(n);
     for (Eigen::Index i = 0; i < n; ++i) probe[i] = std::sin(0.7 * double(i)) + 0.5;
     solve(probe.data(), in_double.data());

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "collision/closest_point.hpp"
 #include "collision/contact_curvature.hpp"
 #include "core/assert.hpp"
 #include "world/recording.hpp"
@@ -273,8 +274,8 @@ void World::add_contact_stiffness(const StepContext& ctx, Body& b) const {
       core_point = core.corners[size_t(c.core_corner)];
     } else {
       const auto& e = core.edges[size_t(c.core_edge)];
-      const Vec3 &p = core.corners[size_t(e[0])], d = core.corners[size_t(e[1])] - p;
-      core_point = p + std::clamp((c.point - p).dot(d) / d.squaredNorm(), 0.0, 1.0) * d;
+      const Vec3 &a = core.corners[size_t(e[0])], &b_end = core.corners[size_t(e[1])];
+      core_point = a + closest_on_segment(c.point, a, b_end) * (b_end - a);
     }
     b.curvature_terms.push_back({int32_t(k), K, core_point});
     for (int r = 0; r < 3; ++r)
