@@ -32,41 +32,89 @@ void FactoredMicaSolver::update_factors(const std::vector<SolverBody>& bodies) {
       rotation = &cache.node_rotation;
     }
     const LaggedFactor::Key key{b.system.h, b.system.alpha, b.system.beta, b.constraint_version};
-    cache.factor.update(*b.fem, key, *b.A, *b.projection, rotation, rotation ? settings_.refactor_interval : 0);
-    factored_[k] = {&cache.factor, rotation};
+    cache.factor.update(*b.fem, key, *b.A, *b.projection, rotation, rotation ? settings_.refactor_interval : 0,
+                        b.extra_stiffness);
+    factored_[k] = {&cache.factor, rotation, b.projection};
+  }
+}
+
+void FactoredMicaSolver::prepare_contact_nodes(const std::vector<SolverBody>& bodies, const ContactRows& rows) {
+  const size_t nt = rows.terms.size();
+  nodes_.resize(bodies.size());
+  term_slot_.resize(nt);
+  for (size_t bi = 0; bi < bodies.size(); ++bi) {
+    const SolverBody& body = bodies[bi];
+    const FactoredBody& f = factored_[bi];
+    ContactNodes& cn = nodes_[bi];
+    if (slot_of_.size() < size_t(body.node_count())) slot_of_.resize(size_t(body.node_count()), -1);
+    cn.node.clear();
+    const auto slot = [&](int32_t i) {
+      if (slot_of_[i] < 0) {
+        slot_of_[i] = int32_t(cn.node.size());
+        cn.node.push_back(i);
+      }
+      return slot_of_[i];
+    };
+    for (size_t t = 0; t < nt; ++t)
+      if (rows.terms[t].body == int32_t(bi)) term_slot_[t] = slot(rows.terms[t].node);
+    const std::vector<TriangleStiffness>* extra = body.extra_stiffness;
+    cn.corrected = extra && !extra->empty();
+    if (cn.corrected)
+      for (const TriangleStiffness& e : *extra)
+        for (int32_t i : e.nodes) slot(i);
+    f.factor->prepare_columns(cn.node);  // the new ones' columns, one solve per body
+    const Eigen::Index m = Eigen::Index(cn.node.size());
+    cn.columns.resize(size_t(m));
+    cn.to_world.resize(size_t(m));
+    for (Eigen::Index a = 0; a < m; ++a) {
+      const int32_t i = cn.node[size_t(a)];
+      cn.columns[size_t(a)] = &f.factor->columns(i);
+      cn.to_world[size_t(a)] = projector(body, i) * f.factor->turn(f.node_rotation, i);
+    }
+    cn.Y.resize(3 * m, 3 * m);
+    for (Eigen::Index a = 0; a < m; ++a)
+      for (Eigen::Index b = 0; b < m; ++b)
+        cn.Y.block<3, 3>(3 * a, 3 * b) = cn.to_world[size_t(a)] *
+                                          cn.columns[size_t(b)]->block<3, 3>(3 * cn.node[size_t(a)], 0) *
+                                          cn.to_world[size_t(b)].transpose();
+    cn.force.setZero(3 * m);
+    cn.t.setZero(3 * m);
+    cn.u.setZero(3 * m);
+    if (cn.corrected) {
+      cn.C.setZero(3 * m, 3 * m);
+      for (const TriangleStiffness& e : *extra)
+        for (int r = 0; r < 3; ++r)
+          for (int c = 0; c < 3; ++c)
+            cn.C.block<3, 3>(3 * slot_of_[e.nodes[r]], 3 * slot_of_[e.nodes[c]]) +=
+                projector(body, e.nodes[r]) * e.K.block<3, 3>(3 * r, 3 * c) * projector(body, e.nodes[c]);
+      cn.M.noalias() = cn.C * cn.Y;
+      cn.M.diagonal().array() += 1.0;
+      cn.lu.compute(cn.M);  // C Y has eigenvalues >= 0 (C and Y positive semidefinite): I + C Y is regular
+      cn.M = cn.lu.inverse();
+      cn.Yc.noalias() = cn.Y * cn.M;
+    } else {
+      cn.Yc = cn.Y;
+    }
+    for (int32_t i : cn.node) slot_of_[i] = -1;
   }
 }
 
 void FactoredMicaSolver::build_compliance(const std::vector<SolverBody>& bodies, const ContactRows& rows) {
-  const std::vector<FactoredBody>& factored = factored_;
+  prepare_contact_nodes(bodies, rows);
   const size_t nr = rows.size(), nt = rows.terms.size();
-  term_columns_.resize(nt);
-  term_force_.resize(nt);
-  for (size_t bi = 0; bi < factored.size(); ++bi) {  // the new contact nodes' columns, one solve per body
-    contact_nodes_.clear();
-    for (const RowTerm& term : rows.terms)
-      if (term.body == int32_t(bi)) contact_nodes_.push_back(term.node);
-    factored[bi].factor->prepare_columns(contact_nodes_);
-  }
   std::vector<int32_t>& row_of = term_row_;
   row_of.resize(nt);
   for (size_t r = 0; r < nr; ++r)
-    for (int32_t t = rows.start[r]; t < rows.start[r + 1]; ++t) {
-      const RowTerm& term = rows.terms[t];
-      term_columns_[t] = &factored[term.body].factor->columns(term.node);
-      const FactoredBody& f = factored[term.body];
-      term_force_[t] = term.coef * (f.factor->turn(f.node_rotation, term.node).transpose() *
-                                    (projector(bodies[term.body], term.node) * rows.direction[r]));
-      row_of[t] = int32_t(r);
-    }
-  // W_rs = sum over term pairs on one body of f_t^T (K^-1)_{node t, node u} f_u.
+    for (int32_t t = rows.start[r]; t < rows.start[r + 1]; ++t) row_of[t] = int32_t(r);
+  // W_rs = sum over term pairs on one body of coef_t coef_u d_r^T (Yc)_{slot t, slot u} d_s.
   W_.setZero(Eigen::Index(nr), Eigen::Index(nr));
   for (size_t t = 0; t < nt; ++t)
     for (size_t u = 0; u < nt; ++u) {
-      if (rows.terms[t].body != rows.terms[u].body) continue;
-      const Eigen::MatrixXd& X = *term_columns_[u];
-      const Mat3 block = X.block<3, 3>(3 * rows.terms[t].node, 0);
-      W_(row_of[t], row_of[u]) += term_force_[t].dot(block * term_force_[u]);
+      const RowTerm &a = rows.terms[t], &b = rows.terms[u];
+      if (a.body != b.body) continue;
+      const Mat3 block = nodes_[a.body].Yc.block<3, 3>(3 * term_slot_[t], 3 * term_slot_[u]);
+      W_(row_of[t], row_of[u]) +=
+          a.coef * b.coef * rows.direction[row_of[t]].dot(block * rows.direction[row_of[u]]);
     }
 }
 
@@ -85,45 +133,76 @@ void FactoredMicaSolver::start_compliance(const std::vector<SolverBody>& bodies,
 }
 
 bool FactoredMicaSolver::body_response(size_t bi, const ContactRows& rows, const std::vector<double>& w) {
-  const Eigen::Index n = Eigen::Index(factored_[bi].factor->node_count());
-  if (Eigen::Index(node_term_.size()) < n) {
-    node_term_.resize(size_t(n), -1);
-    node_force_.resize(size_t(n));
-  }
-  // The forces summed per node first: a node's columns (3n x 3, read from memory) are read once
-  // however many rows press on it (a contact's normal and tangent rows share their nodes).
-  touched_.clear();
+  ContactNodes& cn = nodes_[bi];
+  cn.force.setZero();
+  bool any = false;
   for (size_t r = 0; r < rows.size(); ++r) {
     if (w[r] == 0) continue;
     for (int32_t t = rows.start[r]; t < rows.start[r + 1]; ++t) {
       if (rows.terms[t].body != int32_t(bi)) continue;
-      const int32_t i = rows.terms[t].node;
-      if (node_term_[i] < 0) {
-        node_term_[i] = t;
-        node_force_[i].setZero();
-        touched_.push_back(i);
-      }
-      node_force_[i] += term_force_[t] * w[r];
+      cn.force.segment<3>(3 * term_slot_[t]) += (rows.terms[t].coef * w[r]) * rows.direction[r];
+      any = true;
     }
   }
-  if (touched_.empty()) return false;
-  y_.setZero(3 * n);
-  for (int32_t i : touched_) {
-    y_.noalias() += *term_columns_[node_term_[i]] * node_force_[i];
-    node_term_[i] = -1;
+  return any && respond(bi);
+}
+
+bool FactoredMicaSolver::respond(size_t bi) {
+  ContactNodes& cn = nodes_[bi];
+  const Eigen::VectorXd* f = &cn.force;
+  if (cn.corrected) {
+    cn.moved.noalias() = cn.M * cn.force;  // P_c^-1 U = X M
+    f = &cn.moved;
   }
-  return true;
+  y_.setZero(3 * Eigen::Index(factored_[bi].factor->node_count()));
+  bool any = false;
+  // A slot's columns (3n x 3, read from memory) once per call, however many rows press on it.
+  for (size_t a = 0; a < cn.node.size(); ++a) {
+    const Vec3 g = cn.to_world[a].transpose() * f->segment<3>(3 * Eigen::Index(a));
+    if (g.isZero(0)) continue;
+    y_.noalias() += *cn.columns[a] * g;
+    any = true;
+  }
+  return any;
+}
+
+void FactoredMicaSolver::add_turned(size_t bi, Vec3List& out) const {
+  const FactoredBody& f = factored_[bi];
+  const Projection& p = *f.projection;
+  for (size_t i = 0; i < out.size(); ++i) {
+    const Vec3 d = f.factor->turn(f.node_rotation, int32_t(i)) * y_.segment<3>(3 * Eigen::Index(i));
+    out[i] += p.active() && p.is_constrained[i] ? Vec3(p.S[i] * d) : d;
+  }
+}
+
+void FactoredMicaSolver::start_correction(size_t bi, const Vec3List& z) {
+  ContactNodes& cn = nodes_[bi];
+  const Projection& p = *factored_[bi].projection;
+  for (size_t a = 0; a < cn.node.size(); ++a) {
+    const int32_t i = cn.node[a];
+    cn.t.segment<3>(3 * Eigen::Index(a)) = p.active() && p.is_constrained[i] ? Vec3(p.S[i] * z[i]) : z[i];
+  }
+  if (!cn.corrected) {
+    cn.force.setZero();
+    cn.u = cn.t;
+    return;
+  }
+  cn.force.noalias() = -cn.C * cn.t;
+  cn.u = cn.t;
+  cn.u.noalias() += cn.Yc * cn.force;
+}
+
+void FactoredMicaSolver::precondition(size_t bi, const Vec3List& r, Vec3List& z) {
+  warp_[bi].apply(r, z);
+  if (!nodes_[bi].corrected) return;
+  start_correction(bi, z);
+  if (respond(bi)) add_turned(bi, z);
 }
 
 void FactoredMicaSolver::apply_impulse_change(std::vector<SolverBody>& bodies, const ContactRows& rows,
                                               const std::vector<double>& dlambda) {
-  for (size_t bi = 0; bi < bodies.size(); ++bi) {
-    if (!body_response(bi, rows, dlambda)) continue;
-    Vec3List& v = *bodies[bi].v;
-    const FactoredBody& f = factored_[bi];
-    for (int32_t i = 0; i < bodies[bi].node_count(); ++i)
-      v[i] += projector(bodies[bi], i) * (f.factor->turn(f.node_rotation, i) * y_.segment<3>(3 * i));
-  }
+  for (size_t bi = 0; bi < bodies.size(); ++bi)
+    if (body_response(bi, rows, dlambda)) add_turned(bi, *bodies[bi].v);
 }
 
 void FactoredMicaSolver::solve_small_lcp(const ContactRows& rows, double tolerance, const std::vector<double>& lambda,
@@ -206,7 +285,7 @@ void FactoredMicaSolver::refactor_now(const std::vector<SolverBody>& bodies, con
   for (size_t bi = 0; bi < bodies.size(); ++bi)
     if (factored_[bi].node_rotation)
       factored_[bi].factor->refactor_now(bodies[bi].pattern(), *bodies[bi].A, *bodies[bi].projection,
-                                         factored_[bi].node_rotation);
+                                         factored_[bi].node_rotation, bodies[bi].extra_stiffness);
   for (size_t bi = 0; bi < bodies.size(); ++bi) warp_[bi].bind(factored_[bi].factor, factored_[bi].node_rotation);
   start_compliance(bodies, rows, lambda);
 }
@@ -248,9 +327,11 @@ SolveReport FactoredMicaSolver::solve(const SolveContext& ctx, std::vector<Solve
   pcg_.resize(nb);
   warp_.resize(nb);
   rhs_.resize(nb);
+  corrected_.clear();  // no allocation once it has held nb
+  for (size_t bi = 0; bi < nb; ++bi) corrected_.emplace_back(this, bi);
   for (size_t bi = 0; bi < nb; ++bi) {
     warp_[bi].bind(factored[bi].factor, factored[bi].node_rotation);
-    pcg_[bi].set_preconditioner(&warp_[bi]);
+    pcg_[bi].set_preconditioner(&corrected_[bi]);
   }
   lambda.resize(nr, 0.0);
   start_compliance(bodies, rows, lambda);

@@ -10,7 +10,15 @@
 //    cached columns of K_f^-1 at the contact nodes, solved by projected Gauss-Seidel; the
 //    velocities then follow the impulse change through the same columns.
 // With P = A the loop would end after one correction; the rotations' mismatch costs a few more.
+//
+// The contacts' own stiffness (SolverBody::extra_stiffness: a rounded tool's curvature, new every
+// step) is left out of the factor and added back exactly: P_c = P + U C U^T with U the contact
+// nodes and C that stiffness, P_c^-1 = P^-1 - X (I + C Y)^-1 C X^T (Woodbury), X = P^-1 U the
+// cached columns, Y = U^T X. Both the compliance W and the conjugate gradients use P_c; without
+// it the gradients spend half their iterations rediscovering a stiffness of rank ~30 (nidus press,
+// linear body: 6.5 iterations per round against 2).
 #pragma once
+#include <Eigen/LU>
 #include <Eigen/QR>
 #include <chrono>
 #include <memory>
@@ -66,13 +74,44 @@ class FactoredMicaSolver : public CachingVelocitySolver<FactoredBodyCache> {
   struct FactoredBody {
     LaggedFactor* factor;                     // updated for this solve's system and constraints
     const std::vector<Mat3>* node_rotation;   // null: the linear model (no warping)
+    const Projection* projection;
+  };
+  // A body's contact nodes in a solve (its rows' terms' and extra stiffness's nodes: U), their
+  // factor columns and the compliance among them, world frame, 3 entries per slot.
+  struct ContactNodes {
+    std::vector<int32_t> node;                    // per slot
+    std::vector<const Eigen::MatrixXd*> columns;  // per slot: K_f^-1's three columns (the factor's frame)
+    std::vector<Mat3> to_world;                   // per slot: S_i Q_i (P^-1 = S Q K_f^-1 Q^T S)
+    Eigen::MatrixXd Y;                            // U^T P^-1 U
+    bool corrected = false;                       // C != 0 (else M = I, Yc = Y)
+    Eigen::MatrixXd C;                            // S U^T (extra stiffness) U S
+    Eigen::MatrixXd M;                            // (I + C Y)^-1
+    Eigen::MatrixXd Yc;                           // U^T P_c^-1 U = Y M
+    Eigen::PartialPivLU<Eigen::MatrixXd> lu;      // of I + C Y
+    Eigen::VectorXd force, moved, t, u;           // node forces, M force; a gathered vector, its correction
+  };
+  // The PCG's preconditioner for body bi: z = P_c^-1 r.
+  class CorrectedPreconditioner : public Preconditioner {
+   public:
+    CorrectedPreconditioner(FactoredMicaSolver* solver, size_t body) : solver_(solver), body_(body) {}
+    void apply(const Vec3List& r, Vec3List& z) override { solver_->precondition(body_, r, z); }
+
+   private:
+    FactoredMicaSolver* solver_;
+    size_t body_;
   };
   // Each body's factor brought up to its system (factored_ in the bodies' order).
   void update_factors(const std::vector<SolverBody>& bodies);
   // W, its diagonal and the rows nothing can move along, from the factor in use.
   void start_compliance(const std::vector<SolverBody>& bodies, const ContactRows& rows, std::vector<double>& lambda);
   void build_compliance(const std::vector<SolverBody>& bodies, const ContactRows& rows);
-  // v += S Q K_f^-1 Q^T S G^T dlambda, through the cached columns.
+  // The contact nodes, their columns, Y and the Woodbury terms of each body (nodes_, term_slot_).
+  void prepare_contact_nodes(const std::vector<SolverBody>& bodies, const ContactRows& rows);
+  // z = P_c^-1 r on body bi (the warped factor, then Woodbury's correction).
+  void precondition(size_t bi, const Vec3List& r, Vec3List& z);
+  // Of body bi: t = U^T z, force = -C t (Woodbury's forces for z = P^-1 r), u = U^T of z corrected.
+  void start_correction(size_t bi, const Vec3List& z);
+  // v += P_c^-1 G^T dlambda, through the cached columns.
   void apply_impulse_change(std::vector<SolverBody>& bodies, const ContactRows& rows,
                             const std::vector<double>& dlambda);
   // lambda_next_ solves the contact problem on W around lambda: 0 <= lambda_next _|_ w + W (lambda_next - lambda) >= 0
@@ -101,9 +140,13 @@ class FactoredMicaSolver : public CachingVelocitySolver<FactoredBodyCache> {
                                 const std::optional<SolveContext::Clock::time_point>& deadline);
   // x = W_E^-1 rhs (the least-squares solution where rows are redundant).
   void solve_equalities(const Eigen::Ref<const Eigen::VectorXd>& rhs, Eigen::Ref<Eigen::VectorXd> x);
-  // y_ = K_f^-1 G^T w on body bi for row weights w (the factor's frame, through the cached
-  // columns); false when no row with a weight has a term on the body.
+  // y_ such that S Q y_ = P_c^-1 G^T w on body bi for row weights w (the factor's frame, through
+  // the cached columns); false when no row with a weight has a term on the body.
   bool body_response(size_t bi, const ContactRows& rows, const std::vector<double>& w);
+  // The same for the node forces nodes_[bi].force (U f); false when there are none.
+  bool respond(size_t bi);
+  // out += S Q y_ on body bi.
+  void add_turned(size_t bi, Vec3List& out) const;
   // out += P^-1 G_which^T x (through the cached columns).
   void add_response(const std::vector<SolverBody>& bodies, const ContactRows& rows, const std::vector<int32_t>& which,
                     const Eigen::Ref<const Eigen::VectorXd>& x, std::vector<Vec3List>& out);
@@ -112,6 +155,9 @@ class FactoredMicaSolver : public CachingVelocitySolver<FactoredBodyCache> {
                            const Eigen::Ref<const Eigen::VectorXd>& x, std::vector<Vec3List>& out) const;
   // out = G_E y (no bias).
   void rows_times(const ContactRows& rows, const std::vector<Vec3List>& y, Eigen::Ref<Eigen::VectorXd> out) const;
+  // out = G_E U u of the bodies' nodes_.u, and each body's force -= U^T G_E^T x.
+  void rows_times_nodes(const ContactRows& rows, Eigen::Ref<Eigen::VectorXd> out) const;
+  void subtract_node_forces(const ContactRows& rows, const Eigen::Ref<const Eigen::VectorXd>& x);
   // The decomposition kept for active sets of ne rows, and those of every size up to nr made at once.
   Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd>& equality_solver(Eigen::Index ne);
   void prepare_equality_solvers(Eigen::Index nr);
@@ -120,10 +166,12 @@ class FactoredMicaSolver : public CachingVelocitySolver<FactoredBodyCache> {
   std::vector<FactoredBody> factored_;
   std::vector<PcgSolver> pcg_;
   std::vector<WarpedFactorPreconditioner> warp_;
-  std::vector<const Eigen::MatrixXd*> term_columns_;  // per row term: K_f^-1 columns of its node
+  std::vector<CorrectedPreconditioner> corrected_;
+  std::vector<ContactNodes> nodes_;                   // per body
+  std::vector<int32_t> term_slot_;                    // per row term: its node's slot in its body's nodes_
   std::vector<int32_t> term_row_;                     // per row term: its row
-  std::vector<Vec3> term_force_;                      // per row term: coef Q_i^T S_i d (the factor's frame)
-  Eigen::MatrixXd W_;                                 // G P^-1 G^T
+  std::vector<int32_t> slot_of_;                      // per node, -1 (scratch of prepare_contact_nodes)
+  Eigen::MatrixXd W_;                                 // G P_c^-1 G^T
   std::vector<double> w_, w_prev_, lambda_next_, dlambda_, diag_;
   std::vector<int32_t> live_, live_at_, contact_nodes_;
   Eigen::MatrixXd small_M_;                           // W on the live rows
@@ -134,21 +182,17 @@ class FactoredMicaSolver : public CachingVelocitySolver<FactoredBodyCache> {
   std::vector<double> warped_diag_;  // W_rr before the secant updates
   std::vector<Vec3List> rhs_;
   Eigen::VectorXd y_;
-  // body_response's: the row weights, and the rows' forces summed per node (node_term_: the node's
-  // first term, -1 untouched); grown, never shrunk.
-  std::vector<double> row_weight_;
-  Vec3List node_force_;
-  std::vector<int32_t> node_term_, touched_;
+  std::vector<double> row_weight_;  // add_response's row weights
   Eigen::VectorXd secant_s_, secant_y_, secant_Ws_;  // secant_update's (no allocation once sized)
   // The active-set loop's.
-  Eigen::MatrixXd W0_;  // G P^-1 G^T of the factor, without the secant updates (the projections need it exact)
+  Eigen::MatrixXd W0_;  // G P_c^-1 G^T of the factor, without the secant updates (the projections need it exact)
   // Sized to the largest active set seen (only ever grown); a set of ne rows uses the first ne
   // entries (ne^2 of W_eq_, column-major).
   Eigen::VectorXd W_eq_;
   std::vector<std::unique_ptr<Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd>>> W_eq_solvers_;  // by size
   Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd>* W_eq_solver_ = nullptr;  // this set's
   std::vector<int32_t> eq_;
-  Eigen::VectorXd mu_, mu_neg_, mu_total_, row_scratch_, eq_work_, eq_y_;
+  Eigen::VectorXd mu_, mu_total_, row_scratch_, eq_work_, eq_y_;
   std::vector<double> fixed_, lambda_prev_;
   std::vector<Vec3List> cy_, cr_, cz_, cp_, cq_, ct_, cf_;  // per body: y, r, z, p, A p, scratch, rhs
   std::vector<Vec3List> cz_last_;                           // per body: the last z (the flexible beta)

@@ -71,7 +71,7 @@ void FactoredMicaSolver::choose_equalities(const ContactRows& rows, std::vector<
   const Eigen::Index ne = Eigen::Index(eq_.size()), nr = Eigen::Index(rows.size());
   // Workspaces for any active set of these rows (ne <= nr), grown with the rows only.
   at_least(W_eq_, nr * nr);
-  for (Eigen::VectorXd* v : {&mu_, &mu_neg_, &mu_total_, &row_scratch_, &eq_work_, &eq_y_}) at_least(*v, nr);
+  for (Eigen::VectorXd* v : {&mu_, &mu_total_, &row_scratch_, &eq_work_, &eq_y_}) at_least(*v, nr);
   prepare_equality_solvers(nr);
   Eigen::Map<Eigen::MatrixXd> W_eq(W_eq_.data(), ne, ne);
   for (Eigen::Index a = 0; a < ne; ++a)
@@ -110,17 +110,8 @@ void FactoredMicaSolver::add_response(const std::vector<SolverBody>& bodies, con
                                       std::vector<Vec3List>& out) {
   row_weight_.assign(rows.size(), 0.0);  // keeps its capacity
   for (size_t a = 0; a < which.size(); ++a) row_weight_[size_t(which[a])] = x(Eigen::Index(a));
-  for (size_t bi = 0; bi < bodies.size(); ++bi) {
-    if (!body_response(bi, rows, row_weight_)) continue;
-    const FactoredBody& f = factored_[bi];
-    Vec3List& o = out[bi];
-    for (int32_t i = 0; i < bodies[bi].node_count(); ++i) {
-      const Vec3 d = f.factor->turn(f.node_rotation, i) * y_.segment<3>(3 * i);
-      o[i] += bodies[bi].projection->active() && bodies[bi].projection->is_constrained[i]
-                  ? Vec3(bodies[bi].projection->S[i] * d)
-                  : d;
-    }
-  }
+  for (size_t bi = 0; bi < bodies.size(); ++bi)
+    if (body_response(bi, rows, row_weight_)) add_turned(bi, out[bi]);
 }
 
 void FactoredMicaSolver::subtract_row_forces(const std::vector<SolverBody>& bodies, const ContactRows& rows,
@@ -134,6 +125,25 @@ void FactoredMicaSolver::subtract_row_forces(const std::vector<SolverBody>& bodi
       const Vec3 g = rows.terms[t].coef * x(Eigen::Index(a)) * rows.direction[r];
       out[rows.terms[t].body][i] -= p.active() && p.is_constrained[i] ? Vec3(p.S[i] * g) : g;
     }
+  }
+}
+
+void FactoredMicaSolver::rows_times_nodes(const ContactRows& rows, Eigen::Ref<Eigen::VectorXd> out) const {
+  for (size_t a = 0; a < eq_.size(); ++a) {
+    const int32_t r = eq_[a];
+    double c = 0;
+    for (int32_t t = rows.start[r]; t < rows.start[r + 1]; ++t)
+      c += rows.terms[t].coef * rows.direction[r].dot(nodes_[rows.terms[t].body].u.segment<3>(3 * term_slot_[t]));
+    out(Eigen::Index(a)) = c;
+  }
+}
+
+void FactoredMicaSolver::subtract_node_forces(const ContactRows& rows, const Eigen::Ref<const Eigen::VectorXd>& x) {
+  for (size_t a = 0; a < eq_.size(); ++a) {
+    const int32_t r = eq_[a];
+    for (int32_t t = rows.start[r]; t < rows.start[r + 1]; ++t)
+      nodes_[rows.terms[t].body].force.segment<3>(3 * term_slot_[t]) -=
+          (rows.terms[t].coef * x(Eigen::Index(a))) * rows.direction[r];
   }
 }
 
@@ -171,7 +181,7 @@ SolveReport FactoredMicaSolver::constrained_solve(std::vector<SolverBody>& bodie
   // Onto the equalities: G_E (y + z) + bias_E = 0, through P^-1 G_E^T and W_E = G_E P^-1 G_E^T.
   const Eigen::Index ne = Eigen::Index(eq_.size());
   auto gap = row_scratch_.head(ne);
-  auto mu = mu_.head(ne), mu_neg = mu_neg_.head(ne), mu_total = mu_total_.head(ne);
+  auto mu = mu_.head(ne), mu_total = mu_total_.head(ne);
   rows_times(rows, cy_, gap);
   for (size_t a = 0; a < eq_.size(); ++a) {
     const int32_t r = eq_[a];
@@ -198,15 +208,19 @@ SolveReport FactoredMicaSolver::constrained_solve(std::vector<SolverBody>& bodie
   double rz = 0;
   mu_total.setZero();
   for (;;) {
-    // z = P^-1 r projected onto G_E z = 0; mu: the impulses on E the residual asks for.
+    // z = P_c^-1 r projected onto G_E z = 0; mu: the impulses on E the residual asks for. Both
+    // corrections of P^-1 r (Woodbury's and the projection's) are responses to forces on the
+    // contact nodes: summed there first, they take one pass over the columns.
     for (size_t bi = 0; bi < nb; ++bi) {
       warp_[bi].apply(cr_[bi], cz_[bi]);
       project_free(*bodies[bi].projection, cz_[bi]);
+      start_correction(bi, cz_[bi]);
     }
-    rows_times(rows, cz_, gap);
+    rows_times_nodes(rows, gap);
     solve_equalities(gap, mu);
-    mu_neg = -mu;
-    add_response(bodies, rows, eq_, mu_neg, cz_);
+    subtract_node_forces(rows, mu);
+    for (size_t bi = 0; bi < nb; ++bi)
+      if (respond(bi)) add_turned(bi, cz_[bi]);
     // The equalities take their share of the residual, r -= S G_E^T mu, at every step (the
     // residual update of Gould, Hribar and Nocedal: without it round-off in the projection stalls
     // the residual of a solve far from its factor's system); what is left must be small.

@@ -12,11 +12,20 @@ LaggedFactor::~LaggedFactor() {
   if (job_.valid()) job_.wait();
 }
 
+void LaggedFactor::copy_system(Slot& slot, const BlockPattern& pattern, const BlockValues& A,
+                               const std::vector<TriangleStiffness>* extra) {
+  slot.A = A;  // the same size: no allocation after the first
+  if (!extra) return;
+  for (const TriangleStiffness& e : *extra)
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) slot.A[size_t(pattern.find(e.nodes[r], e.nodes[c]))] -= e.K.block<3, 3>(3 * r, 3 * c);
+}
+
 void LaggedFactor::factor(Slot& slot, const BlockPattern& pattern, const BlockValues& A, const Projection& projection,
-                          const std::vector<Mat3>* node_rotation) {
+                          const std::vector<Mat3>* node_rotation, const std::vector<TriangleStiffness>* extra) {
   if (!slot.direct.analyzed()) slot.direct.analyze(pattern);
-  slot.direct.factorize(ProjectedSystem{pattern, A, projection});
-  slot.A = A;  // what it was made from, for a saved state (the same size: no allocation after the first)
+  copy_system(slot, pattern, A, extra);  // what it is made from, kept for a saved state
+  slot.direct.factorize(ProjectedSystem{pattern, slot.A, projection});
   slot.projection = projection;
   if (node_rotation) slot.rotation = *node_rotation;
   else slot.rotation.clear();
@@ -42,10 +51,10 @@ void LaggedFactor::clear_columns() {
 }
 
 void LaggedFactor::refactor_now(const BlockPattern& pattern, const BlockValues& A, const Projection& projection,
-                                const std::vector<Mat3>* node_rotation) {
+                                const std::vector<Mat3>* node_rotation, const std::vector<TriangleStiffness>* extra) {
   clear_columns();
   try {
-    factor(writable(active_), pattern, A, projection, node_rotation);
+    factor(writable(active_), pattern, A, projection, node_rotation, extra);
   } catch (...) {
     key_ = Key{};  // the factor in use is gone: the next update factors again
     throw;
@@ -74,7 +83,8 @@ void LaggedFactor::launch(const BlockPattern& pattern) {
 }
 
 void LaggedFactor::update(const FemModel& fem, const Key& key, const BlockValues& A, const Projection& projection,
-                          const std::vector<Mat3>* node_rotation, int32_t interval) {
+                          const std::vector<Mat3>* node_rotation, int32_t interval,
+                          const std::vector<TriangleStiffness>* extra) {
   ++step_;
   node_count_ = fem.node_count();
   if (!(key == key_) || !active_->direct.analyzed()) {
@@ -85,7 +95,7 @@ void LaggedFactor::update(const FemModel& fem, const Key& key, const BlockValues
     }
     launch_staged_ = false;
     // throws on failure: the key stays, the next step retries
-    factor(writable(active_), fem.pattern, A, projection, node_rotation);
+    factor(writable(active_), fem.pattern, A, projection, node_rotation, extra);
     key_ = key;
     launched_at_ = step_;  // the next refresh starts from a later step
     clear_columns();
@@ -98,7 +108,7 @@ void LaggedFactor::update(const FemModel& fem, const Key& key, const BlockValues
     // (in a step that may be undone, that one moves aside: writable).
     Slot& slot = writable(pending_);
     if (!slot.direct.analyzed()) slot.direct.analyze(fem.pattern);
-    slot.A = A;
+    copy_system(slot, fem.pattern, A, extra);
     slot.projection = projection;
     if (open_) {
       if (node_rotation) staged_rotation_ = *node_rotation;

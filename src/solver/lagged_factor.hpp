@@ -20,6 +20,7 @@
 #include "fem/fem_model.hpp"
 #include "solver/direct_solver.hpp"
 #include "solver/pcg.hpp"
+#include "solver/velocity_solver.hpp"
 
 namespace mica {
 
@@ -40,14 +41,16 @@ class LaggedFactor {
   // Once per step, with this step's system A (M + h C + h^2 K of the current rotations), its
   // projection and node rotations (null: a linear body, no warping). Factors A at once when the
   // key changed; otherwise adopts and launches background factorizations every `interval` steps
-  // (0: never).
+  // (0: never). What A holds of `extra` (the contacts' stiffness, which changes every step) is
+  // left out of what is factored: the solver adds the current one back (factored_mica.hpp).
   void update(const FemModel& fem, const Key& key, const BlockValues& A, const Projection& projection,
-              const std::vector<Mat3>* node_rotation, int32_t interval);
+              const std::vector<Mat3>* node_rotation, int32_t interval,
+              const std::vector<TriangleStiffness>* extra = nullptr);
   // Factors the given system now, on the calling thread (the factored sweep's remedy when a solve
   // with the current factor drags on). A background factorization in flight goes on, and is
   // dropped at adoption as older than this one.
   void refactor_now(const BlockPattern& pattern, const BlockValues& A, const Projection& projection,
-                    const std::vector<Mat3>* node_rotation);
+                    const std::vector<Mat3>* node_rotation, const std::vector<TriangleStiffness>* extra = nullptr);
   // out = K_f^-1 in (the factor's frame, no warping); with `single`, from the factor's single-
   // precision copy (a preconditioner's solve: relative error ~1e-7).
   void solve(const Vec3List& in, Vec3List& out, bool single = false) const;
@@ -92,7 +95,10 @@ class LaggedFactor {
     int64_t born = -1;           // the solve whose system it is
   };
   void factor(Slot& slot, const BlockPattern& pattern, const BlockValues& A, const Projection& projection,
-              const std::vector<Mat3>* node_rotation);
+              const std::vector<Mat3>* node_rotation, const std::vector<TriangleStiffness>* extra);
+  // slot.A = A - extra.
+  static void copy_system(Slot& slot, const BlockPattern& pattern, const BlockValues& A,
+                          const std::vector<TriangleStiffness>* extra);
   void adopt();
   void launch(const BlockPattern& pattern);  // the background factorization of *pending_
   // `slot` (active_ or pending_), or, in a step between begin() and its end, a spare in its place

@@ -8,6 +8,7 @@
 //
 // Adding a solver: a class here in solver/ and a case in make_velocity_solver.
 #pragma once
+#include <array>
 #include <chrono>
 #include <cstdint>
 #include <memory>
@@ -64,6 +65,15 @@ struct SystemKey {
   bool operator==(const SystemKey& o) const { return h == o.h && alpha == o.alpha && beta == o.beta; }
 };
 
+// A stiffness A carries on three nodes beyond the body's elements: a rounded tool's contact
+// curvature, h^2 F K_c over a triangle's corners (World::add_contact_stiffness). It is of low
+// rank and changes every step, so a factored solver factors A without it and adds it back
+// exactly (Woodbury; factored_mica.hpp).
+struct TriangleStiffness {
+  std::array<int32_t, 3> nodes;
+  Eigen::Matrix<double, 9, 9> K;  // blocks (r, s) couple nodes[r] and nodes[s]
+};
+
 // One body's system as the solver sees it.
 struct SolverBody {
   uint64_t key = 0;                          // the body's caches in the solver (unique per world)
@@ -75,6 +85,7 @@ struct SolverBody {
   Vec3List* contact_impulse = nullptr;       // out: G^T lambda per node, N s
   const Colouring* colours = nullptr;        // node blocks for a parallel sweep (node_colouring.hpp), or null
   const std::vector<Mat3>* rotation = nullptr;  // element rotations A is built with (null: linear model)
+  const std::vector<TriangleStiffness>* extra_stiffness = nullptr;  // part of A (null: none)
   SystemKey system;
   uint64_t matrix_version = 0;      // changes whenever the values of A change
   uint64_t constraint_version = 0;  // changes whenever the body's constraint set changes

@@ -79,15 +79,16 @@ struct BodyScratch {
   Vec3List f_int, f_ext, b, v_next, x_next;
   std::vector<Mat3> constrained_sum;  // per node, sum of I - S over its constraint groups (reactions)
   Projection projection;
-  // The contact-curvature terms this step put into A (World::add_contact_stiffness): the contact's
-  // index, its h^2 F K_c over the triangle's corners, and the point of the tool's core the contact
-  // force passes through (its line of action). compute_forces hands their impulse to the tool.
+  // The contact-curvature terms this step put into A (World::add_contact_stiffness): their
+  // h^2 F K_c over the triangle's corners (what the solver sees), and per term the contact's index
+  // and the point of the tool's core the contact force passes through (its line of action).
+  // compute_forces hands their impulse to the tool. Cleared each step, they keep their capacity.
   struct CurvatureTerm {
     int32_t contact;
-    Eigen::Matrix<double, 9, 9> K;
     Vec3 core_point;
   };
-  std::vector<CurvatureTerm> curvature_terms;  // cleared each step, keeps its capacity
+  std::vector<TriangleStiffness> curvature_stiffness;
+  std::vector<CurvatureTerm> curvature_terms;  // curvature_stiffness[k]'s contact and core point
 
   // What A was built for; a linear body reuses it while unchanged.
   SystemKey matrix_key{0, -1, -1};

@@ -257,6 +257,7 @@ void World::add_contact_stiffness(const StepContext& ctx, Body& b) const {
   thread_local ToolCore core;  // kept: a step allocates nothing here
   int32_t core_of = -1;
   b.curvature_terms.clear();
+  b.curvature_stiffness.clear();
   for (size_t k = 0; k < contacts_.size(); ++k) {
     const Contact& c = contacts_[k];
     if (c.tool < 0 || (c.core_corner < 0 && c.core_edge < 0) || c.a.body != index) continue;
@@ -277,7 +278,8 @@ void World::add_contact_stiffness(const StepContext& ctx, Body& b) const {
       const Vec3 &a = core.corners[size_t(e[0])], &b_end = core.corners[size_t(e[1])];
       core_point = a + closest_on_segment(c.point, a, b_end) * (b_end - a);
     }
-    b.curvature_terms.push_back({int32_t(k), K, core_point});
+    b.curvature_terms.push_back({int32_t(k), core_point});
+    b.curvature_stiffness.push_back({{t[0], t[1], t[2]}, K});
     for (int r = 0; r < 3; ++r)
       for (int s = 0; s < 3; ++s) b.A[size_t(b.fem.pattern.find(t[r], t[s]))] += K.block<3, 3>(3 * r, 3 * s);
     // A linear body keeps A between steps: this one is not its plain matrix any more.
@@ -377,6 +379,7 @@ void World::solve(const StepContext& ctx) {
     sb.contact_impulse = &b.contact_impulse;
     sb.colours = ctx.pool && !b.node_colours.empty() ? &b.node_colours : nullptr;
     sb.rotation = b.settings.corotational ? &b.R : nullptr;
+    sb.extra_stiffness = &b.curvature_stiffness;
     sb.system = b.matrix_key;
     sb.matrix_version = b.matrix_version;
     sb.constraint_version = b.lpc_version;
@@ -427,12 +430,13 @@ void World::compute_forces(const StepContext& ctx) {
   // The curvature terms in A push the triangles' corners by -h^2 F K_c v+ (add_contact_stiffness):
   // a contact force too, which the tool feels the other way round.
   for (Body* b : ctx.dynamic)
-    for (const Body::CurvatureTerm& term : b->curvature_terms) {
-      const Contact& c = contacts_[size_t(term.contact)];
-      const Tri& tri = b->surface[size_t(c.triangle)];
+    for (size_t k = 0; k < b->curvature_terms.size(); ++k) {
+      const Body::CurvatureTerm& term = b->curvature_terms[k];
+      const TriangleStiffness& stiffness = b->curvature_stiffness[k];
       Vec3 impulse = Vec3::Zero();
       for (int r = 0; r < 3; ++r)
-        for (int s = 0; s < 3; ++s) impulse -= term.K.block<3, 3>(3 * r, 3 * s) * b->v_next[size_t(tri[s])];
+        for (int s = 0; s < 3; ++s) impulse -= stiffness.K.block<3, 3>(3 * r, 3 * s) * b->v_next[size_t(stiffness.nodes[s])];
+      const Contact& c = contacts_[size_t(term.contact)];
       curvature_impulse_[size_t(term.contact)] = impulse;
       Tool& t = *ctx.tools[size_t(c.tool)];
       const Vec3 f = -impulse / h;

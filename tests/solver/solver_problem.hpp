@@ -24,6 +24,7 @@ struct SolverProblem {
   std::vector<Contact> contacts;
   ContactRows rows;
   std::vector<double> lambda;
+  std::vector<TriangleStiffness> extra;  // what of A the solver is told is contact stiffness
 
   explicit SolverProblem(double friction = 0, int32_t cells = 3, bool contact = true) {
     const TetMesh mesh = make_box_grid(Vec3(0, 0, 0), Vec3(0.1, 0.1, 0.1), {cells, cells, cells}, 6);
@@ -73,6 +74,7 @@ struct SolverProblem {
     s.v = &v;
     s.contact_impulse = &impulse;
     s.rotation = &R;
+    s.extra_stiffness = extra.empty() ? nullptr : &extra;
     s.system = SystemKey{kH, 0, 0};
     return s;
   }
