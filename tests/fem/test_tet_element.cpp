@@ -1,6 +1,10 @@
 // SPDX-License-Identifier: Apache-2.0
 // Element-level physics: patch test, rigid-motion invariance, stiffness against a finite
 // difference of the forces, and mass totals.
+#include <Eigen/SVD>
+#include <cstdio>
+#include <random>
+
 #include "fem/fem_model.hpp"
 #include "fem/rotation.hpp"
 #include "test_util.hpp"
@@ -83,6 +87,36 @@ static void test_rotation_is_proper_for_inverted_elements(void**) {
   assert_near((proper_rotation(Q * Vec3(1.1, 0.9, 1.0).asDiagonal()) - Q).norm(), 0.0, 1e-12);
 }
 
+// The polar factor against the SVD's U V^T (the oracle), table-driven over what the solver feeds
+// it: elements' deformation gradients (small and large stretch, turned) and nodes' summed element
+// rotations (a rotation scaled by the node's valence, slightly spread).
+static void test_rotation_matches_the_svd_polar_factor(void**) {
+  struct Case {
+    const char* name;
+    double scale, stretch;  // F = scale * Q * (I + symmetric noise of norm `stretch`)
+  } cases[] = {
+      {"small strain", 1.0, 1e-3}, {"strain 5 %", 1.0, 0.05},  {"strain 30 %", 1.0, 0.3},
+      {"node sum", 20.0, 1e-3},     {"node sum, spread", 14.0, 0.05}, {"tiny scale", 1e-3, 0.05},
+  };
+  std::mt19937 rng(11);
+  std::normal_distribution<double> normal;
+  for (const Case& c : cases) {
+    double worst = 0;
+    for (int trial = 0; trial < 200; ++trial) {
+      const Mat3 Q = rotation_about(Vec3(normal(rng), normal(rng), normal(rng)), 3 * normal(rng));
+      Mat3 noise;
+      for (int k = 0; k < 9; ++k) noise(k / 3, k % 3) = normal(rng);
+      const Mat3 sym = noise + noise.transpose();
+      const Mat3 F = c.scale * Q * (Mat3::Identity() + (c.stretch / sym.norm()) * sym);  // stretches within 1 +- stretch
+      Eigen::JacobiSVD<Mat3> svd(F, Eigen::ComputeFullU | Eigen::ComputeFullV);
+      const Mat3 polar = svd.matrixU() * svd.matrixV().transpose();
+      worst = std::max(worst, (proper_rotation(F) - polar).lpNorm<Eigen::Infinity>());
+    }
+    std::printf("  %-18s worst entry difference from the SVD's polar factor %.1e\n", c.name, worst);
+    assert_true(worst < 1e-13);
+  }
+}
+
 // -d f / d x against the assembled K, by central differences along random directions.
 static void check_stiffness(const FemModel& m, const Vec3List& x, bool corotational, double rel_tol) {
   std::vector<Mat3> R(m.elements.size(), Mat3::Identity());
@@ -145,6 +179,7 @@ int main(void) {
       cmocka_unit_test(test_patch_corotational),
       cmocka_unit_test(test_rigid_rotation_gives_no_force),
       cmocka_unit_test(test_rotation_is_proper_for_inverted_elements),
+      cmocka_unit_test(test_rotation_matches_the_svd_polar_factor),
       cmocka_unit_test(test_stiffness_matches_finite_difference),
       cmocka_unit_test(test_total_mass),
   };
