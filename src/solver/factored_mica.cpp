@@ -73,13 +73,18 @@ void FactoredMicaSolver::prepare_contact_nodes(const std::vector<SolverBody>& bo
     }
     cn.Y.resize(3 * m, 3 * m);
     for (Eigen::Index a = 0; a < m; ++a)
-      for (Eigen::Index b = 0; b < m; ++b)
-        cn.Y.block<3, 3>(3 * a, 3 * b) = cn.to_world[size_t(a)] *
-                                          cn.columns[size_t(b)]->block<3, 3>(3 * cn.node[size_t(a)], 0) *
-                                          cn.to_world[size_t(b)].transpose();
+      for (Eigen::Index b = a; b < m; ++b) {
+        const Mat3 block = cn.to_world[size_t(a)] *
+                           SupernodalSolve::product(*cn.columns[size_t(a)], *cn.columns[size_t(b)]) *
+                           cn.to_world[size_t(b)].transpose();
+        cn.Y.block<3, 3>(3 * a, 3 * b) = block;
+        cn.Y.block<3, 3>(3 * b, 3 * a) = block.transpose();
+      }
     cn.force.setZero(3 * m);
     cn.t.setZero(3 * m);
     cn.u.setZero(3 * m);
+    cn.exact.setZero(3 * m);
+    cn.moved.setZero(3 * m);
     if (cn.corrected) {
       cn.C.setZero(3 * m, 3 * m);
       for (const TriangleStiffness& e : *extra)
@@ -147,23 +152,33 @@ bool FactoredMicaSolver::body_response(size_t bi, const ContactRows& rows, const
   return any && respond(bi);
 }
 
-bool FactoredMicaSolver::respond(size_t bi) {
+bool FactoredMicaSolver::add_forces(size_t bi) {
   ContactNodes& cn = nodes_[bi];
   const Eigen::VectorXd* f = &cn.force;
   if (cn.corrected) {
     cn.moved.noalias() = cn.M * cn.force;  // P_c^-1 U = X M
     f = &cn.moved;
   }
-  y_.setZero(3 * Eigen::Index(factored_[bi].factor->node_count()));
+  const SupernodalSolve& halves = factored_[bi].factor->halves();
   bool any = false;
-  // A slot's columns (3n x 3, read from memory) once per call, however many rows press on it.
   for (size_t a = 0; a < cn.node.size(); ++a) {
     const Vec3 g = cn.to_world[a].transpose() * f->segment<3>(3 * Eigen::Index(a));
     if (g.isZero(0)) continue;
-    y_.noalias() += *cn.columns[a] * g;
+    halves.add(*cn.columns[a], g);
     any = true;
   }
   return any;
+}
+
+bool FactoredMicaSolver::respond(size_t bi) {
+  const SupernodalSolve& halves = factored_[bi].factor->halves();
+  halves.clear(true);
+  if (!add_forces(bi)) return false;
+  y_.resize(3 * Eigen::Index(factored_[bi].factor->node_count()));
+  halves.backward(y_.data());
+  ContactNodes& cn = nodes_[bi];
+  cn.exact.noalias() = cn.Yc * cn.force;  // U^T P_c^-1 U f
+  return true;
 }
 
 void FactoredMicaSolver::add_turned(size_t bi, Vec3List& out) const {
@@ -173,15 +188,18 @@ void FactoredMicaSolver::add_turned(size_t bi, Vec3List& out) const {
     const Vec3 d = f.factor->turn(f.node_rotation, int32_t(i)) * y_.segment<3>(3 * Eigen::Index(i));
     out[i] += p.active() && p.is_constrained[i] ? Vec3(p.S[i] * d) : d;
   }
-}
-
-void FactoredMicaSolver::start_correction(size_t bi, const Vec3List& z) {
-  ContactNodes& cn = nodes_[bi];
-  const Projection& p = *factored_[bi].projection;
+  const ContactNodes& cn = nodes_[bi];  // the contact nodes' exact values in place of y_'s
   for (size_t a = 0; a < cn.node.size(); ++a) {
     const int32_t i = cn.node[a];
-    cn.t.segment<3>(3 * Eigen::Index(a)) = p.active() && p.is_constrained[i] ? Vec3(p.S[i] * z[i]) : z[i];
+    out[i] += cn.exact.segment<3>(3 * Eigen::Index(a)) - cn.to_world[a] * y_.segment<3>(3 * Eigen::Index(i));
   }
+}
+
+void FactoredMicaSolver::start_correction(size_t bi) {
+  ContactNodes& cn = nodes_[bi];
+  const SupernodalSolve& halves = factored_[bi].factor->halves();
+  for (size_t a = 0; a < cn.node.size(); ++a)
+    cn.t.segment<3>(3 * Eigen::Index(a)) = cn.to_world[a] * halves.dot(*cn.columns[a]);
   if (!cn.corrected) {
     cn.force.setZero();
     cn.u = cn.t;
@@ -192,11 +210,22 @@ void FactoredMicaSolver::start_correction(size_t bi, const Vec3List& z) {
   cn.u.noalias() += cn.Yc * cn.force;
 }
 
+void FactoredMicaSolver::finish_correction(size_t bi, Vec3List& z) {
+  ContactNodes& cn = nodes_[bi];
+  cn.u = cn.t;
+  cn.u.noalias() += cn.Yc * cn.force;
+  for (size_t a = 0; a < cn.node.size(); ++a) z[cn.node[a]] = cn.u.segment<3>(3 * Eigen::Index(a));
+}
+
 void FactoredMicaSolver::precondition(size_t bi, const Vec3List& r, Vec3List& z) {
-  warp_[bi].apply(r, z);
-  if (!nodes_[bi].corrected) return;
-  start_correction(bi, z);
-  if (respond(bi)) add_turned(bi, z);
+  if (!nodes_[bi].corrected) return warp_[bi].apply(r, z);
+  warp_[bi].forward(r);
+  start_correction(bi);
+  add_forces(bi);
+  warp_[bi].backward(z);
+  const Projection& p = *factored_[bi].projection;
+  for (int32_t i : p.nodes) z[i] = p.S[i] * z[i];
+  finish_correction(bi, z);
 }
 
 void FactoredMicaSolver::apply_impulse_change(std::vector<SolverBody>& bodies, const ContactRows& rows,

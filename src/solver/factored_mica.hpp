@@ -7,16 +7,22 @@
 //  - velocities: projected conjugate gradients preconditioned by P^-1 (a few iterations where
 //    block Gauss-Seidel needs thousands on stiff or fine meshes);
 //  - contact: the impulses see the compliance W = G P^-1 G^T, a small dense matrix built from the
-//    cached columns of K_f^-1 at the contact nodes, solved by projected Gauss-Seidel; the
-//    velocities then follow the impulse change through the same columns.
+//    factor's half columns at the contact nodes (below), solved by a small LCP; the velocities
+//    then follow the impulse change through the same half columns.
 // With P = A the loop would end after one correction; the rotations' mismatch costs a few more.
 //
 // The contacts' own stiffness (SolverBody::extra_stiffness: a rounded tool's curvature, new every
 // step) is left out of the factor and added back exactly: P_c = P + U C U^T with U the contact
-// nodes and C that stiffness, P_c^-1 = P^-1 - X (I + C Y)^-1 C X^T (Woodbury), X = P^-1 U the
-// cached columns, Y = U^T X. Both the compliance W and the conjugate gradients use P_c; without
-// it the gradients spend half their iterations rediscovering a stiffness of rank ~30 (nidus press,
-// linear body: 6.5 iterations per round against 2).
+// nodes and C that stiffness, P_c^-1 = P^-1 - X (I + C Y)^-1 C X^T (Woodbury), X = P^-1 U,
+// Y = U^T X. Both the compliance W and the conjugate gradients use P_c; without it the gradients
+// spend half their iterations rediscovering a stiffness of rank ~30 (nidus press, linear body:
+// 6.5 iterations per round against 2).
+//
+// Everything about the contact nodes goes through their half columns H = L^-1 P U of the factor
+// K_f = P^T L L^T P (LaggedFactor::columns): Y from H^T H, and a correction of a solve pair
+// between its two halves (SupernodalSolve::forward .. backward). A preconditioner step with
+// Woodbury's correction and the projection onto the equalities costs one solve pair, and a new
+// factor's contact nodes cost a forward solve each, along their elimination path only.
 #pragma once
 #include <Eigen/LU>
 #include <Eigen/QR>
@@ -44,9 +50,9 @@ struct FactoredBodyCache {
 // rotations and refreshed every SolverSettings::refactor_interval solves in the background.
 //
 // Allocation: solve() allocates only while its workspaces grow: on the first solves, when the
-// contact rows change in number (W, the small problem's and the active set's workspaces are
-// sized by them; the active set's decompositions, one per size, only grow with them), and when a
-// factor is made or adopted (its columns afresh).
+// contact rows or their nodes change in number (W, Y, the small problem's and the active set's
+// workspaces are sized by them; the active set's decompositions, one per size, only grow with
+// them), and for the half columns of a node new to contact or of a factor made or adopted.
 // Otherwise it makes no heap allocation (tests/solver/test_solve_allocations.cpp).
 class FactoredMicaSolver : public CachingVelocitySolver<FactoredBodyCache> {
  public:
@@ -77,10 +83,10 @@ class FactoredMicaSolver : public CachingVelocitySolver<FactoredBodyCache> {
     const Projection* projection;
   };
   // A body's contact nodes in a solve (its rows' terms' and extra stiffness's nodes: U), their
-  // factor columns and the compliance among them, world frame, 3 entries per slot.
+  // half columns and the compliance among them, world frame, 3 entries per slot.
   struct ContactNodes {
     std::vector<int32_t> node;                    // per slot
-    std::vector<const Eigen::MatrixXd*> columns;  // per slot: K_f^-1's three columns (the factor's frame)
+    std::vector<const SupernodalSolve::HalfColumns*> columns;  // per slot: its half columns (the factor's frame)
     std::vector<Mat3> to_world;                   // per slot: S_i Q_i (P^-1 = S Q K_f^-1 Q^T S)
     Eigen::MatrixXd Y;                            // U^T P^-1 U
     bool corrected = false;                       // C != 0 (else M = I, Yc = Y)
@@ -88,7 +94,10 @@ class FactoredMicaSolver : public CachingVelocitySolver<FactoredBodyCache> {
     Eigen::MatrixXd M;                            // (I + C Y)^-1
     Eigen::MatrixXd Yc;                           // U^T P_c^-1 U = Y M
     Eigen::PartialPivLU<Eigen::MatrixXd> lu;      // of I + C Y
-    Eigen::VectorXd force, moved, t, u;           // node forces, M force; a gathered vector, its correction
+    // Node forces, M force; t = U^T z of a preconditioner's z = P^-1 r, u = U^T of z corrected (as
+    // of the forces); U^T of a response: the values a single-precision backward solve only
+    // approximates, put back exactly.
+    Eigen::VectorXd force, moved, t, u, exact;
   };
   // The PCG's preconditioner for body bi: z = P_c^-1 r.
   class CorrectedPreconditioner : public Preconditioner {
@@ -105,13 +114,19 @@ class FactoredMicaSolver : public CachingVelocitySolver<FactoredBodyCache> {
   // W, its diagonal and the rows nothing can move along, from the factor in use.
   void start_compliance(const std::vector<SolverBody>& bodies, const ContactRows& rows, std::vector<double>& lambda);
   void build_compliance(const std::vector<SolverBody>& bodies, const ContactRows& rows);
-  // The contact nodes, their columns, Y and the Woodbury terms of each body (nodes_, term_slot_).
+  // The contact nodes, their half columns, Y and the Woodbury terms of each body (nodes_, term_slot_).
   void prepare_contact_nodes(const std::vector<SolverBody>& bodies, const ContactRows& rows);
-  // z = P_c^-1 r on body bi (the warped factor, then Woodbury's correction).
+  // z = P_c^-1 r on body bi (the warped factor with Woodbury's correction between its halves).
   void precondition(size_t bi, const Vec3List& r, Vec3List& z);
-  // Of body bi: t = U^T z, force = -C t (Woodbury's forces for z = P^-1 r), u = U^T of z corrected.
-  void start_correction(size_t bi, const Vec3List& z);
-  // v += P_c^-1 G^T dlambda, through the cached columns.
+  // Of body bi, between the halves of z = P^-1 r: t = U^T z, force = -C t (Woodbury's forces),
+  // u = U^T of z corrected.
+  void start_correction(size_t bi);
+  // After the backward half into z (projected): z = u = t + Yc force exactly at the contact nodes.
+  void finish_correction(size_t bi, Vec3List& z);
+  // Adds the response to nodes_[bi].force, H M force (the factor's frame), to the halves'
+  // workspace; false when there is no force.
+  bool add_forces(size_t bi);
+  // v += P_c^-1 G^T dlambda (a backward solve of the half columns).
   void apply_impulse_change(std::vector<SolverBody>& bodies, const ContactRows& rows,
                             const std::vector<double>& dlambda);
   // lambda_next_ solves the contact problem on W around lambda: 0 <= lambda_next _|_ w + W (lambda_next - lambda) >= 0
@@ -140,14 +155,14 @@ class FactoredMicaSolver : public CachingVelocitySolver<FactoredBodyCache> {
                                 const std::optional<SolveContext::Clock::time_point>& deadline);
   // x = W_E^-1 rhs (the least-squares solution where rows are redundant).
   void solve_equalities(const Eigen::Ref<const Eigen::VectorXd>& rhs, Eigen::Ref<Eigen::VectorXd> x);
-  // y_ such that S Q y_ = P_c^-1 G^T w on body bi for row weights w (the factor's frame, through
-  // the cached columns); false when no row with a weight has a term on the body.
+  // y_ such that S Q y_ = P_c^-1 G^T w on body bi for row weights w (the factor's frame: a
+  // backward solve of the half columns); false when no row with a weight has a term on the body.
   bool body_response(size_t bi, const ContactRows& rows, const std::vector<double>& w);
   // The same for the node forces nodes_[bi].force (U f); false when there are none.
   bool respond(size_t bi);
   // out += S Q y_ on body bi.
   void add_turned(size_t bi, Vec3List& out) const;
-  // out += P^-1 G_which^T x (through the cached columns).
+  // out += P_c^-1 G_which^T x (a backward solve of the half columns).
   void add_response(const std::vector<SolverBody>& bodies, const ContactRows& rows, const std::vector<int32_t>& which,
                     const Eigen::Ref<const Eigen::VectorXd>& x, std::vector<Vec3List>& out);
   // out -= S G_E^T x.

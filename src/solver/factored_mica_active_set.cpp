@@ -210,17 +210,20 @@ SolveReport FactoredMicaSolver::constrained_solve(std::vector<SolverBody>& bodie
   for (;;) {
     // z = P_c^-1 r projected onto G_E z = 0; mu: the impulses on E the residual asks for. Both
     // corrections of P^-1 r (Woodbury's and the projection's) are responses to forces on the
-    // contact nodes: summed there first, they take one pass over the columns.
+    // contact nodes, added between the halves of its solve pair.
     for (size_t bi = 0; bi < nb; ++bi) {
-      warp_[bi].apply(cr_[bi], cz_[bi]);
-      project_free(*bodies[bi].projection, cz_[bi]);
-      start_correction(bi, cz_[bi]);
+      warp_[bi].forward(cr_[bi]);
+      start_correction(bi);
     }
     rows_times_nodes(rows, gap);
     solve_equalities(gap, mu);
     subtract_node_forces(rows, mu);
-    for (size_t bi = 0; bi < nb; ++bi)
-      if (respond(bi)) add_turned(bi, cz_[bi]);
+    for (size_t bi = 0; bi < nb; ++bi) {
+      add_forces(bi);
+      warp_[bi].backward(cz_[bi]);
+      project_free(*bodies[bi].projection, cz_[bi]);
+      finish_correction(bi, cz_[bi]);
+    }
     // The equalities take their share of the residual, r -= S G_E^T mu, at every step (the
     // residual update of Gould, Hribar and Nocedal: without it round-off in the projection stalls
     // the residual of a solve far from its factor's system); what is left must be small.

@@ -26,6 +26,7 @@ void LaggedFactor::factor(Slot& slot, const BlockPattern& pattern, const BlockVa
   if (!slot.direct.analyzed()) slot.direct.analyze(pattern);
   copy_system(slot, pattern, A, extra);  // what it is made from, kept for a saved state
   slot.direct.factorize(ProjectedSystem{pattern, slot.A, projection});
+  if (!slot.direct.by_hand()) fail(Errc::Unsupported, "this CHOLMOD made a factor other than a supernodal LL^T of int indices, which the factored sweep needs");
   slot.projection = projection;
   if (node_rotation) slot.rotation = *node_rotation;
   else slot.rotation.clear();
@@ -69,7 +70,7 @@ void LaggedFactor::adopt() {
     return;  // the copied system did not factor (not positive definite): keep the one in use
   }
   job_ = {};
-  if (pending_->born < active_->born) return;  // refactored since it was launched
+  if (pending_->born < active_->born || !pending_->direct.by_hand()) return;  // refactored since it was launched
   std::swap(active_, pending_);
   clear_columns();
 }
@@ -233,17 +234,7 @@ void LaggedFactor::save(ByteWriter& out) const {
   out.put(uint8_t(in_flight));
   if (active) save_slot(*active_, out);
   if (in_flight) save_slot(*pending_, out);
-  // The cached columns, by node (each 3n x 3, column-major).
-  std::vector<int32_t> nodes;
-  for (const auto& [node, cols] : columns_) nodes.push_back(node);
-  std::sort(nodes.begin(), nodes.end());
-  out.put(uint64_t(nodes.size()));
-  for (int32_t node : nodes) {
-    const Eigen::MatrixXd& cols = columns_.at(node);
-    out.put(node);
-    out.put(int64_t(cols.rows()));
-    out.put_bytes(cols.data(), size_t(cols.size()) * sizeof(double));
-  }
+  out.put(uint64_t(0));  // no cached columns (a state of 0.6's first builds kept them)
 }
 
 void LaggedFactor::load(ByteReader& in, const BlockPattern& pattern) {
@@ -265,16 +256,17 @@ void LaggedFactor::load(ByteReader& in, const BlockPattern& pattern) {
     done.set_value();
     job_ = done.get_future().share();
   }
+  // Cached columns in a state of 0.6's first builds (dense, 3n x 3 each): read past, made again.
   const uint64_t count = in.get<uint64_t>("the cached columns");
   if (count > uint64_t(std::max<int64_t>(n, 0))) fail(Errc::Parse, "more cached columns than nodes: corrupt state");
+  std::vector<double> skipped;
   for (uint64_t k = 0; k < count; ++k) {
     const int32_t node = in.get<int32_t>("a cached column");
     const int64_t rows = in.get<int64_t>("a cached column");
     if (node < 0 || node >= n || rows != 3 * n)
       fail(Errc::Parse, "a cached column does not fit its body: corrupt state");
-    Eigen::MatrixXd cols(rows, 3);
-    in.get_bytes(cols.data(), size_t(cols.size()) * sizeof(double), "a cached column");
-    columns_[node] = std::move(cols);
+    skipped.resize(size_t(rows) * 3);
+    in.get_bytes(skipped.data(), skipped.size() * sizeof(double), "a cached column");
   }
 }
 
@@ -285,17 +277,11 @@ void LaggedFactor::solve(const Vec3List& in, Vec3List& out, bool single) const {
 }
 
 void LaggedFactor::prepare_columns(const std::vector<int32_t>& nodes) {
-  missing_.clear();
-  for (int32_t node : nodes)
-    if (!columns_.count(node) && std::find(missing_.begin(), missing_.end(), node) == missing_.end())
-      missing_.push_back(node);
-  if (missing_.empty()) return;
-  if (open_) columns_added_.insert(columns_added_.end(), missing_.begin(), missing_.end());
-  const Eigen::Index k = Eigen::Index(missing_.size());
-  units_.setZero(3 * node_count_, 3 * k);
-  for (Eigen::Index q = 0; q < k; ++q) units_.block<3, 3>(3 * missing_[q], 3 * q).setIdentity();
-  active_->direct.solve_raw(units_, batch_);
-  for (Eigen::Index q = 0; q < k; ++q) columns_[missing_[q]] = batch_.middleCols<3>(3 * q);
+  for (int32_t node : nodes) {
+    if (columns_.count(node)) continue;
+    if (open_) columns_added_.push_back(node);
+    active_->direct.by_hand()->half_columns(3 * node, columns_[node]);
+  }
 }
 
 void WarpedFactorPreconditioner::bind(LaggedFactor* factor, const std::vector<Mat3>* node_rotation) {
@@ -316,6 +302,20 @@ void WarpedFactorPreconditioner::apply(const Vec3List& r, Vec3List& z) {
   for (size_t i = 0; i < n; ++i) rotated_[i] = turn_[i].transpose() * r[i];
   factor_->solve(rotated_, z, true);
   for (size_t i = 0; i < n; ++i) z[i] = turn_[i] * z[i];
+}
+
+void WarpedFactorPreconditioner::forward(const Vec3List& r) {
+  const size_t n = r.size();
+  rotated_.resize(n);
+  for (size_t i = 0; i < n; ++i) rotated_[i] = turn_.empty() ? r[i] : Vec3(turn_[i].transpose() * r[i]);
+  factor_->halves().forward(flat(rotated_).data(), true);
+}
+
+void WarpedFactorPreconditioner::backward(Vec3List& z) {
+  z.resize(rotated_.size());
+  factor_->halves().backward(flat(z).data());
+  if (turn_.empty()) return;
+  for (size_t i = 0; i < z.size(); ++i) z[i] = turn_[i] * z[i];
 }
 
 }  // namespace mica

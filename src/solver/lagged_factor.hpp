@@ -54,12 +54,13 @@ class LaggedFactor {
   // out = K_f^-1 in (the factor's frame, no warping); with `single`, from the factor's single-
   // precision copy (a preconditioner's solve: relative error ~1e-7).
   void solve(const Vec3List& in, Vec3List& out, bool single = false) const;
-  // Computes the columns of K_f^-1 of all these nodes not yet cached, in one solve (many
-  // right-hand sides cost far less than one solve each with a supernodal factor).
+  // Computes the half columns (SupernodalSolve::HalfColumns) of all these nodes not yet cached.
   void prepare_columns(const std::vector<int32_t>& nodes);
-  // The three columns of K_f^-1 belonging to a prepared `node` (3n x 3), kept until the factor
-  // changes: the response of every node to a unit force on `node`.
-  const Eigen::MatrixXd& columns(int32_t node) const { return columns_.at(node); }
+  // A prepared node's half columns H = L^-1 P E (E its unit columns; K_f = P^T L L^T P), kept
+  // until the factor changes: K_f^-1 E = P^T L^-T H, E^T K_f^-1 E' = H^T H'.
+  const SupernodalSolve::HalfColumns& columns(int32_t node) const { return columns_.at(node); }
+  // The factor in use's solve in halves (SupernodalSolve::forward .. backward).
+  const SupernodalSolve& halves() const { return *active_->direct.by_hand(); }
   // Q_i = R_i R_f,i^T: how far node i turned since the factor's step (R_i: now).
   Mat3 turn(const std::vector<Mat3>* node_rotation, int32_t i) const {
     if (!node_rotation) return Mat3::Identity();
@@ -78,10 +79,11 @@ class LaggedFactor {
   void commit();
   void rollback();
   // What a later solve depends on (World::save_state), between steps only: the key and refresh
-  // schedule, the systems the factor in use and the one in flight were made from (each slot
-  // keeps a copy), and the cached columns. load() into a fresh LaggedFactor reads it back and
-  // factors those systems again (the same matrix factors to the same bits); it throws
-  // Error(Parse) on a state that does not fit `pattern`.
+  // schedule, and the systems the factor in use and the one in flight were made from (each slot
+  // keeps a copy); the half columns are made again as needed (each node's alone: the same
+  // bits). load() into a fresh LaggedFactor reads it back and factors those systems again (the
+  // same matrix factors to the same bits); it throws Error(Parse) on a state that does not fit
+  // `pattern`.
   void save(ByteWriter& out) const;
   void load(ByteReader& in, const BlockPattern& pattern);
 
@@ -126,15 +128,13 @@ class LaggedFactor {
   std::vector<Mat3> staged_rotation_;
   int64_t staged_born_ = -1;
   bool columns_cleared_ = false;
-  std::unordered_map<int32_t, Eigen::MatrixXd> columns_kept_;
+  std::unordered_map<int32_t, SupernodalSolve::HalfColumns> columns_kept_;
   std::vector<int32_t> columns_added_;
   int64_t step_ = 0, launched_at_ = -1;
   int64_t factorizations_ = 0;
   int32_t node_count_ = 0;
   mutable Eigen::VectorXd x_;
-  Eigen::MatrixXd units_, batch_;  // prepare_columns' right-hand sides and solutions
-  std::vector<int32_t> missing_;
-  std::unordered_map<int32_t, Eigen::MatrixXd> columns_;
+  std::unordered_map<int32_t, SupernodalSolve::HalfColumns> columns_;
 };
 
 // The warped preconditioner z = Q K_f^-1 Q^T r (Q per node, see LaggedFactor::turn).
@@ -145,6 +145,10 @@ class WarpedFactorPreconditioner : public Preconditioner {
   // In single precision, from the factor's copy: three quarters of the time of a double solve
   // pair on the nidus (bench_factor); the solvers' residuals and projections stay in double.
   void apply(const Vec3List& r, Vec3List& z) override;
+  // apply() in halves (LaggedFactor::halves): forward(r) leaves L^-1 P Q^T r in the halves'
+  // workspace, where the caller may read and add half columns; backward(z) = Q P^T L^-T of it.
+  void forward(const Vec3List& r);
+  void backward(Vec3List& z);
 
  private:
   LaggedFactor* factor_ = nullptr;

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "solver/supernodal_solve.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace mica {
@@ -20,6 +21,10 @@ bool SupernodalSolve::bind(const cholmod_factor* L, bool single) {
   const Eigen::Index n = Eigen::Index(L->n), below = Eigen::Index(L->maxesize > 0 ? L->maxesize : 1);
   w_.resize(n);
   t_.resize(below);
+  w3_.setZero(n, 3);
+  t3_.resize(below, 3);
+  inverse_perm_.resize(size_t(n));
+  for (Eigen::Index i = 0; i < n; ++i) inverse_perm_[size_t(perm_[i])] = int32_t(i);
   L_ = L;
   if (single) {
     values_single_.assign(values_, values_ + L->xsize);
@@ -44,46 +49,152 @@ void SupernodalSolve::solve_single(const double* b, double* x) const {
   run(values_single_.data(), w_single_, t_single_, b, x);
 }
 
+namespace {
+
+// A supernode k holds columns super[k] .. super[k+1) of L as a dense block (column-major, nr
+// rows, leading dimension nr): its diagonal block on top, then the rows s[pi[k] + nc ..].
 template <class T>
-void SupernodalSolve::run(const T* values, Eigen::Matrix<T, Eigen::Dynamic, 1>& w,
-                          Eigen::Matrix<T, Eigen::Dynamic, 1>& t_all, const double* b, double* x) const {
-  using Matrix = Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic>;
-  using Block = Eigen::Map<const Matrix, 0, Eigen::OuterStride<>>;
-  const Eigen::Index n = w.size(), nsuper = Eigen::Index(L_->nsuper);
-  for (Eigen::Index i = 0; i < n; ++i) w[i] = T(b[perm_[i]]);
-  // A supernode k holds columns super[k] .. super[k+1) of L as a dense block (column-major,
-  // nr rows, leading dimension nr): its diagonal block on top, then the rows s[pi[k] + nc ..].
-  auto block = [&](Eigen::Index k, Eigen::Index& c0, Eigen::Index& nc, Eigen::Index& nr) {
-    c0 = super_[k];
-    nc = super_[k + 1] - c0;
-    nr = pi_[k + 1] - pi_[k];
-    return Block(values + px_[k], nr, nc, Eigen::OuterStride<>(nr));
-  };
-  Eigen::Index c0, nc, nr;
-  for (Eigen::Index k = 0; k < nsuper; ++k) {  // L w' = w
-    const Block X = block(k, c0, nc, nr);
+struct Supernode {
+  Supernode(const T* values, const int* super, const int* pi, const int* px, const int* s, Eigen::Index k)
+      : c0(super[k]), nc(super[k + 1] - c0), below(pi[k + 1] - pi[k] - nc), rows(s + pi[k] + nc),
+        X(values + px[k], nc + below, nc, Eigen::OuterStride<>(nc + below)) {}
+  Eigen::Index c0, nc, below;
+  const int* rows;  // the rows below the diagonal block
+  Eigen::Map<const Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic>, 0, Eigen::OuterStride<>> X;
+};
+
+}  // namespace
+
+template <class T>
+void SupernodalSolve::run_forward(const T* values, Eigen::Matrix<T, Eigen::Dynamic, 1>& w,
+                                  Eigen::Matrix<T, Eigen::Dynamic, 1>& t_all) const {
+  for (Eigen::Index k = 0; k < Eigen::Index(L_->nsuper); ++k) {  // L w' = w
+    const Supernode<T> sn(values, super_, pi_, px_, s_, k);
+    const Eigen::Index c0 = sn.c0, nc = sn.nc, below = sn.below;
+    const int* rows = sn.rows;
+    const auto& X = sn.X;
     auto xk = w.segment(c0, nc);
     X.topRows(nc).template triangularView<Eigen::Lower>().solveInPlace(xk);
-    const Eigen::Index below = nr - nc;
     if (below == 0) continue;
     auto t = t_all.head(below);
     t.noalias() = X.bottomRows(below) * xk;
-    const int* rows = s_ + pi_[k] + nc;
     for (Eigen::Index i = 0; i < below; ++i) w[rows[i]] -= t[i];
   }
-  for (Eigen::Index k = nsuper - 1; k >= 0; --k) {  // L^T w' = w
-    const Block X = block(k, c0, nc, nr);
+}
+
+template <class T>
+void SupernodalSolve::run_backward(const T* values, Eigen::Matrix<T, Eigen::Dynamic, 1>& w,
+                                   Eigen::Matrix<T, Eigen::Dynamic, 1>& t_all) const {
+  for (Eigen::Index k = Eigen::Index(L_->nsuper) - 1; k >= 0; --k) {  // L^T w' = w
+    const Supernode<T> sn(values, super_, pi_, px_, s_, k);
+    const Eigen::Index c0 = sn.c0, nc = sn.nc, below = sn.below;
+    const int* rows = sn.rows;
+    const auto& X = sn.X;
     auto xk = w.segment(c0, nc);
-    const Eigen::Index below = nr - nc;
     if (below > 0) {
       auto t = t_all.head(below);
-      const int* rows = s_ + pi_[k] + nc;
       for (Eigen::Index i = 0; i < below; ++i) t[i] = w[rows[i]];
       xk.noalias() -= X.bottomRows(below).transpose() * t;
     }
     X.topRows(nc).template triangularView<Eigen::Lower>().transpose().solveInPlace(xk);
   }
+}
+
+template <class T>
+void SupernodalSolve::run(const T* values, Eigen::Matrix<T, Eigen::Dynamic, 1>& w,
+                          Eigen::Matrix<T, Eigen::Dynamic, 1>& t_all, const double* b, double* x) const {
+  const Eigen::Index n = w.size();
+  for (Eigen::Index i = 0; i < n; ++i) w[i] = T(b[perm_[i]]);
+  run_forward(values, w, t_all);
+  run_backward(values, w, t_all);
   for (Eigen::Index i = 0; i < n; ++i) x[perm_[i]] = double(w[i]);
+}
+
+void SupernodalSolve::half_columns(int32_t first, HalfColumns& out) const {
+  out.start.clear();
+  out.length.clear();
+  for (int c = 0; c < 3; ++c) w3_(inverse_perm_[size_t(first + c)], c) = 1;
+  // The forward solve of the unit columns, in double, skipping the supernodes they have not
+  // reached (zero there: nothing to pass on); those they reach are the segments.
+  Eigen::Index total = 0;
+  for (Eigen::Index k = 0; k < Eigen::Index(L_->nsuper); ++k) {
+    const Supernode<double> sn(values_, super_, pi_, px_, s_, k);
+    auto xk = w3_.middleRows(sn.c0, sn.nc);
+    if (xk.isZero(0)) continue;
+    sn.X.topRows(sn.nc).triangularView<Eigen::Lower>().solveInPlace(xk);
+    out.start.push_back(int32_t(sn.c0));
+    out.length.push_back(int32_t(sn.nc));
+    total += sn.nc;
+    if (sn.below == 0) continue;
+    auto t = t3_.topRows(sn.below);
+    t.noalias() = sn.X.bottomRows(sn.below) * xk;
+    for (Eigen::Index i = 0; i < sn.below; ++i) w3_.row(sn.rows[i]) -= t.row(i);
+  }
+  out.values.resize(total, 3);
+  Eigen::Index at = 0;
+  for (size_t q = 0; q < out.start.size(); ++q) {
+    out.values.middleRows(at, out.length[q]) = w3_.middleRows(out.start[q], out.length[q]);
+    w3_.middleRows(out.start[q], out.length[q]).setZero();  // every row it touched lies in a segment
+    at += out.length[q];
+  }
+}
+
+Mat3 SupernodalSolve::product(const HalfColumns& a, const HalfColumns& b) {
+  // Both paths run up the same tree: their common supernodes are the same segments, in order.
+  Mat3 p = Mat3::Zero();
+  Eigen::Index ia = 0, ib = 0;
+  for (size_t qa = 0, qb = 0; qa < a.start.size() && qb < b.start.size();) {
+    if (a.start[qa] < b.start[qb]) {
+      ia += a.length[qa++];
+    } else if (b.start[qb] < a.start[qa]) {
+      ib += b.length[qb++];
+    } else {
+      p.noalias() += a.values.middleRows(ia, a.length[qa]).transpose() * b.values.middleRows(ib, b.length[qb]);
+      ia += a.length[qa++];
+      ib += b.length[qb++];
+    }
+  }
+  return p;
+}
+
+void SupernodalSolve::forward(const double* b, bool single) const {
+  const Eigen::Index n = w_.size();
+  for (Eigen::Index i = 0; i < n; ++i) w_[i] = b[perm_[i]];
+  halves_single_ = single && this->single();
+  if (!halves_single_) return run_forward(values_, w_, t_);
+  w_single_ = w_.cast<float>();
+  run_forward(values_single_.data(), w_single_, t_single_);
+  w_ = w_single_.cast<double>();  // dot and add in double
+}
+
+Vec3 SupernodalSolve::dot(const HalfColumns& h) const {
+  Vec3 d = Vec3::Zero();
+  Eigen::Index at = 0;
+  for (size_t q = 0; q < h.start.size(); ++q) {
+    d.noalias() += h.values.middleRows(at, h.length[q]).transpose() * w_.segment(h.start[q], h.length[q]);
+    at += h.length[q];
+  }
+  return d;
+}
+
+void SupernodalSolve::add(const HalfColumns& h, const Vec3& f) const {
+  Eigen::Index at = 0;
+  for (size_t q = 0; q < h.start.size(); ++q) {
+    w_.segment(h.start[q], h.length[q]).noalias() += h.values.middleRows(at, h.length[q]) * f;
+    at += h.length[q];
+  }
+}
+
+void SupernodalSolve::backward(double* x) const {
+  const Eigen::Index n = w_.size();
+  if (halves_single_) {
+    w_single_ = w_.cast<float>();
+    run_backward(values_single_.data(), w_single_, t_single_);
+    for (Eigen::Index i = 0; i < n; ++i) x[perm_[i]] = double(w_single_[i]);
+    return;
+  }
+  run_backward(values_, w_, t_);
+  for (Eigen::Index i = 0; i < n; ++i) x[perm_[i]] = w_[i];
 }
 
 }  // namespace mica

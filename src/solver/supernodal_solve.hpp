@@ -13,6 +13,8 @@
 #include <Eigen/Dense>
 #include <vector>
 
+#include "core/types.hpp"
+
 namespace mica {
 
 class SupernodalSolve {
@@ -32,7 +34,38 @@ class SupernodalSolve {
   // condition number.
   void solve_single(const double* b, double* x) const;
 
+  // A node's half columns L^-1 P E, E the three unit columns of DOFs first .. first + 2: nonzero
+  // only on the supernodes of their path up the elimination tree (a few hundred of the nidus's
+  // 8208 rows), kept as those segments. With them, A^-1 E = P^T L^-T H and E^T A^-1 E' = H^T H'.
+  struct HalfColumns {
+    std::vector<int32_t> start, length;              // the segments' first permuted row, rows
+    Eigen::Matrix<double, Eigen::Dynamic, 3> values;  // their rows, one segment after another
+  };
+  void half_columns(int32_t first, HalfColumns& out) const;
+  // H^T H' (E^T A^-1 E').
+  static Mat3 product(const HalfColumns& a, const HalfColumns& b);
+  // The solve pair in halves, with what lies between them in the caller's hands (the factored
+  // sweep's correction of its preconditioner, factored_mica.cpp): forward(b) keeps w = L^-1 P b;
+  // dot(H) = H^T w; add(H, f): w += H f; clear(single): w = 0 instead of forward(); backward(x):
+  // x = P^T L^-T w. With `single` and the copy, the halves run in single precision: x along E
+  // is then H^T w only to single's precision, and a caller that needs it exact puts back the
+  // values it knows.
+  void forward(const double* b, bool single) const;
+  Vec3 dot(const HalfColumns& h) const;
+  void add(const HalfColumns& h, const Vec3& f) const;
+  void clear(bool single) const {
+    w_.setZero();
+    halves_single_ = single && this->single();
+  }
+  void backward(double* x) const;
+
  private:
+  template <class T>
+  void run_forward(const T* values, Eigen::Matrix<T, Eigen::Dynamic, 1>& w,
+                   Eigen::Matrix<T, Eigen::Dynamic, 1>& t) const;
+  template <class T>
+  void run_backward(const T* values, Eigen::Matrix<T, Eigen::Dynamic, 1>& w,
+                    Eigen::Matrix<T, Eigen::Dynamic, 1>& t) const;
   template <class T>
   void run(const T* values, Eigen::Matrix<T, Eigen::Dynamic, 1>& w, Eigen::Matrix<T, Eigen::Dynamic, 1>& t,
            const double* b, double* x) const;
@@ -41,9 +74,12 @@ class SupernodalSolve {
   const int *super_ = nullptr, *pi_ = nullptr, *px_ = nullptr, *s_ = nullptr, *perm_ = nullptr;
   const double* values_ = nullptr;
   std::vector<float> values_single_;
+  std::vector<int32_t> inverse_perm_;  // a DOF's permuted row
   // The permuted vector, and a supernode's rows below its columns (grown, never shrunk).
   mutable Eigen::VectorXd w_, t_;
   mutable Eigen::VectorXf w_single_, t_single_;
+  mutable Eigen::Matrix<double, Eigen::Dynamic, 3> w3_, t3_;  // half_columns' (w3_ zero between calls)
+  mutable bool halves_single_ = false;                       // forward() left w in w_single_
 };
 
 }  // namespace mica

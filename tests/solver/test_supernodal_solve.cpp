@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 // The hand-written supernodal solve (solver/supernodal_solve.hpp) against cholmod_solve2 on the
-// same factor: the double solve to round-off, the single-precision one to its precision, and a
-// factor of another kind refused.
+// same factor: the double solve to round-off, the single-precision one to its precision, the
+// half columns and the solve in halves against A^-1's columns, and a factor of another kind
+// refused.
 #include "solver/direct_solver.hpp"  // before cmocka (test_util.hpp)
 #include "solver/solver_problem.hpp"
 #include "solver/supernodal_solve.hpp"
@@ -62,6 +63,45 @@ static void test_single_within_its_precision(void**) {
   assert_true(relative(X.col(1), reference.col(0)) <= 1e-13);
 }
 
+// Half columns H = L^-1 P E of two nodes: H_a^T H_b against the block of A^-1 that cholmod_solve2
+// gives; they are sparse (a path up the elimination tree); and the solve in halves with half
+// columns added between them is A^-1 (b + E f), with what it gives along E as H^T of what was
+// between them (dot), in double and, to its precision, in single.
+static void test_half_columns_and_halves(void**) {
+  for (bool single : {false, true}) {
+    Factored f(single);
+    const int32_t n = f.p.fem.node_count(), b = n - 2;  // free nodes (the base is fixed): a inside, b on top
+    int32_t a = n / 2;
+    while (f.p.projection.is_constrained[a]) ++a;
+    const SupernodalSolve& halves = *f.direct.by_hand();
+    SupernodalSolve::HalfColumns Ha, Hb;
+    halves.half_columns(3 * a, Ha);
+    halves.half_columns(3 * b, Hb);
+    Eigen::MatrixXd E = Eigen::MatrixXd::Zero(3 * n, 3), columns;
+    E.middleRows<3>(3 * b).setIdentity();
+    f.direct.solve_raw_cholmod(E, columns);  // A^-1 E_b
+    const Mat3 block = columns.middleRows<3>(3 * a), ab = SupernodalSolve::product(Ha, Hb);
+    print_message("single %d: H_a^T H_b against A^-1's block %.2g (rows kept: %ld and %ld of %d)\n", int(single),
+                  (ab - block).norm() / block.norm(), long(Ha.values.rows()), long(Hb.values.rows()), 3 * n);
+    assert_true(block.norm() > 0 && (ab - block).norm() <= 1e-12 * block.norm());
+    assert_true(Ha.values.rows() < 3 * n / 2);
+    const Vec3 f_b(0.3, -1, 2);
+    halves.forward(f.b.data(), true);
+    const Vec3 along = halves.dot(Hb) + SupernodalSolve::product(Hb, Hb) * f_b;
+    halves.add(Hb, f_b);
+    Eigen::VectorXd x(3 * n), reference;
+    halves.backward(x.data());
+    Eigen::MatrixXd solved;
+    f.direct.solve_raw_cholmod(f.b + E * f_b, solved);
+    reference = solved.col(0);
+    const double d = relative(x, reference), d_along = (x.segment<3>(3 * b) - along).norm() / along.norm();
+    print_message("  in halves against cholmod_solve2 %.2g; along E_b against H^T w %.2g\n", d, d_along);
+    assert_true(d <= (single ? 1e-4 : 1e-13));
+    assert_true(d_along <= (single ? 1e-4 : 1e-13));
+    assert_true(!single || d > 1e-12);  // it did run in single precision
+  }
+}
+
 // A simplicial factor is not a supernodal one: bind refuses it.
 static void test_other_factors_refused(void**) {
   struct Simplicial : Eigen::CholmodSimplicialLLT<Eigen::SparseMatrix<double>, Eigen::Lower> {
@@ -81,6 +121,7 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_double_matches_cholmod),
       cmocka_unit_test(test_single_within_its_precision),
+      cmocka_unit_test(test_half_columns_and_halves),
       cmocka_unit_test(test_other_factors_refused),
   };
   return cmocka_run_group_tests(tests, nullptr, nullptr);
