@@ -157,12 +157,56 @@ static void test_rollback_leaves_the_saved_factor(void**) {
   assert_true(before.bytes() == after.bytes());
 }
 
+// A state saved by the first 0.6 builds ends with dense cached columns (count, then per node its
+// index, 3n and 3n x 3 doubles) where a state now ends with the count 0: it still loads (the
+// columns read past, the factor the same: it saves the same bytes again), and one whose columns
+// do not fit the body is refused as corrupt.
+static void test_loads_a_state_with_dense_columns(void**) {
+  Twist t = make_twist(1);
+  step(t);
+  const Body& b = t.world->body(t.body);
+  std::vector<Mat3> node_rotation;
+  compute_node_rotations(b.fem, b.R, node_rotation);
+  LaggedFactor factor;
+  factor.update(b.fem, LaggedFactor::Key{0.01, 0, 0, 0}, b.A, b.projection, &node_rotation, 0);
+  ByteWriter now;
+  factor.save(now);
+  const int64_t n = b.fem.node_count();
+  auto with_columns = [&](int64_t rows) {
+    ByteWriter old;
+    old.put_bytes(now.bytes().data(), now.bytes().size() - sizeof(uint64_t));  // up to the count
+    old.put(uint64_t(1));
+    old.put(int32_t(2));
+    old.put(rows);
+    const std::vector<double> columns(size_t(rows) * 3, 0.25);
+    old.put_bytes(columns.data(), columns.size() * sizeof(double));
+    return old.bytes();
+  };
+  const std::vector<uint8_t> fits = with_columns(3 * n), corrupt = with_columns(3 * n - 3);
+  LaggedFactor loaded;
+  ByteReader in(fits.data(), fits.size());
+  loaded.load(in, b.fem.pattern);
+  assert_int_equal(in.remaining(), 0);
+  ByteWriter again;
+  loaded.save(again);
+  assert_true(again.bytes() == now.bytes());
+  LaggedFactor refused;
+  ByteReader bad(corrupt.data(), corrupt.size());
+  try {
+    refused.load(bad, b.fem.pattern);
+    fail_msg("a state whose columns do not fit its body was loaded");
+  } catch (const Error& e) {
+    assert_true(e.code() == Errc::Parse);
+  }
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_rollback_leaves_the_saved_factor),
       cmocka_unit_test(test_results_do_not_depend_on_timing),
       cmocka_unit_test(test_refresh_saves_iterations),
       cmocka_unit_test(test_long_solve_refactors),
+      cmocka_unit_test(test_loads_a_state_with_dense_columns),
   };
   return cmocka_run_group_tests(tests, nullptr, nullptr);
 }
