@@ -26,7 +26,9 @@ void LaggedFactor::factor(Slot& slot, const BlockPattern& pattern, const BlockVa
   if (!slot.direct.analyzed()) slot.direct.analyze(pattern);
   copy_system(slot, pattern, A, extra);  // what it is made from, kept for a saved state
   slot.direct.factorize(ProjectedSystem{pattern, slot.A, projection});
-  if (!slot.direct.by_hand()) fail(Errc::Unsupported, "this CHOLMOD made a factor other than a supernodal LL^T of int indices, which the factored sweep needs");
+  if (!slot.direct.by_hand())
+    fail(Errc::Unsupported, "this CHOLMOD made a factor other than a supernodal LL^T of int indices, which the "
+                            "factored sweep needs");
   slot.projection = projection;
   if (node_rotation) slot.rotation = *node_rotation;
   else slot.rotation.clear();
@@ -70,7 +72,8 @@ void LaggedFactor::adopt() {
     return;  // the copied system did not factor (not positive definite): keep the one in use
   }
   job_ = {};
-  if (pending_->born < active_->born || !pending_->direct.by_hand()) return;  // refactored since it was launched
+  // Refactored since it was launched, or a factor the halves cannot use (see factor()).
+  if (pending_->born < active_->born || !pending_->direct.by_hand()) return;
   std::swap(active_, pending_);
   clear_columns();
 }

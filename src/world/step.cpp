@@ -435,7 +435,8 @@ void World::compute_forces(const StepContext& ctx) {
       const TriangleStiffness& stiffness = b->curvature_stiffness[k];
       Vec3 impulse = Vec3::Zero();
       for (int r = 0; r < 3; ++r)
-        for (int s = 0; s < 3; ++s) impulse -= stiffness.K.block<3, 3>(3 * r, 3 * s) * b->v_next[size_t(stiffness.nodes[s])];
+        for (int s = 0; s < 3; ++s)
+          impulse -= stiffness.K.block<3, 3>(3 * r, 3 * s) * b->v_next[size_t(stiffness.nodes[s])];
       const Contact& c = contacts_[size_t(term.contact)];
       curvature_impulse_[size_t(term.contact)] = impulse;
       Tool& t = *ctx.tools[size_t(c.tool)];
