@@ -95,7 +95,9 @@ void FactoredMicaSolver::prepare_contact_nodes(const std::vector<SolverBody>& bo
       cn.M.noalias() = cn.C * cn.Y;
       cn.M.diagonal().array() += 1.0;
       cn.lu.compute(cn.M);  // C Y has eigenvalues >= 0 (C and Y positive semidefinite): I + C Y is regular
-      cn.M = cn.lu.inverse();
+      cn.M.setIdentity();
+      cn.Yc = cn.lu.solve(cn.M);  // (Eigen's inverse() allocates; a solve into another matrix does not)
+      cn.M = cn.Yc;
       cn.Yc.noalias() = cn.Y * cn.M;
     } else {
       cn.Yc = cn.Y;

@@ -11,7 +11,8 @@
 //  - grasp + press: two jaws squeezing the sides' upper nodes, and the sphere.
 // Each runs both loops (SolverSettings::active_set) with the factor current (a linear body: the
 // factor is A) and lagged (a co-rotational body: A re-assembled every step from its rotations,
-// the first step's factor warped).
+// the first step's factor warped). The sphere's contact curvature is in A on a face of pressed
+// nodes, a little larger every step (SolverBody::extra_stiffness: Woodbury's correction).
 // malloc is counted too, except in a sanitizer build: the sanitizer owns malloc (replacing it
 // there aborts at start-up), and only operator new is counted.
 #if !defined(__SANITIZE_ADDRESS__) && !defined(__SANITIZE_THREAD__)
@@ -43,6 +44,7 @@ struct Scene {
   SolverProblem p{kMu, 4, false};
   std::vector<Tool> tools;
   bool corotational = true;
+  int32_t steps = 0;
 
   explicit Scene(bool grasp, bool corotational_body) : corotational(corotational_body) {
     // A sphere of 20 cm radius 5 mm into the middle of the (sheared) top face and coming down at
@@ -53,6 +55,16 @@ struct Scene {
       if (p.fem.rest[i].y() > 0.1 - 1e-9 && (p.fem.rest[i] - Vec3(0.05, 0.1, 0.05)).norm() < 0.04)
         sphere.nodes.push_back(i);
     tools.push_back(sphere);
+    // The curvature's place: a face of three pressed nodes (a tet's).
+    for (const TetElement& el : p.fem.elements) {
+      std::vector<int32_t> pressed;
+      for (int32_t i : el.nodes)
+        if (std::count(sphere.nodes.begin(), sphere.nodes.end(), i)) pressed.push_back(i);
+      if (pressed.size() < 3) continue;
+      p.extra.push_back({{pressed[0], pressed[1], pressed[2]}, Eigen::Matrix<double, 9, 9>::Zero()});
+      break;
+    }
+    add_curvature();
     // Jaws 2 mm inside the sides, on their upper halves' nodes, squeezing and lifting.
     if (grasp)
       for (double side : {0.0, 0.1}) {
@@ -63,6 +75,18 @@ struct Scene {
         tools.push_back(jaw);
       }
     build_rows();
+  }
+
+  // h^2 F K_c-like: positive semidefinite, of rank 3, a tenth of a node's diagonal block and
+  // growing by a tenth each step (its values change, its nodes do not), added to A.
+  void add_curvature() {
+    TriangleStiffness& e = p.extra[0];
+    Eigen::Matrix<double, 9, 3> B;
+    for (int k = 0; k < 27; ++k) B(k / 3, k % 3) = std::sin(1.0 + k);
+    const double s = 0.1 * (1 + 0.1 * steps) * p.A[size_t(p.fem.pattern.find(e.nodes[0], e.nodes[0]))].norm();
+    e.K = (s / B.squaredNorm()) * B * B.transpose();
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) p.A[size_t(p.fem.pattern.find(e.nodes[r], e.nodes[c]))] += e.K.block<3, 3>(3 * r, 3 * c);
   }
 
   // Contacts of the tools at the nodes' current positions (the same nodes every step).
@@ -88,10 +112,12 @@ struct Scene {
     const double h = SolverProblem::kH;
     for (size_t i = 0; i < p.x.size(); ++i) p.x[i] += h * p.v[i];
     for (Tool& t : tools) t.centre += h * t.velocity;
+    ++steps;
     if (corotational) {
       compute_rotations(p.fem, p.x, p.R);
       set_scaled_mass(p.fem, 1.0, p.A);
       assemble_elastic(p.fem, p.x, &p.R, h * h, &p.A, p.f_int);
+      add_curvature();
     } else {
       assemble_elastic(p.fem, p.x, &p.R, h * h, nullptr, p.f_int);  // linear about the first rotations
     }
