@@ -173,7 +173,7 @@ void solve_frictional_contact(const Eigen::MatrixXd& M, const Eigen::VectorXd& q
   };
   // A Newton step factors the dense n x n Jacobian: past kMaxNewtonRows rows (hundreds of
   // contacts, a body gone wild) twenty of them per batch took minutes a step; sweeps only there.
-  const bool newton = n <= kMaxNewtonRows;
+  const bool newton = n <= std::min(kMaxNewtonRows, settings.max_newton_rows);
   // Progress is judged every kStallWindow sweeps: a window that did not halve the best relative
   // residual switches to the damped sweeps, a second such window stops ("stalled"). A problem that
   // stalls (friction near redundant contacts, which need not have a unique solution) would

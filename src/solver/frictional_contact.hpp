@@ -23,6 +23,7 @@ struct FrictionalSettings {
   // contact, the impulse -q_n / M_nn its normal row alone asks for.
   double tolerance = 1e-10;
   int32_t max_sweeps = 5000;  // block Gauss-Seidel sweeps, then as many damped ones; a stall stops sooner (.cpp)
+  Eigen::Index max_newton_rows = kMaxNewtonRows;  // Newton steps only on problems of at most this many rows
   std::optional<std::chrono::steady_clock::time_point> deadline;  // stop (unsolved) once past it
 };
 
