@@ -202,12 +202,8 @@ void FactoredMicaSolver::start_correction(size_t bi) {
   const SupernodalSolve& halves = factored_[bi].factor->halves();
   for (size_t a = 0; a < cn.node.size(); ++a)
     cn.t.segment<3>(3 * Eigen::Index(a)) = cn.to_world[a] * halves.dot(*cn.columns[a]);
-  if (!cn.corrected) {
-    cn.force.setZero();
-    cn.u = cn.t;
-    return;
-  }
-  cn.force.noalias() = -cn.C * cn.t;
+  if (cn.corrected) cn.force.noalias() = -cn.C * cn.t;
+  else cn.force.setZero();
   cn.u = cn.t;
   cn.u.noalias() += cn.Yc * cn.force;
 }
@@ -225,9 +221,7 @@ void FactoredMicaSolver::precondition(size_t bi, const Vec3List& r, Vec3List& z)
   start_correction(bi);
   add_forces(bi);
   warp_[bi].backward(z);
-  const Projection& p = *factored_[bi].projection;
-  for (int32_t i : p.nodes) z[i] = p.S[i] * z[i];
-  finish_correction(bi, z);
+  finish_correction(bi, z);  // the contact nodes exact and projected; PcgSolver projects the rest
 }
 
 void FactoredMicaSolver::apply_impulse_change(std::vector<SolverBody>& bodies, const ContactRows& rows,
@@ -284,8 +278,8 @@ void FactoredMicaSolver::solve_small_lcp(const ContactRows& rows, double toleran
   fs.tolerance = std::max(1e-3 * tolerance, 1e-13);
   // A prediction, solved again from its result every round: not worth 10^4 sweeps or a dense
   // Newton step on hundreds of rows (a fuzzed box under a tool, 78 frictional contacts that
-  // stall: 32-92 ms per call, mostly 234 x 234 factorizations; the tests' problems take at most
-  // 24 sweeps, the largest has 117 rows).
+  // stall spent 32-92 ms per call in 234 x 234 factorizations, found_frictional_stall_78_contacts;
+  // the tests' problems need far fewer sweeps, the largest, test_solve_allocations', 117 rows).
   fs.max_sweeps = 256;
   fs.max_newton_rows = 120;
   fs.deadline = deadline;

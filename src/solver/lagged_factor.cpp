@@ -21,14 +21,18 @@ void LaggedFactor::copy_system(Slot& slot, const BlockPattern& pattern, const Bl
       for (int c = 0; c < 3; ++c) slot.A[size_t(pattern.find(e.nodes[r], e.nodes[c]))] -= e.K.block<3, 3>(3 * r, 3 * c);
 }
 
+void LaggedFactor::require_halves(const Slot& slot) {
+  if (!slot.direct.by_hand())
+    fail(Errc::Unsupported, "this CHOLMOD made a factor other than a supernodal LL^T of int indices, which the "
+                            "factored sweep needs");
+}
+
 void LaggedFactor::factor(Slot& slot, const BlockPattern& pattern, const BlockValues& A, const Projection& projection,
                           const std::vector<Mat3>* node_rotation, const std::vector<TriangleStiffness>* extra) {
   if (!slot.direct.analyzed()) slot.direct.analyze(pattern);
   copy_system(slot, pattern, A, extra);  // what it is made from, kept for a saved state
   slot.direct.factorize(ProjectedSystem{pattern, slot.A, projection});
-  if (!slot.direct.by_hand())
-    fail(Errc::Unsupported, "this CHOLMOD made a factor other than a supernodal LL^T of int indices, which the "
-                            "factored sweep needs");
+  require_halves(slot);
   slot.projection = projection;
   if (node_rotation) slot.rotation = *node_rotation;
   else slot.rotation.clear();
@@ -223,6 +227,7 @@ void LaggedFactor::load_slot(Slot& slot, ByteReader& in, const BlockPattern& pat
   if (!fits) fail(Errc::Parse, "a saved factor does not fit its body's matrix pattern: corrupt state");
   slot.direct.analyze(pattern);
   slot.direct.factorize(ProjectedSystem{pattern, slot.A, slot.projection});
+  require_halves(slot);
 }
 
 void LaggedFactor::save(ByteWriter& out) const {

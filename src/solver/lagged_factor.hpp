@@ -98,6 +98,8 @@ class LaggedFactor {
   };
   void factor(Slot& slot, const BlockPattern& pattern, const BlockValues& A, const Projection& projection,
               const std::vector<Mat3>* node_rotation, const std::vector<TriangleStiffness>* extra);
+  // Throws Error(Unsupported) unless the slot's factor can be solved in halves (halves()).
+  static void require_halves(const Slot& slot);
   // slot.A = A - extra.
   static void copy_system(Slot& slot, const BlockPattern& pattern, const BlockValues& A,
                           const std::vector<TriangleStiffness>* extra);
