@@ -268,12 +268,14 @@ static int scaling(const char* csv_path, int max_tets, int32_t sweep) {
   char m[300];
   machine(m, sizeof m);
   fprintf(csv, "# bench_nidus --scaling: %s; MICA %s sweep\n", m, sweep_name(sweep));
-  fprintf(csv, "cells,nodes,tets,ms_median,ms_p95,iterations,ms_per_iteration,mem_B_per_tet,force_N\n");
+  fprintf(csv, "cells,nodes,tets,ms_median,ms_p95,iterations,ms_per_iteration,mem_B_per_tet,force_N,ms_rotations,"
+               "ms_elements,ms_solve\n");
   printf("# bench_nidus --scaling: %s\n", m);
   printf("# command: OMP_THREAD_LIMIT=1 OPENBLAS_NUM_THREADS=1 taskset -c 1 build/bench/bench_nidus --scaling %s %d %s\n", csv_path, max_tets,
          sweep_name(sweep));
-  printf("%6s %8s %8s %10s %10s %10s %12s %10s\n", "cells", "nodes", "tets", "median ms", "p95 ms", "iters",
-         "ms/iter", "B/tet");
+  /* The last three columns: mean ms per step of the stages rotations, elements and solve. */
+  printf("%6s %8s %8s %10s %10s %10s %12s %10s %9s %9s %9s\n", "cells", "nodes", "tets", "median ms", "p95 ms", "iters",
+         "ms/iter", "B/tet", "rot ms", "elem ms", "solve ms");
   const int sizes[] = {6, 8, 11, 14, 18, 22, 26, 30};
   for (int s = 0; s < 8; ++s) {
     const int n = sizes[s];
@@ -310,11 +312,14 @@ static int scaling(const char* csv_path, int max_tets, int32_t sweep) {
     if (press(world, body, tool, c, y0, 0.007, 0.1, 0.003, def.tool_radius + def.tool_margin, 0.01, 9, steps, &fig))
       return 1;
     fig.mem_step_b_per_tet = 1024.0 * (double)(rss1 - rss0) / fig.tets;
-    fprintf(csv, "%d,%d,%d,%.4f,%.4f,%.1f,%.5f,%.0f,%.5g\n", n, fig.nodes, fig.tets, fig.median, fig.p95,
-            fig.iterations, fig.iterations > 0 ? fig.median / fig.iterations : NAN, fig.mem_step_b_per_tet, fig.force);
+    const double* st = fig.stage_ms;
+    fprintf(csv, "%d,%d,%d,%.4f,%.4f,%.1f,%.5f,%.0f,%.5g,%.4f,%.4f,%.4f\n", n, fig.nodes, fig.tets, fig.median, fig.p95,
+            fig.iterations, fig.iterations > 0 ? fig.median / fig.iterations : NAN, fig.mem_step_b_per_tet, fig.force,
+            st[MICA_STAGE_ROTATIONS], st[MICA_STAGE_ELEMENTS], st[MICA_STAGE_SOLVE]);
     fflush(csv);
-    printf("%6d %8d %8d %10.3f %10.3f %10.1f %12.5f %10.0f\n", n, fig.nodes, fig.tets, fig.median, fig.p95,
-           fig.iterations, fig.iterations > 0 ? fig.median / fig.iterations : NAN, fig.mem_step_b_per_tet);
+    printf("%6d %8d %8d %10.3f %10.3f %10.1f %12.5f %10.0f %9.3f %9.3f %9.3f\n", n, fig.nodes, fig.tets, fig.median,
+           fig.p95, fig.iterations, fig.iterations > 0 ? fig.median / fig.iterations : NAN, fig.mem_step_b_per_tet,
+           st[MICA_STAGE_ROTATIONS], st[MICA_STAGE_ELEMENTS], st[MICA_STAGE_SOLVE]);
     fflush(stdout);
     fprintf(stderr, "progress %d %d\n", s + 1, 8);
     mica_world_destroy(world);

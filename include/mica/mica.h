@@ -175,8 +175,9 @@ typedef struct mica_world_def {
   double body_margin;      /**< m: contacts between bodies are made for gaps below this; default 0.001 */
   double body_friction;    /**< Coulomb coefficient between bodies, >= 0; default 0 */
   /* Since 0.3: */
-  int32_t warm_start;      /**< MICA: 1 starts each step's iteration from the last step's velocities
-                                and impulses (matched by persistent contact keys); 0 from zero; default 1 */
+  int32_t warm_start;      /**< MICA: 1 starts each step's iteration from the velocities extrapolated
+                                from the last two steps (since 0.6; the last step's before) and from
+                                its impulses (matched by persistent contact keys); 0 from zero; default 1 */
   int32_t reserved2;       /**< zero */
   double relaxation;       /**< MICA, Gauss-Seidel sweep: over-relaxation omega in (0, 2); default 1 (the paper) */
   /** Iterative solvers: > 0 stops the solve when the step has used this many milliseconds of

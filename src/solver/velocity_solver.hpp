@@ -34,7 +34,7 @@ enum class MicaSweep { GaussSeidel, Factored };
 struct SolverSettings {
   double tolerance = 1e-8;      // the stopping test's (each solver's header says on what)
   int32_t max_iterations = 200;
-  bool warm_start = true;       // MICA: start from the last step's velocities and impulses (else zero)
+  bool warm_start = true;       // MICA: start from the velocities the caller gives and the last impulses (else zero)
   int32_t pgs_sweeps = 1;       // MICA: PGS sweeps over the contact rows per iteration
   bool paper_norm = false;      // MICA: stop on the paper's 2-norm of the change of (v, lambda) instead
   double relaxation = 1.0;      // MICA: MBGS over-relaxation omega in (0, 2); 1 is the paper's Gauss-Seidel

@@ -18,6 +18,7 @@ BodyState::BodyState(const BodyModel& model) {
   const size_t n = model.fem.rest.size();
   x = model.fem.rest;
   v.assign(n, Vec3::Zero());
+  v_previous.assign(n, Vec3::Zero());
   node_forces.assign(n, Vec3::Zero());
   contact_impulse.assign(n, Vec3::Zero());
   bvh.build(x, model.surface);

@@ -52,6 +52,7 @@ struct BodyState {
   explicit BodyState(const BodyModel& model);
 
   Vec3List x, v;
+  Vec3List v_previous;          // v at the last step's start (v itself when the host set v): the warm start's trend
   Vec3List node_forces;        // persistent user loads, N
   bool has_node_forces = false;
   uint64_t lpc_version = 0;    // bumped when a constraint on this body is added or removed

@@ -58,6 +58,7 @@ void World::set_velocities(Id id, const Vec3List& v) {
   if (!b.is_dynamic()) fail(Errc::WrongState, b.name + " is static: it has no velocities to set");
   check_values(b, v, "velocities");
   b.v = v;
+  b.v_previous = v;  // no trend to extrapolate from velocities the host set
   if (recorder_) recorder_->write(RecordKind::SetVelocities, id, v);
 }
 

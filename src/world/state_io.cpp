@@ -9,8 +9,8 @@
 //   world    step statistics (the step counter), the re-linearisation's energy debt, the warm-start
 //            impulses by row key, the last step's contacts, rows and impulses (the contacts readout),
 //            pairs of bodies created overlapping
-//   bodies   positions, velocities, node forces, contact impulses, the rotations a step hands the
-//            next, and what the solver keeps for the body (its lagged factor: VelocitySolver::save_body)
+//   bodies   positions, velocities (now and at the last step's start), node forces, contact
+//            impulses, the rotations a step hands the next, and what the solver keeps for the body (its lagged factor: VelocitySolver::save_body)
 //   tools    poses (now and at the last step), velocities, force, torque, contact count, stiffness
 //   lpcs     prescribed velocity, reaction, handle (targets or grab offsets, pose, tool)
 //   devices  the force filter (moving average) and the last force sent
@@ -30,7 +30,7 @@ namespace mica {
 namespace {
 
 constexpr char kMagic[8] = {'M', 'I', 'C', 'A', 'S', 'T', 'A', 'T'};
-constexpr uint32_t kFormatVersion = 2;  // 2: the contacts' curvature impulses
+constexpr uint32_t kFormatVersion = 3;  // 2: the contacts' curvature impulses; 3: v_previous
 // Byte order and the size of a double: a state is read back only where it was written.
 constexpr uint32_t kLayout = 0x01020304u ^ uint32_t(sizeof(double) << 24);
 
@@ -119,7 +119,7 @@ std::string shape_difference(const Shape& saved, const Shape& here) {
 
 // What a restore reads for a body before it changes anything.
 struct BodyData {
-  Vec3List x, v, node_forces, contact_impulse, x_end;
+  Vec3List x, v, v_previous, node_forces, contact_impulse, x_end;
   uint8_t has_node_forces = 0;
   std::vector<Mat3> R, R_end;
   double u_start = 0, k_start = 0, u_end = 0;
@@ -212,6 +212,7 @@ std::vector<uint8_t> World::save_state() const {
   bodies_.for_each([&](Id, const Body& b) {
     out.put_vector(b.x);
     out.put_vector(b.v);
+    out.put_vector(b.v_previous);
     out.put_vector(b.node_forces);
     out.put(uint8_t(b.has_node_forces));
     out.put_vector(b.contact_impulse);
@@ -358,6 +359,7 @@ void World::restore_state(const uint8_t* data, size_t size) {
     const size_t n = size_t(b.fem.node_count()), e = b.R.size();
     in.get_vector(d.x, "a body's positions");
     in.get_vector(d.v, "a body's velocities");
+    in.get_vector(d.v_previous, "a body's last velocities");
     in.get_vector(d.node_forces, "a body's node forces");
     d.has_node_forces = in.get<uint8_t>("a body's node forces");
     in.get_vector(d.contact_impulse, "a body's contact impulses");
@@ -369,10 +371,10 @@ void World::restore_state(const uint8_t* data, size_t size) {
     d.u_end = in.get<double>("a body's energies");
     d.u_start_known = in.get<uint8_t>("a body's energies");
     in.get_vector(d.solver, "a body's solver state");
-    require(d.x.size() == n && d.v.size() == n && d.node_forces.size() == n && d.contact_impulse.size() == n &&
+    require(d.x.size() == n && d.v.size() == n && d.v_previous.size() == n && d.node_forces.size() == n && d.contact_impulse.size() == n &&
                 d.R.size() == e && d.R_end.size() == e && (d.x_end.empty() || d.x_end.size() == n),
             "a body's arrays do not match its node or tet count");
-    require(flat(d.x).allFinite() && flat(d.v).allFinite() && flat(d.node_forces).allFinite(),
+    require(flat(d.x).allFinite() && flat(d.v).allFinite() && flat(d.v_previous).allFinite() && flat(d.node_forces).allFinite(),
             "a body's positions, velocities or forces are not finite");
     solver_bodies.push_back({b.key, &b.fem, d.solver.data(), d.solver.size()});
   }
@@ -436,6 +438,7 @@ void World::restore_state(const uint8_t* data, size_t size) {
     BodyData& d = body_data[k++];
     b.x = d.x;  // the same size: copied in place (no allocation; a positions view stays valid)
     b.v = d.v;
+    b.v_previous = d.v_previous;
     b.node_forces.swap(d.node_forces);
     b.has_node_forces = d.has_node_forces != 0;
     b.contact_impulse.swap(d.contact_impulse);

@@ -81,7 +81,8 @@ Id World::add_body(const TetMesh& mesh, const BodySettings& settings, const Vec3
                                          std::to_string(q.slivers.front()) + "; worst aspect " +
                                          std::to_string(q.worst_aspect) + ". They slow iterative solvers.");
   if (!settings.is_static)
-    for (Vec3& u : body->v) u = velocity;
+    for (Vec3List* w : {&body->v, &body->v_previous})
+      for (Vec3& u : *w) u = velocity;
   if (pool_ && !settings.is_static) {
     body->element_colours = colour_elements(body->tets, body->fem.node_count(),
                                             block_size_for(int32_t(body->tets.size()), 16, 1024));
