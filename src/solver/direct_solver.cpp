@@ -68,9 +68,25 @@ void DirectSolver::analyze(const BlockPattern& pattern) {
       value_source_[size_t(&it.valueRef() - lower_.valuePtr())] = 9 * k + 3 * (col % 3) + row % 3;
     }
   projected_.resize(pattern.block_count());
+  // The fill-reducing ordering: AMD (CHOLMOD's default) or nested dissection (CHOLMOD's NESDIS over
+  // METIS), whichever fills less. On tet meshes nested dissection wins and more so the larger the
+  // mesh: 9.5 % fewer stored entries and 27 % fewer flops on the nidus, 28 % and 51 % on a 35k-tet
+  // cube (bench_factor). Both are deterministic, so a restored state factors the same bits.
+  cholmod_common& common = llt_.cholmod();
+  common.nmethods = 2;
+  common.method[0].ordering = CHOLMOD_AMD;
+  common.method[1].ordering = CHOLMOD_NESDIS;
+  common.postorder = 1;
   llt_.analyzePattern(lower_);
   analyzed_ = true;
 }
+
+int64_t DirectSolver::factor_entries() const {
+  const cholmod_factor* L = analyzed_ ? llt_.factor() : nullptr;
+  return L ? int64_t(L->is_super ? L->xsize : L->nzmax) : 0;
+}
+
+int DirectSolver::ordering() const { return analyzed_ && llt_.factor() ? llt_.factor()->ordering : 0; }
 
 void DirectSolver::factorize(const ProjectedSystem& sys) {
   const BlockPattern& p = sys.pattern;

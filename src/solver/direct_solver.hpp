@@ -39,6 +39,10 @@ class DirectSolver : public LinearSolver {
   // solved with the copy (a preconditioner's solve), else as solve_raw.
   void solve_one(const Eigen::Ref<const Eigen::VectorXd>& b, Eigen::VectorXd& x, bool single);
   int64_t factorizations() const { return factorizations_; }
+  // The analysed factor's stored entries (supernodal: dense blocks, zeros included) and the
+  // ordering chosen (CHOLMOD_AMD, CHOLMOD_NESDIS, ...); 0 before analyze.
+  int64_t factor_entries() const;
+  int ordering() const;
   // The hand-written solve bound to the last factorization (its halves and half columns), or
   // null when CHOLMOD made a factor of another kind.
   const SupernodalSolve* by_hand() const { return by_hand_.bound() ? &by_hand_ : nullptr; }
