@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: Apache-2.0 */
-/* What every benchmark prints beside its figures: a monotonic clock, a sort order for medians,
+/* What every benchmark prints beside its figures: a monotonic clock, the thread's CPU time, a sort order for medians,
  * and the machine it ran on (CPU, the CPUs it may use, the load). Header-only (static inline: a
  * benchmark takes what it needs); Linux. */
 #pragma once
@@ -12,6 +12,14 @@
 static inline double now_ms(void) {
   struct timespec t;
   clock_gettime(CLOCK_MONOTONIC, &t);
+  return 1e3 * (double)t.tv_sec + 1e-6 * (double)t.tv_nsec;
+}
+
+/* The calling thread's CPU time: what a step cost when the wall clock is polluted by other load
+ * (it leaves out time the thread waited, e.g. for a background factorization). */
+static inline double thread_cpu_ms(void) {
+  struct timespec t;
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
   return 1e3 * (double)t.tv_sec + 1e-6 * (double)t.tv_nsec;
 }
 
