@@ -176,6 +176,7 @@ mica_status press_scene_create(const press_scene_def* def, press_scene* s) {
   wd.mica_sweep = d->sweep;
   wd.tolerance = d->tolerance;
   wd.max_iterations = d->max_iterations;
+  wd.refactor_interval = d->refactor_interval;
   if (mica_world_create(&wd, &s->world) != MICA_OK)
     return fail(s, MICA_ERR_INVALID_ARGUMENT, "mica_world_create: %s", mica_world_last_error(NULL));
 

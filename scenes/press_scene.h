@@ -61,6 +61,8 @@ typedef struct press_scene_def {
   double density;         /* kg/m^3; default 1000 */
   double rayleigh_alpha;  /* 1/s; default 2 */
   double rayleigh_beta;   /* s; default 0 */
+  int32_t refactor_interval; /* MICA, factored sweep: refresh the factor every this many steps in
+                                the background (mica_world_def.refactor_interval); default 0 */
 } press_scene_def;
 
 typedef struct press_scene {
