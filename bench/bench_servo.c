@@ -2,11 +2,12 @@
 /* What one servo cycle costs, and how steady the 1 kHz period is, while the simulation thread
  * steps a large scene as fast as it can (the worst case for the servo thread's core).
  *
- * usage: bench_servo [seconds] [cells-per-side | mesh] [refactor interval]
+ * usage: bench_servo [seconds] [cells-per-side | mesh | idle] [refactor interval]
  *   a number: a cube of cells^3 x 6 tets (default 12: 10368), MICA's Gauss-Seidel sweep at 1e-4;
  *   a mesh (data/nidus/nidus.msh): bench_nidus's scene (scenes/press_scene.h), MICA's factored
  *   sweep at 1e-6, the factor refreshed every `refactor interval` steps on a background thread
- *   (default 4; 0: never), the sphere held by a simulated device 2 mm deep +- 1 mm at 1 Hz.
+ *   (default 4; 0: never), the sphere held by a simulated device 2 mm deep +- 1 mm at 1 Hz;
+ *   "idle": nothing steps (the machine's own floor: its timer and scheduler).
  * The servo thread (this one) asks for SCHED_FIFO and says whether it got it.
  */
 #define _GNU_SOURCE
@@ -57,13 +58,14 @@ static void* simulate(void* arg) {
 }
 
 static const char kUsage[] =
-    "usage: bench_servo [seconds] [cells-per-side | mesh] [refactor interval]\n"
+    "usage: bench_servo [seconds] [cells-per-side | mesh | idle] [refactor interval]\n"
     "What one servo cycle costs, and how steady the 1 kHz period is, while a simulation thread steps a\n"
     "scene as fast as it can.\n"
     "  seconds            how long it runs (default 10)\n"
     "  cells-per-side     a cube of cells^3 x 6 tets (default 12: 10368), MICA's Gauss-Seidel sweep at 1e-4\n"
     "  mesh               a mesh file (data/nidus/nidus.msh): bench_nidus's scene, MICA's factored sweep at\n"
     "                     1e-6, the sphere held by a simulated device 2 mm deep +- 1 mm at 1 Hz\n"
+    "  idle               nothing steps: the machine's own floor for the servo loop\n"
     "  refactor interval  with a mesh: refresh the factor every this many steps in the background\n"
     "                     (default 4; 0: never)\n"
     "  --help             this text\n"
@@ -74,8 +76,10 @@ int main(int argc, char** argv) {
   if (cli >= 0) return cli;
   const double seconds = argc > 1 ? atof(argv[1]) : 10.0;
   const char* scene_arg = argc > 2 ? argv[2] : "12";
-  const int use_mesh = strspn(scene_arg, "0123456789") != strlen(scene_arg);
-  const int32_t cells = use_mesh ? 0 : atoi(scene_arg);
+  /* "idle": the default cube built but never stepped: the machine's own floor for the servo loop. */
+  const int idle = strcmp(scene_arg, "idle") == 0;
+  const int use_mesh = !idle && strspn(scene_arg, "0123456789") != strlen(scene_arg);
+  const int32_t cells = use_mesh ? 0 : idle ? 12 : atoi(scene_arg);
   const int32_t refactor = argc > 3 ? atoi(argv[3]) : 4;
   mica_world* world = NULL;
   mica_device_def dd = mica_device_def_default();
@@ -123,14 +127,15 @@ int main(int argc, char** argv) {
     tets = scene.tets;
     dd.tool = scene.tool;
     dd.trajectory = press;
-    snprintf(what, sizeof what, "a cube of %d tets: MICA Gauss-Seidel sweep, tol 1e-4", (int)tets);
+    snprintf(what, sizeof what, idle ? "nothing (idle)" : "a cube of %d tets: MICA Gauss-Seidel sweep, tol 1e-4",
+             (int)tets);
   }
   mica_device_id device;
   if (mica_device_create(world, &dd, &device) != MICA_OK) return 1;
 
   sim s = {world, 1, 0};
-  pthread_t thread;
-  pthread_create(&thread, NULL, simulate, &s); /* before the servo asks for SCHED_FIFO: not inherited */
+  pthread_t thread = 0;
+  if (!idle) pthread_create(&thread, NULL, simulate, &s); /* before the servo asks for SCHED_FIFO: not inherited */
   /* A haptic host runs its servo thread at a real-time priority where it may (CAP_SYS_NICE or an
    * rtprio limit); without it, the kernel's fair scheduler. */
   struct sched_param prio = {.sched_priority = 80};
@@ -158,7 +163,7 @@ int main(int argc, char** argv) {
     }
   }
   atomic_store(&s.running, 0);
-  pthread_join(thread, NULL);
+  if (!idle) pthread_join(thread, NULL);
   long late_half = 0;
   for (long k = 0; k < cycles; ++k) late_half += late[k] > 0.5;
   qsort(late, (size_t)cycles, sizeof(double), cmp);
