@@ -184,7 +184,8 @@ int main(int argc, char** argv) {
          period[1 + (long)(m * 0.99)], period[1 + (long)(m * 0.999)], period[cycles - 1]);
   printf("late (ms):            median %.3f  p99 %.3f  p99.9 %.3f  max %.3f   (behind the 1 ms schedule); "
          "%ld of %ld cycles late by more than 0.5 ms\n",
-         late[cycles / 2], late[(long)(cycles * 0.99)], late[(long)(cycles * 0.999)], late[cycles - 1], late_half, cycles);
+         late[cycles / 2], late[(long)(cycles * 0.99)], late[(long)(cycles * 0.999)], late[cycles - 1], late_half,
+         cycles);
   free(cost);
   free(period);
   free(late);

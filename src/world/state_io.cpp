@@ -10,7 +10,8 @@
 //            impulses by row key, the last step's contacts, rows and impulses (the contacts readout),
 //            pairs of bodies created overlapping
 //   bodies   positions, velocities (now and at the last step's start), node forces, contact
-//            impulses, the rotations a step hands the next, and what the solver keeps for the body (its lagged factor: VelocitySolver::save_body)
+//            impulses, the rotations a step hands the next, and what the solver keeps for the body
+//            (its lagged factor: VelocitySolver::save_body)
 //   tools    poses (now and at the last step), velocities, force, torque, contact count, stiffness
 //   lpcs     prescribed velocity, reaction, handle (targets or grab offsets, pose, tool)
 //   devices  the force filter (moving average) and the last force sent
@@ -371,10 +372,11 @@ void World::restore_state(const uint8_t* data, size_t size) {
     d.u_end = in.get<double>("a body's energies");
     d.u_start_known = in.get<uint8_t>("a body's energies");
     in.get_vector(d.solver, "a body's solver state");
-    require(d.x.size() == n && d.v.size() == n && d.v_previous.size() == n && d.node_forces.size() == n && d.contact_impulse.size() == n &&
-                d.R.size() == e && d.R_end.size() == e && (d.x_end.empty() || d.x_end.size() == n),
+    require(d.x.size() == n && d.v.size() == n && d.v_previous.size() == n && d.node_forces.size() == n &&
+                d.contact_impulse.size() == n && d.R.size() == e && d.R_end.size() == e && (d.x_end.empty() || d.x_end.size() == n),
             "a body's arrays do not match its node or tet count");
-    require(flat(d.x).allFinite() && flat(d.v).allFinite() && flat(d.v_previous).allFinite() && flat(d.node_forces).allFinite(),
+    require(flat(d.x).allFinite() && flat(d.v).allFinite() && flat(d.v_previous).allFinite() &&
+                flat(d.node_forces).allFinite(),
             "a body's positions, velocities or forces are not finite");
     solver_bodies.push_back({b.key, &b.fem, d.solver.data(), d.solver.size()});
   }
