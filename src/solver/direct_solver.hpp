@@ -39,10 +39,13 @@ class DirectSolver : public LinearSolver {
   // solved with the copy (a preconditioner's solve), else as solve_raw.
   void solve_one(const Eigen::Ref<const Eigen::VectorXd>& b, Eigen::VectorXd& x, bool single);
   int64_t factorizations() const { return factorizations_; }
-  // The analysed factor's stored entries (supernodal: dense blocks, zeros included) and the
-  // ordering chosen (CHOLMOD_AMD, CHOLMOD_NESDIS, ...); 0 before analyze.
+  // The analysed factor's stored entries (supernodal: dense blocks, zeros included), the ordering
+  // chosen (CHOLMOD_AMD, CHOLMOD_NESDIS, ...) and CHOLMOD's counts of the nonzeros in L and of the
+  // flops of one factorization; 0 before analyze.
   int64_t factor_entries() const;
   int ordering() const;
+  double factor_nonzeros() const { return nonzeros_; }
+  double factor_flops() const { return flops_; }
   // The hand-written solve bound to the last factorization (its halves and half columns), or
   // null when CHOLMOD made a factor of another kind.
   const SupernodalSolve* by_hand() const { return by_hand_.bound() ? &by_hand_ : nullptr; }
@@ -64,6 +67,7 @@ class DirectSolver : public LinearSolver {
   Vec3List rhs_, tmp_, check_;
   Eigen::MatrixXd y_flat_;
   bool analyzed_ = false;
+  double nonzeros_ = 0, flops_ = 0;  // CHOLMOD's counts from the analysis
   int64_t factorizations_ = 0;
 };
 
