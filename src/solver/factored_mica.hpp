@@ -52,7 +52,8 @@ struct FactoredBodyCache {
 // Allocation: solve() allocates only while its workspaces grow: on the first solves, when the
 // contact rows or their nodes change in number (W, Y, the small problem's and the active set's
 // workspaces are sized by them; the active set's decompositions, one per size, only grow with
-// them), and for the half columns of a node new to contact or of a factor made or adopted.
+// them), and for the half columns of a node new to contact (a factor made or adopted remakes
+// those it has in the same buffers).
 // Otherwise it makes no heap allocation (tests/solver/test_solve_allocations.cpp).
 class FactoredMicaSolver : public CachingVelocitySolver<FactoredBodyCache> {
  public:

@@ -2,15 +2,12 @@
 #include "solver/lagged_factor.hpp"
 
 #include <algorithm>
-#include <future>
 
 namespace mica {
 
 LaggedFactor::LaggedFactor() : active_(std::make_unique<Slot>()), pending_(std::make_unique<Slot>()) {}
 
-LaggedFactor::~LaggedFactor() {
-  if (job_.valid()) job_.wait();
-}
+LaggedFactor::~LaggedFactor() { worker_.wait(); }
 
 void LaggedFactor::copy_system(Slot& slot, const BlockPattern& pattern, const BlockValues& A,
                                const std::vector<TriangleStiffness>* extra) {
@@ -41,7 +38,7 @@ void LaggedFactor::factor(Slot& slot, const BlockPattern& pattern, const BlockVa
 }
 
 LaggedFactor::Slot& LaggedFactor::writable(std::unique_ptr<Slot>& slot) {
-  const bool saved = slot.get() == saved_.active || (slot.get() == saved_.pending && saved_.job.valid());
+  const bool saved = slot.get() == saved_.active || (slot.get() == saved_.pending && saved_.in_flight);
   if (!open_ || !saved) return *slot;
   std::unique_ptr<Slot>& keep = kept_[0] ? kept_[1] : kept_[0];
   keep = std::move(slot);
@@ -54,7 +51,7 @@ void LaggedFactor::clear_columns() {
     columns_kept_.swap(columns_);
     columns_cleared_ = true;
   }
-  columns_.clear();
+  columns_id_ = ++last_columns_id_;  // never given before: every cached column is stale
 }
 
 void LaggedFactor::refactor_now(const BlockPattern& pattern, const BlockValues& A, const Projection& projection,
@@ -69,25 +66,26 @@ void LaggedFactor::refactor_now(const BlockPattern& pattern, const BlockValues& 
 }
 
 void LaggedFactor::adopt() {
-  try {
-    job_.get();
-  } catch (...) {
-    job_ = {};
-    return;  // the copied system did not factor (not positive definite): keep the one in use
-  }
-  job_ = {};
+  worker_.wait();
+  in_flight_ = false;
+  if (worker_.error()) return;  // the copied system did not factor (not positive definite): keep the one in use
   // Refactored since it was launched, or a factor the halves cannot use (see factor()).
   if (pending_->born < active_->born || !pending_->direct.by_hand()) return;
   std::swap(active_, pending_);
   clear_columns();
 }
 
+void LaggedFactor::factor_pending(void* self) {
+  const LaggedFactor& f = *static_cast<const LaggedFactor*>(self);
+  Slot& slot = *f.job_slot_;  // the stepping thread leaves it alone until adopt()
+  slot.direct.factorize(ProjectedSystem{*f.job_pattern_, slot.A, slot.projection});
+}
+
 void LaggedFactor::launch(const BlockPattern& pattern) {
-  Slot& slot = *pending_;
-  const BlockPattern* p = &pattern;  // fixed for the body's life, which outlives the job
-  job_ = std::async(std::launch::async, [&slot, p] {
-           slot.direct.factorize(ProjectedSystem{*p, slot.A, slot.projection});
-         }).share();
+  job_slot_ = pending_.get();  // pending_ itself may be moved (a rollback) while the job runs
+  job_pattern_ = &pattern;      // fixed for the body's life, which outlives the job
+  in_flight_ = true;
+  worker_.start(&LaggedFactor::factor_pending, this);
 }
 
 void LaggedFactor::update(const FemModel& fem, const Key& key, const BlockValues& A, const Projection& projection,
@@ -97,9 +95,9 @@ void LaggedFactor::update(const FemModel& fem, const Key& key, const BlockValues
   node_count_ = fem.node_count();
   if (!(key == key_) || !active_->direct.analyzed()) {
     // A new step size, damping or constraint set: what is in flight is for another system.
-    if (job_.valid()) {
-      job_.wait();
-      job_ = {};
+    if (in_flight_) {
+      worker_.wait();
+      in_flight_ = false;
     }
     launch_staged_ = false;
     // throws on failure: the key stays, the next step retries
@@ -110,8 +108,8 @@ void LaggedFactor::update(const FemModel& fem, const Key& key, const BlockValues
     return;
   }
   if (interval <= 0) return;
-  if (job_.valid() && step_ - launched_at_ >= interval) adopt();
-  if (!job_.valid() && !launch_staged_ && step_ > launched_at_) {
+  if (in_flight_ && step_ - launched_at_ >= interval) adopt();
+  if (!in_flight_ && !launch_staged_ && step_ > launched_at_) {
     // The copies the worker factors: *pending_ is free, or holds the factor replaced just now
     // (in a step that may be undone, that one moves aside: writable).
     Slot& slot = writable(pending_);
@@ -142,7 +140,8 @@ void LaggedFactor::begin() {
   saved_.factorizations = factorizations_;
   saved_.active = active_.get();
   saved_.pending = pending_.get();
-  saved_.job = job_;
+  saved_.in_flight = in_flight_;
+  saved_.columns_id = columns_id_;
   columns_cleared_ = false;
   columns_added_.clear();
   open_ = true;
@@ -155,9 +154,8 @@ void LaggedFactor::commit() {
     if (k && !spare_) spare_ = std::move(k);
     k.reset();
   }
-  columns_kept_.clear();
   columns_added_.clear();
-  saved_.job = {};
+  saved_.in_flight = false;
   saved_.active = saved_.pending = nullptr;
   if (launch_staged_) {
     launch_staged_ = false;
@@ -184,8 +182,8 @@ void LaggedFactor::rollback() {
   active_ = std::move(active);
   pending_ = std::move(pending);
   spare_ = std::move(spare);
-  job_ = saved_.job;
-  saved_.job = {};
+  in_flight_ = saved_.in_flight;  // its job is over or still running: no job started since begin()
+  saved_.in_flight = false;
   saved_.active = saved_.pending = nullptr;
   key_ = saved_.key;
   step_ = saved_.step;
@@ -196,7 +194,7 @@ void LaggedFactor::rollback() {
   } else {
     for (int32_t node : columns_added_) columns_.erase(node);
   }
-  columns_kept_.clear();
+  columns_id_ = saved_.columns_id;
   columns_added_.clear();
   columns_cleared_ = false;
 }
@@ -237,7 +235,7 @@ void LaggedFactor::save(ByteWriter& out) const {
   out.put(factorizations_);
   out.put(node_count_);
   const bool active = active_->direct.analyzed();
-  const bool in_flight = job_.valid();
+  const bool in_flight = in_flight_;
   out.put(uint8_t(active));
   out.put(uint8_t(in_flight));
   if (active) save_slot(*active_, out);
@@ -260,9 +258,7 @@ void LaggedFactor::load(ByteReader& in, const BlockPattern& pattern) {
   if (active) load_slot(*active_, in, pattern);
   if (in_flight) {
     load_slot(*pending_, in, pattern);
-    std::promise<void> done;  // factored now: adopted on the schedule it was launched with
-    done.set_value();
-    job_ = done.get_future().share();
+    in_flight_ = true;  // factored now (the worker has no job): adopted on the schedule it was launched with
   }
   // Cached columns in a state of 0.6's first builds (dense, 3n x 3 each): read past, made again.
   const uint64_t count = in.get<uint64_t>("the cached columns");
@@ -286,9 +282,12 @@ void LaggedFactor::solve(const Vec3List& in, Vec3List& out, bool single) const {
 
 void LaggedFactor::prepare_columns(const std::vector<int32_t>& nodes) {
   for (int32_t node : nodes) {
-    if (columns_.count(node)) continue;
-    if (open_) columns_added_.push_back(node);
-    active_->direct.by_hand()->half_columns(3 * node, columns_[node]);
+    const auto [at, added] = columns_.try_emplace(node);
+    CachedColumns& c = at->second;
+    if (c.made_for == columns_id_) continue;
+    if (added && open_) columns_added_.push_back(node);
+    active_->direct.by_hand()->half_columns(3 * node, c.h);
+    c.made_for = columns_id_;
   }
 }
 

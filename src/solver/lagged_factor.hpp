@@ -9,13 +9,15 @@
 // Refactored at once when the step, the damping or the constraint set changed; and, with a
 // refresh interval L > 0, every L steps in the background: the system of step k is copied and
 // factored on a worker thread while steps k .. k+L-1 run, and adopted at step k+L. Adoption is in
-// lockstep (the step waits if the worker is late), so results never depend on timing.
+// lockstep (the step waits if the worker is late), so results never depend on timing. The worker
+// is one thread per factor, "mica-factor", made at the first refresh and kept until the factor
+// is destroyed: a refresh makes no thread and allocates nothing on the stepping thread.
 #pragma once
 #include <Eigen/Dense>
-#include <future>
 #include <memory>
 #include <unordered_map>
 
+#include "core/background_thread.hpp"
 #include "core/byte_stream.hpp"
 #include "fem/fem_model.hpp"
 #include "solver/direct_solver.hpp"
@@ -58,7 +60,7 @@ class LaggedFactor {
   void prepare_columns(const std::vector<int32_t>& nodes);
   // A prepared node's half columns H = L^-1 P E (E its unit columns; K_f = P^T L L^T P), kept
   // until the factor changes: K_f^-1 E = P^T L^-T H, E^T K_f^-1 E' = H^T H'.
-  const SupernodalSolve::HalfColumns& columns(int32_t node) const { return columns_.at(node); }
+  const SupernodalSolve::HalfColumns& columns(int32_t node) const { return columns_.at(node).h; }
   // The factor in use's solve in halves (SupernodalSolve::forward .. backward).
   const SupernodalSolve& halves() const { return *active_->direct.by_hand(); }
   // Q_i = R_i R_f,i^T: how far node i turned since the factor's step (R_i: now).
@@ -105,6 +107,7 @@ class LaggedFactor {
                           const std::vector<TriangleStiffness>* extra);
   void adopt();
   void launch(const BlockPattern& pattern);  // the background factorization of *pending_
+  static void factor_pending(void* self);      // the worker's job
   // `slot` (active_ or pending_), or, in a step between begin() and its end, a spare in its place
   // when begin() saw it in use or in flight: rollback() puts that one back as it was.
   Slot& writable(std::unique_ptr<Slot>& slot);
@@ -114,14 +117,17 @@ class LaggedFactor {
 
   Key key_;
   std::unique_ptr<Slot> active_, pending_;
-  std::shared_future<void> job_;  // the background factorization of *pending_
+  bool in_flight_ = false;  // *pending_ is being (or was) factored by worker_, not yet adopted
+  Slot* job_slot_ = nullptr;  // the worker's job: the slot and pattern it factors
+  const BlockPattern* job_pattern_ = nullptr;
   // begin() .. commit() / rollback().
   struct Saved {
     Key key;
     int64_t step = 0, launched_at = -1, factorizations = 0;
     const Slot* active = nullptr;
     const Slot* pending = nullptr;
-    std::shared_future<void> job;
+    bool in_flight = false;
+    uint64_t columns_id = 0;
   } saved_;
   bool open_ = false;
   std::unique_ptr<Slot> kept_[2], spare_;  // slots of begin() replaced in the step; a free one
@@ -130,13 +136,22 @@ class LaggedFactor {
   std::vector<Mat3> staged_rotation_;
   int64_t staged_born_ = -1;
   bool columns_cleared_ = false;
-  std::unordered_map<int32_t, SupernodalSolve::HalfColumns> columns_kept_;
   std::vector<int32_t> columns_added_;
   int64_t step_ = 0, launched_at_ = -1;
   int64_t factorizations_ = 0;
   int32_t node_count_ = 0;
   mutable Eigen::VectorXd x_;
-  std::unordered_map<int32_t, SupernodalSolve::HalfColumns> columns_;
+  // The half columns, each marked with the factor it was made from: a new factor marks them all
+  // stale instead of freeing them, and prepare_columns() makes them again in the same buffers (a
+  // refresh adopted allocates nothing). In a step that may be undone, the first new factor swaps
+  // in the other map (kept: stale marks, buffers to reuse), and a rollback swaps back.
+  struct CachedColumns {
+    SupernodalSolve::HalfColumns h;
+    uint64_t made_for = 0;  // a columns_id_
+  };
+  std::unordered_map<int32_t, CachedColumns> columns_, columns_kept_;
+  uint64_t columns_id_ = 1, last_columns_id_ = 1;  // the factor in use's mark; the last one given
+  BackgroundThread worker_{"mica-factor"};  // last: destroyed (joined) before the slots it factors
 };
 
 // The warped preconditioner z = Q K_f^-1 Q^T r (Q per node, see LaggedFactor::turn).
