@@ -85,10 +85,11 @@ static long status_kb(const char* key) {
   } while (0)
 
 typedef struct {
-  double median, p95, max, mean, cpu_median, iterations, mem_create_b_per_tet, mem_step_b_per_tet, force;
+  double median, p95, max, mean, cpu_median, iterations, solves, mem_create_b_per_tet, mem_step_b_per_tet, force;
   double reversals; /* fraction of contact nodes' velocity changes that reverse from step to step */
   double stage_ms[MICA_STAGE_COUNT]; /* mean wall-clock ms per timed step in each stage */
   int32_t nodes, tets, capped, contacts;
+  int32_t factorizations; /* made or started in the background, over the timed steps */
 } figures;
 
 /* Steps a world with a sphere pressing from `y0` down by `depth` at `speed`, then moving up
@@ -105,8 +106,9 @@ static int press(mica_world* world, mica_body_id body, mica_tool_id tool, const 
   const size_t n3 = 3 * (size_t)out->nodes;
   double *x = malloc(sizeof(double) * n3), *v = malloc(sizeof(double) * n3), *v_last = calloc(n3, sizeof(double)),
          *dv_last = calloc(n3, sizeof(double));
-  long iterations = 0, changes = 0, reversals = 0;
+  long iterations = 0, solves = 0, changes = 0, reversals = 0;
   out->capped = 0;
+  out->factorizations = 0;
   for (int k = 0; k < warmup + steps; ++k) {
     const double t = (k + 1) * dt, t_in = depth / speed;
     const double travel = t < t_in ? speed * t : depth + wobble * sin(2 * M_PI * (t - t_in));
@@ -139,6 +141,8 @@ static int press(mica_world* world, mica_body_id body, mica_tool_id tool, const 
     cpu[k - warmup] = cpu_elapsed;
     for (int g = 0; g < MICA_STAGE_COUNT; ++g) out->stage_ms[g] += st.stages[g].ms_last_step / steps;
     iterations += st.solver_iterations;
+    solves += st.solves;
+    out->factorizations += st.factorizations;
     if (!st.converged) ++out->capped;
   }
   double f[3];
@@ -153,6 +157,7 @@ static int press(mica_world* world, mica_body_id body, mica_tool_id tool, const 
   out->cpu_median = quantile(cpu, steps, 0.5);
   free(cpu);
   out->iterations = (double)iterations / steps;
+  out->solves = (double)solves / steps;
   out->reversals = changes ? (double)reversals / (double)changes : 0;
   free(ms);
   free(x);
@@ -247,6 +252,10 @@ static int nidus(const char* path, const mica_world_def* wd, int steps, int warm
   printf("mean ms/step          %.3f\n", fig.mean);
   printf("median CPU ms/step    %.3f (the stepping thread's CPU time: less polluted by other load)\n", fig.cpu_median);
   printf("iterations/step       %.1f (mean over timed steps; %d stopped at the cap)\n", fig.iterations, fig.capped);
+  printf("solves/step           %.2f (velocity solves: the factored sweep's rounds, each solving every body)\n",
+         fig.solves);
+  printf("factorizations        %d in the %d timed steps (made, or started in the background)\n", fig.factorizations,
+         steps);
   printf("tool force            %.4f N, %d contacts at the end\n", fig.force, fig.contacts);
   /* Where a step's time goes (the step's own stage timers; the re-linearisation's check counts in rotations). */
   static const char* stage_names[MICA_STAGE_COUNT] = {"loads", "rotations", "elements", "damping", "constraints",

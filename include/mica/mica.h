@@ -200,7 +200,8 @@ typedef struct mica_world_def {
   int32_t relinearise_max; /**< at most this many solves per step for that; < 2 turns the check off; default 8 */
   /** MICA_SWEEP_FACTORED on co-rotational bodies: every this many solves (one per
    *  step, more when a step is re-linearised) the factor is refreshed from the current system:
-   *  copied, factored on a background thread (one per body) while the steps go on, and used from
+   *  copied, factored on a background thread (one per body, "mica-factor", made at its first
+   *  refresh and kept until the world is destroyed) while the steps go on, and used from
    *  that many solves later (in lockstep: the step waits for a late factorization, so results do
    *  not depend on timing). Meant for bodies that keep turning far from the factor's shape; on the
    *  nidus benchmark (a tool crushing a few elements) it did not pay reliably (0.83-1.29x in
@@ -1146,6 +1147,14 @@ typedef struct mica_world_stats {
   /* Since 0.5: */
   int32_t contacts;              /**< contacts the last step made (tool and body features closer than their margins) */
   int32_t body_contacts;         /**< of them, between two bodies (or a body and a static body) */
+  /* Since 0.6: */
+  /** Velocity solves of the last step: the factored sweep's rounds (each solves every body's
+   *  velocities with the contact impulses, or the predicted contact set, held), 1 per solve for
+   *  the other solvers; more when the step was re-linearised (mica_world_def.relinearise_tolerance). */
+  int32_t solves;
+  /** Numeric factorizations the last step made, or started in the background
+   *  (mica_world_def.refactor_interval), summed over bodies: the steps that paid for one. */
+  int32_t factorizations;
 } mica_world_stats;
 
 /** Copies the statistics of the last step and since creation into `out`, writing at most

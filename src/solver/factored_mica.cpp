@@ -398,6 +398,7 @@ SolveReport FactoredMicaSolver::solve(const SolveContext& ctx, std::vector<Solve
       may_refactor = false;
     }
     ++outer;
+    ++report.solves;
     // Velocities for the current impulses: A v = b + G^T lambda on the free directions. While the
     // impulses still move, a hundredth of their last change is accuracy enough (inexact Newton);
     // near the end the solves aim a little below the tolerance, so the outer test is not starved.

@@ -308,6 +308,7 @@ SolveReport FactoredMicaSolver::solve_active_set(const SolveContext& ctx, std::v
       have_pair = false;
     }
     ++outer;
+    ++report.solves;
     lambda = lambda_next_;
     choose_equalities(rows, lambda);
     const int32_t cap = may_refactor ? std::max(1, settings.refactor_after - report.iterations)

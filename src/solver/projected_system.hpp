@@ -12,6 +12,7 @@ namespace mica {
 // (velocity_solver.hpp); MICA's loops also fill the terms of their stopping test.
 struct SolveReport {
   int32_t iterations = 0;
+  int32_t solves = 0;   // velocity solves: the factored sweep's rounds (0: the solver counts none, the world counts 1)
   double residual = 0;  // ||P y - r|| / ||r|| of the projected system (0 when r = 0); a velocity solve: its worst measure
   bool converged = true;
   bool out_of_time = false;  // stopped at the time budget (converged is then false)

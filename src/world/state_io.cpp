@@ -31,7 +31,7 @@ namespace mica {
 namespace {
 
 constexpr char kMagic[8] = {'M', 'I', 'C', 'A', 'S', 'T', 'A', 'T'};
-constexpr uint32_t kFormatVersion = 3;  // 2: the contacts' curvature impulses; 3: v_previous
+constexpr uint32_t kFormatVersion = 4;  // 2: the contacts' curvature impulses; 3: v_previous; 4: solves, factorizations
 // Byte order and the size of a double: a state is read back only where it was written.
 constexpr uint32_t kLayout = 0x01020304u ^ uint32_t(sizeof(double) << 24);
 
@@ -145,7 +145,7 @@ static_assert(sizeof(BodyPoint) == 6 * 4 + 3 * 8, "BodyPoint has padding");
 static_assert(sizeof(Contact) == 8 + 2 * sizeof(BodyPoint) + 3 * sizeof(Vec3) + 2 * 8 + 4 * 4 + 8, "Contact has padding");
 static_assert(sizeof(RowTerm) == 2 * 4 + 8, "RowTerm has padding");
 static_assert(sizeof(StageStats) == 2 * 4 + 3 * 8, "StageStats has padding");
-static_assert(sizeof(WorldStats) == 8 + kStageCount * sizeof(StageStats) + 2 * 8 + 4 + 2 * 1 + 2 * 1,
+static_assert(sizeof(WorldStats) == 8 + kStageCount * sizeof(StageStats) + 2 * 8 + 4 + 2 * 1 + 2 * 1 + 2 * 4,
               "WorldStats has padding");
 
 struct LpcData {

@@ -30,6 +30,8 @@ struct WorldStats {
   bool converged = true;
   bool out_of_time = false;  // a solve stopped at WorldSettings::time_budget_ms
   uint8_t unused[2] = {};
+  int32_t solver_solves = 0;    // velocity solves (SolveReport::solves, at least 1 per solve)
+  int32_t factorizations = 0;   // numeric factorizations made or started in the background
 };
 
 // Runs a stage if the plan holds it, timing it into the stats.

@@ -108,6 +108,7 @@ void World::advance(double h) {
   StepContext ctx = begin_step(h);
   const Plan& plan = ctx.plan;
   stats_.solver_iterations = 0;
+  stats_.solver_solves = 0;
   stats_.solver_residual = 0;
   stats_.converged = true;
   stats_.out_of_time = false;
@@ -137,8 +138,10 @@ void World::advance(double h) {
   stage.run(Stage::Constraints, plan.constraints, [&] {
     for (Body* b : ctx.dynamic) build_projection(ctx, *b);
   });
+  const int64_t factored_before = factorizations(ctx);
   stage.run(Stage::Solve, plan.solve, [&] { solve(ctx); });
   if (plan.rotations && plan.solve) relinearise(ctx, stage);
+  stats_.factorizations = int32_t(factorizations(ctx) - factored_before);
   stage.run(Stage::Integrate, plan.integrate, [&] {
     for (Body* b : ctx.dynamic)
       for (size_t i = 0; i < b->x.size(); ++i) b->x_next[i] = b->x[i] + h * b->v_next[i];
@@ -474,8 +477,15 @@ void World::compute_forces(const StepContext& ctx) {
   });
 }
 
+int64_t World::factorizations(const StepContext& ctx) const {
+  int64_t n = 0;
+  for (const Body* b : ctx.dynamic) n += solver_->factorizations(b->key);
+  return n;
+}
+
 void World::record(const SolveReport& report) {
   stats_.solver_iterations += report.iterations;
+  stats_.solver_solves += std::max(1, report.solves);
   // A NaN residual must show, not vanish in a max.
   if (!(report.residual <= stats_.solver_residual)) stats_.solver_residual = report.residual;
   stats_.converged = stats_.converged && report.converged;

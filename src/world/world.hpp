@@ -249,6 +249,8 @@ class World {
   void start_rotations(const StepContext& ctx, Body& b) const;
   void relinearise(const StepContext& ctx, StageRunner& stage);
   void record(const SolveReport& report);
+  // Numeric factorizations the solver has made of the step's bodies so far (the stats' per step).
+  int64_t factorizations(const StepContext& ctx) const;
   void check_finite(const StepContext& ctx) const;
   void compute_forces(const StepContext& ctx);
   void check_forces() const;

@@ -24,6 +24,8 @@
 
 #include <mica/mica.h>
 
+#include "press_scene.h"
+
 /* ------------------------------------------------------------------------------------------ */
 /* Helpers                                                                                     */
 
@@ -966,6 +968,64 @@ static void test_stats(void** state) {
   mica_world_destroy(w);
 }
 
+/* The stats' solves and factorizations, per step of a sphere pressed into a small co-rotational
+ * cube: the exact solver factors every step (a new matrix each step) in one solve per Solve
+ * stage run; the factored sweep factors at the first solve, then only when a solve drags on
+ * (100 iterations) or, with a refresh interval L, at solves 2, 2 + L, 2 + 2L, ... (started in
+ * the background, adopted L solves later); its solves are its rounds, at least one per Solve
+ * stage run and at most one per iteration. */
+static void test_stats_count_solves_and_factorizations(void** state) {
+  (void)state;
+  static const struct {
+    const char* name;
+    int32_t solver, refactor_interval;
+  } cases[] = {
+      {"exact", MICA_SOLVER_DIRECT, 0},
+      {"factored sweep", MICA_SOLVER_MICA, 0},
+      {"factored sweep, refreshed every 3 steps", MICA_SOLVER_MICA, 3},
+  };
+  for (size_t c = 0; c < sizeof cases / sizeof cases[0]; ++c) {
+    press_scene_def def = press_scene_def_default();
+    def.cells = 4;
+    def.solver = cases[c].solver;
+    def.tolerance = 1e-8;
+    def.load_time = 0.1;
+    def.hold_time = 0.1;
+    def.refactor_interval = cases[c].refactor_interval;
+    press_scene s;
+    if (press_scene_create(&def, &s) != MICA_OK) fail_msg("%s", s.error);
+    int32_t most_contacts = 0, most_solves = 0;
+    for (int32_t k = 1; k <= s.steps; ++k) {
+      int32_t contacts = 0;
+      if (press_scene_step(&s, k, NULL, &contacts) != MICA_OK) fail_msg("%s", s.error);
+      const mica_world_stats st = stats_of(s.world);
+      const int32_t solve_runs = st.stages[MICA_STAGE_SOLVE].runs_last_step;
+      int32_t factors;
+      if (cases[c].solver == MICA_SOLVER_DIRECT) {
+        assert_int_equal(st.solves, solve_runs);
+        factors = solve_runs;
+      } else {
+        assert_true(st.solves >= solve_runs);
+        assert_true(st.solves <= st.solver_iterations);
+        const int32_t interval = cases[c].refactor_interval;
+        factors = k == 1 || st.solver_iterations >= 100;
+        for (int64_t n = st.stages[MICA_STAGE_SOLVE].runs_total - solve_runs + 1;
+             n <= st.stages[MICA_STAGE_SOLVE].runs_total; ++n)
+          factors += interval > 0 && n >= 2 && (n - 2) % interval == 0;
+      }
+      if (st.factorizations != factors)
+        fail_msg("%s, step %d: %d factorizations, expected %d (%d iterations, %d solves)", cases[c].name, k,
+                 st.factorizations, factors, st.solver_iterations, st.solves);
+      if (contacts > most_contacts) most_contacts = contacts;
+      if (st.solves > most_solves) most_solves = st.solves;
+    }
+    print_message("%s: %d steps, at most %d contacts and %d solves in a step\n", cases[c].name, s.steps,
+                  most_contacts, most_solves);
+    assert_true(most_contacts > 0);  /* the sphere pressed */
+    press_scene_destroy(&s);
+  }
+}
+
 /* A block clamped at x = 0 sagging under gravity, `steps` steps of 0.01 s. */
 static double* clamped_block(mica_world* w, int steps) {
   const double lo[3] = {0, 0, 0}, hi[3] = {0.4, 0.1, 0.1};
@@ -1115,6 +1175,7 @@ int main(void) {
       cmocka_unit_test(test_destroy_body_stales_its_lpcs),
       cmocka_unit_test(test_vtk_output),
       cmocka_unit_test(test_stats),
+      cmocka_unit_test(test_stats_count_solves_and_factorizations),
       cmocka_unit_test(test_pcg_matches_direct),
       cmocka_unit_test(test_pcg_not_converged),
       cmocka_unit_test(test_sliver_is_reported),

@@ -213,6 +213,8 @@ class mica_world_stats(Structure):
         ("stages", mica_stage_stats * MICA_STAGE_COUNT),
         ("contacts", c_int32),
         ("body_contacts", c_int32),
+        ("solves", c_int32),  # since 0.6
+        ("factorizations", c_int32),
     ]
 
 

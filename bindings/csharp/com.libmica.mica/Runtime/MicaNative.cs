@@ -251,6 +251,8 @@ namespace LibMica
             public fixed byte stages[MICA_STAGE_COUNT * 32];
             public int contacts;
             public int body_contacts;
+            public int solves;          // since 0.6
+            public int factorizations;
 
             public mica_stage_stats Stage(int stage)
             {
