@@ -7,7 +7,10 @@ namespace mica {
 
 LaggedFactor::LaggedFactor() : active_(std::make_unique<Slot>()), pending_(std::make_unique<Slot>()) {}
 
-LaggedFactor::~LaggedFactor() { worker_.wait(); }
+LaggedFactor::~LaggedFactor() {
+  stop_preparing_.store(true, std::memory_order_relaxed);
+  worker_.wait();
+}
 
 void LaggedFactor::copy_system(Slot& slot, const BlockPattern& pattern, const BlockValues& A,
                                const std::vector<TriangleStiffness>* extra) {
@@ -66,6 +69,7 @@ void LaggedFactor::refactor_now(const BlockPattern& pattern, const BlockValues& 
 }
 
 void LaggedFactor::adopt() {
+  stop_preparing_.store(true, std::memory_order_relaxed);
   worker_.wait();
   in_flight_ = false;
   if (worker_.error()) return;  // the copied system did not factor (not positive definite): keep the one in use
@@ -73,17 +77,40 @@ void LaggedFactor::adopt() {
   if (pending_->born < active_->born || !pending_->direct.by_hand()) return;
   std::swap(active_, pending_);
   clear_columns();
+  // The worker's half columns, copied (the slot keeps its own for a rollback): the same bits as
+  // prepare_columns() makes, in buffers of the same sizes (no allocation once both maps hold the node).
+  for (size_t k = 0; k < active_->prepared_count; ++k) {
+    const auto [at, added] = columns_.try_emplace(active_->prepare[k]);
+    if (added && open_) columns_added_.push_back(active_->prepare[k]);
+    at->second.h = active_->prepared[k];
+    at->second.made_for = columns_id_;
+  }
 }
 
 void LaggedFactor::factor_pending(void* self) {
   const LaggedFactor& f = *static_cast<const LaggedFactor*>(self);
   Slot& slot = *f.job_slot_;  // the stepping thread leaves it alone until adopt()
   slot.direct.factorize(ProjectedSystem{*f.job_pattern_, slot.A, slot.projection});
+  const SupernodalSolve* halves = slot.direct.by_hand();
+  if (!halves) return;  // adopt() drops such a factor
+  for (size_t k = 0; k < slot.prepare.size() && !f.stop_preparing_.load(std::memory_order_relaxed); ++k) {
+    halves->half_columns(3 * slot.prepare[k], slot.prepared[k]);
+    slot.prepared_count = k + 1;
+  }
 }
 
 void LaggedFactor::launch(const BlockPattern& pattern) {
   job_slot_ = pending_.get();  // pending_ itself may be moved (a rollback) while the job runs
   job_pattern_ = &pattern;      // fixed for the body's life, which outlives the job
+  // The nodes whose half columns the factor in use has: the worker makes them for its factor.
+  std::vector<int32_t>& nodes = job_slot_->prepare;
+  nodes.clear();
+  for (const auto& [node, c] : columns_)
+    if (c.made_for == columns_id_) nodes.push_back(node);
+  std::sort(nodes.begin(), nodes.end());  // the same order whatever the map's history
+  if (job_slot_->prepared.size() < nodes.size()) job_slot_->prepared.resize(nodes.size());
+  job_slot_->prepared_count = 0;
+  stop_preparing_.store(false, std::memory_order_relaxed);
   in_flight_ = true;
   worker_.start(&LaggedFactor::factor_pending, this);
 }
@@ -96,6 +123,7 @@ void LaggedFactor::update(const FemModel& fem, const Key& key, const BlockValues
   if (!(key == key_) || !active_->direct.analyzed()) {
     // A new step size, damping or constraint set: what is in flight is for another system.
     if (in_flight_) {
+      stop_preparing_.store(true, std::memory_order_relaxed);
       worker_.wait();
       in_flight_ = false;
     }
@@ -218,6 +246,8 @@ void LaggedFactor::load_slot(Slot& slot, ByteReader& in, const BlockPattern& pat
   in.get_vector(slot.projection.is_constrained, "a factor's projection");
   in.get_vector(slot.rotation, "a factor's rotations");
   slot.born = in.get<int64_t>("a factor's step");
+  slot.prepare.clear();  // its half columns are made again as needed
+  slot.prepared_count = 0;
   bool fits = slot.A.size() == size_t(pattern.block_count()) && slot.projection.S.size() == n &&
               slot.projection.z.size() == n && slot.projection.is_constrained.size() == n &&
               (slot.rotation.empty() || slot.rotation.size() == n);
