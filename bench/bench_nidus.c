@@ -16,6 +16,10 @@
  * Memory: VmRSS (/proc/self/status) before and after mica_body_create_from_file, and after the
  * first step (when the solver's buffers exist), divided by the tets.
  *
+ * Per step (mica_world_stats): CG iterations, velocity solves (the factored sweep's rounds) and
+ * factorizations made or started; the timed steps by kind (one solve, two or more, with a
+ * factorization) with their mean ms, which shows where the p95 comes from.
+ *
  * usage: bench_nidus [mesh] [tolerance] [steps] [warm-up] [E] [dt] [gauss-seidel steps] [refactor interval] [linear]
  *          defaults: data/nidus/nidus.msh 1e-6 200 40 1e4 0.01 30 4; runs MICA with the factored
  *          sweep (the first step's factor), again with the factor refreshed in the background every
@@ -90,6 +94,9 @@ typedef struct {
   double stage_ms[MICA_STAGE_COUNT]; /* mean wall-clock ms per timed step in each stage */
   int32_t nodes, tets, capped, contacts;
   int32_t factorizations; /* made or started in the background, over the timed steps */
+  /* Timed steps by kind: [0] one solve, [1] two or more, [2] with a factorization made or started. */
+  int32_t kind_steps[3];
+  double kind_ms[3]; /* their mean wall-clock ms */
 } figures;
 
 /* Steps a world with a sphere pressing from `y0` down by `depth` at `speed`, then moving up
@@ -143,6 +150,9 @@ static int press(mica_world* world, mica_body_id body, mica_tool_id tool, const 
     iterations += st.solver_iterations;
     solves += st.solves;
     out->factorizations += st.factorizations;
+    const int kind = st.factorizations > 0 ? 2 : st.solves > 1 ? 1 : 0;
+    out->kind_steps[kind] += 1;
+    out->kind_ms[kind] += elapsed;
     if (!st.converged) ++out->capped;
   }
   double f[3];
@@ -158,6 +168,8 @@ static int press(mica_world* world, mica_body_id body, mica_tool_id tool, const 
   free(cpu);
   out->iterations = (double)iterations / steps;
   out->solves = (double)solves / steps;
+  for (int kind = 0; kind < 3; ++kind)
+    if (out->kind_steps[kind]) out->kind_ms[kind] /= out->kind_steps[kind];
   out->reversals = changes ? (double)reversals / (double)changes : 0;
   free(ms);
   free(x);
@@ -256,6 +268,9 @@ static int nidus(const char* path, const mica_world_def* wd, int steps, int warm
          fig.solves);
   printf("factorizations        %d in the %d timed steps (made, or started in the background)\n", fig.factorizations,
          steps);
+  printf("steps by kind         one solve: %d, mean %.2f ms; two or more solves: %d, mean %.2f ms; with a "
+         "factorization: %d, mean %.2f ms\n",
+         fig.kind_steps[0], fig.kind_ms[0], fig.kind_steps[1], fig.kind_ms[1], fig.kind_steps[2], fig.kind_ms[2]);
   printf("tool force            %.4f N, %d contacts at the end\n", fig.force, fig.contacts);
   /* Where a step's time goes (the step's own stage timers; the re-linearisation's check counts in rotations). */
   static const char* stage_names[MICA_STAGE_COUNT] = {"loads", "rotations", "elements", "damping", "constraints",
