@@ -5,12 +5,13 @@
 // body's first step (co-rotational, E = 1e4 Pa, nu = 0.4, rho = 1000, Rayleigh alpha = 2,
 // dt = 10 ms, no constraints). Each figure is the best of 5 (factorizations) or 20 (solves).
 //
-// usage: bench_factor [mesh]
+// usage: bench_factor [mesh | cube:N]
 //   OPENBLAS_NUM_THREADS=1 taskset -c 1 build/bench/bench_factor data/nidus/nidus.msh
 #include <Eigen/CholmodSupport>
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <string>
 
 #include "mesh/mesh_io.hpp"
@@ -61,7 +62,8 @@ static const char kUsage[] =
     "usage: bench_factor [mesh]\n"
     "CHOLMOD's simplicial LDL^T against supernodal LL^T on a body's first velocity system\n"
     "(co-rotational, E = 1e4 Pa, nu = 0.4, alpha = 2, dt = 10 ms): analysis, factorization, solves.\n"
-    "  mesh    a .msh or .node/.ele file (default data/nidus/nidus.msh)\n"
+    "  mesh    a .msh or .node/.ele file (default data/nidus/nidus.msh), or cube:N, the 0.1 m cube of\n"
+    "          N^3 cubes x 6 tets of bench_nidus --scaling (cube:18 is its 35k-tet box)\n"
     "  --help  this text\n"
     "Run it as: OPENBLAS_NUM_THREADS=1 taskset -c 1 build/bench/bench_factor data/nidus/nidus.msh\n";
 
@@ -75,7 +77,13 @@ int main(int argc, char** argv) {
   BodySettings bs;
   bs.material = {1e4, 0.4, 1000};
   bs.rayleigh_alpha = 2;
-  const Id id = world.add_body(load_mesh(path), bs, Vec3::Zero(), Vec3::Zero());
+  const int cube = path.rfind("cube:", 0) == 0 ? std::atoi(path.c_str() + 5) : 0;
+  if (path.rfind("cube:", 0) == 0 && (cube < 1 || cube > 60)) {
+    std::fprintf(stderr, "bench_factor: %s: cube:N takes N from 1 to 60\n", path.c_str());
+    return 2;
+  }
+  const TetMesh mesh = cube ? make_box_grid(Vec3(0, 0, 0), Vec3(0.1, 0.1, 0.1), {cube, cube, cube}, 6) : load_mesh(path);
+  const Id id = world.add_body(mesh, bs, Vec3::Zero(), Vec3::Zero());
   world.step(0.01);  // assembles A
   const Body& body = world.body(id);
   const BlockPattern& p = body.fem.pattern;
