@@ -75,6 +75,11 @@ void LaggedFactor::adopt() {
   if (worker_.error()) return;  // the copied system did not factor (not positive definite): keep the one in use
   // Refactored since it was launched, or a factor the halves cannot use (see factor()).
   if (pending_->born < active_->born || !pending_->direct.by_hand()) return;
+  // The next launch asks the worker for these too (which columns it makes does not change
+  // results, so a rollback leaves this list as it is).
+  recent_nodes_.clear();
+  for (const auto& [node, c] : columns_)
+    if (c.made_for == columns_id_) recent_nodes_.push_back(node);
   std::swap(active_, pending_);
   clear_columns();
   // The worker's half columns, copied (the slot keeps its own for a rollback): the same bits as
@@ -85,6 +90,7 @@ void LaggedFactor::adopt() {
     at->second.h = active_->prepared[k];
     at->second.made_for = columns_id_;
   }
+  columns_from_worker_ += int64_t(active_->prepared_count);
 }
 
 void LaggedFactor::factor_pending(void* self) {
@@ -102,11 +108,19 @@ void LaggedFactor::factor_pending(void* self) {
 void LaggedFactor::launch(const BlockPattern& pattern) {
   job_slot_ = pending_.get();  // pending_ itself may be moved (a rollback) while the job runs
   job_pattern_ = &pattern;      // fixed for the body's life, which outlives the job
-  // The nodes whose half columns the factor in use has: the worker makes them for its factor.
+  // The nodes whose half columns the factor in use has, and those the one it replaced had (a
+  // launch right after an adoption comes before the step's contact nodes are made again): the
+  // worker makes them for its factor.
   std::vector<int32_t>& nodes = job_slot_->prepare;
   nodes.clear();
-  for (const auto& [node, c] : columns_)
-    if (c.made_for == columns_id_) nodes.push_back(node);
+  if (background_columns_) {
+    for (const auto& [node, c] : columns_)
+      if (c.made_for == columns_id_) nodes.push_back(node);
+    for (int32_t node : recent_nodes_) {
+      const auto at = columns_.find(node);
+      if (at == columns_.end() || at->second.made_for != columns_id_) nodes.push_back(node);
+    }
+  }
   std::sort(nodes.begin(), nodes.end());  // the same order whatever the map's history
   if (job_slot_->prepared.size() < nodes.size()) job_slot_->prepared.resize(nodes.size());
   job_slot_->prepared_count = 0;

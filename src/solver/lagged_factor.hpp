@@ -12,8 +12,9 @@
 // lockstep (the step waits if the worker is late), so results never depend on timing. The worker
 // is one thread per factor, "mica-factor", made at the first refresh and kept until the factor
 // is destroyed: a refresh makes no thread and allocates nothing on the stepping thread. After
-// factoring, the worker also makes the half columns of the nodes that had them at launch (the
-// contact nodes then, most of them still in contact at adoption), which the stepping thread
+// factoring, the worker also makes the half columns of the nodes that had them at launch, or
+// before the adoption just made (the contact nodes then, most of them still in contact at
+// adoption), which the stepping thread
 // would otherwise make again at adoption (4 ms of a 13 ms step on the nidus); adoption stops it
 // after the column in hand and makes the rest itself (a column is the same bits whoever makes
 // it), so a late worker costs the step no more than it did without this.
@@ -75,6 +76,13 @@ class LaggedFactor {
     return active_->rotation.empty() ? (*node_rotation)[i] : Mat3((*node_rotation)[i] * active_->rotation[i].transpose());
   }
   int64_t factorizations() const { return factorizations_; }
+  // Whether a background refresh also makes half columns (on; a test turns it off to compare),
+  // and how many adoptions have taken from it so far.
+  void set_background_columns(bool on) { background_columns_ = on; }
+  int64_t columns_from_worker() const { return columns_from_worker_; }
+  // Blocks until the background refresh in flight, its columns included, is done (a test's
+  // way to give the worker all the time it needs; adoption does not wait for the columns).
+  void wait_for_worker() { worker_.wait(); }
   int32_t node_count() const { return node_count_; }
 
   // A step that may fail: begin() before its first update(), then commit() if the step is kept or
@@ -130,6 +138,9 @@ class LaggedFactor {
   std::unique_ptr<Slot> active_, pending_;
   bool in_flight_ = false;  // *pending_ is being (or was) factored by worker_, not yet adopted
   std::atomic<bool> stop_preparing_{false};  // adoption is due: the worker makes no more columns
+  bool background_columns_ = true;
+  std::vector<int32_t> recent_nodes_;  // the nodes with columns of the factor adopt() replaced
+  int64_t columns_from_worker_ = 0;
   Slot* job_slot_ = nullptr;  // the worker's job: the slot and pattern it factors
   const BlockPattern* job_pattern_ = nullptr;
   // begin() .. commit() / rollback().

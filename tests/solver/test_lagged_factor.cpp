@@ -2,7 +2,8 @@
 // The factored sweep with a factor refreshed in the background (LaggedFactor): results do not
 // depend on when the worker finishes (lockstep adoption), a refreshed factor keeps a turning body
 // to fewer iterations than the first step's, a changed constraint set refactors at once, and a
-// solve that drags on refactors the current system.
+// solve that drags on refactors the current system; the half columns a refresh makes in the
+// background are those the step would make.
 #include <chrono>
 #include <cstring>
 #include <thread>
@@ -157,6 +158,42 @@ static void test_rollback_leaves_the_saved_factor(void**) {
   assert_true(before.bytes() == after.bytes());
 }
 
+// The half columns a background refresh makes (after its factorization, on the worker) are the
+// same bits as those the stepping thread makes after adoption: two factors updated alike, one
+// with the worker's columns turned off, the other given time to make them all (each launch
+// follows an adoption here, before the solve makes its columns: the nodes of the factor
+// replaced are asked for too, else the worker would be asked for none).
+static void test_background_columns_are_the_same_bits(void**) {
+  Twist t = make_twist(1);
+  step(t);
+  const Body& b = t.world->body(t.body);
+  const LaggedFactor::Key key{0.01, 0, 0, 0};
+  LaggedFactor worker, stepper;
+  stepper.set_background_columns(false);
+  std::vector<Mat3> node_rotation;
+  for (int k = 0; k < 6; ++k) {
+    compute_node_rotations(b.fem, b.R, node_rotation);
+    for (LaggedFactor* f : {&worker, &stepper}) {
+      f->update(b.fem, key, b.A, b.projection, &node_rotation, 1);  // refreshes every solve
+      f->prepare_columns(t.top_nodes);
+    }
+    worker.wait_for_worker();  // it makes all its columns
+    step(t);
+  }
+  print_message("6 solves: %lld factorizations each, %lld columns taken from the worker\n",
+                (long long)worker.factorizations(), (long long)worker.columns_from_worker());
+  assert_int_equal(worker.factorizations(), stepper.factorizations());
+  // Factored at once, then each later solve adopts a refresh with all the nodes' columns.
+  assert_int_equal(worker.columns_from_worker(), 4 * int64_t(t.top_nodes.size()));
+  assert_int_equal(stepper.columns_from_worker(), 0);
+  for (int32_t node : t.top_nodes) {
+    const SupernodalSolve::HalfColumns &a = worker.columns(node), &s = stepper.columns(node);
+    assert_true(a.start == s.start && a.length == s.length);
+    assert_int_equal(a.values.size(), s.values.size());
+    assert_memory_equal(a.values.data(), s.values.data(), size_t(a.values.size()) * sizeof(double));
+  }
+}
+
 // A state saved by the first 0.6 builds ends with dense cached columns (count, then per node its
 // index, 3n and 3n x 3 doubles) where a state now ends with the count 0: it still loads (the
 // columns read past, the factor the same: it saves the same bytes again), and one whose columns
@@ -207,6 +244,7 @@ int main(void) {
       cmocka_unit_test(test_refresh_saves_iterations),
       cmocka_unit_test(test_long_solve_refactors),
       cmocka_unit_test(test_loads_a_state_with_dense_columns),
+      cmocka_unit_test(test_background_columns_are_the_same_bits),
   };
   return cmocka_run_group_tests(tests, nullptr, nullptr);
 }
