@@ -14,10 +14,10 @@
 // is destroyed: a refresh makes no thread and allocates nothing on the stepping thread. After
 // factoring, the worker also makes the half columns of the nodes that had them at launch, or
 // before the adoption just made (the contact nodes then, most of them still in contact at
-// adoption), which the stepping thread
-// would otherwise make again at adoption (4 ms of a 13 ms step on the nidus); adoption stops it
-// after the column in hand and makes the rest itself (a column is the same bits whoever makes
-// it), so a late worker costs the step no more than it did without this.
+// adoption), which the stepping thread would otherwise make again at adoption (4 ms of a 13 ms
+// step on the nidus); adoption stops it after the column in hand and makes the rest itself (a
+// column is the same bits whoever makes it), so a late worker costs the step no more than it
+// did without this.
 #pragma once
 #include <Eigen/Dense>
 #include <atomic>
