@@ -60,6 +60,10 @@ class SupernodalSolve {
   void backward(double* x) const;
 
  private:
+  // The single-precision copy with each supernode's diagonal block inverted, and its halves.
+  void make_single();
+  void forward_inverted(const float* values, float* w) const;
+  void backward_inverted(const float* values, float* w) const;
   template <class T>
   void run_forward(const T* values, Eigen::Matrix<T, Eigen::Dynamic, 1>& w,
                    Eigen::Matrix<T, Eigen::Dynamic, 1>& t) const;
@@ -78,6 +82,7 @@ class SupernodalSolve {
   // The permuted vector, and a supernode's rows below its columns (grown, never shrunk).
   mutable Eigen::VectorXd w_, t_;
   mutable Eigen::VectorXf w_single_, t_single_;
+  mutable Eigen::VectorXf x_single_, y_single_;  // a supernode's columns and rows (the inverted halves')
   mutable Eigen::Matrix<double, Eigen::Dynamic, 3> w3_, t3_;  // half_columns' (w3_ zero between calls)
   mutable bool halves_single_ = false;                       // forward() left w in w_single_
 };
