@@ -85,6 +85,7 @@ void FactoredMicaSolver::prepare_contact_nodes(const std::vector<SolverBody>& bo
     cn.u.setZero(3 * m);
     cn.exact.setZero(3 * m);
     cn.moved.setZero(3 * m);
+    cn.load.setZero(3 * m);
     if (cn.corrected) {
       cn.C.setZero(3 * m, 3 * m);
       for (const TriangleStiffness& e : *extra)

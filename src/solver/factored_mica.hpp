@@ -99,6 +99,7 @@ class FactoredMicaSolver : public CachingVelocitySolver<FactoredBodyCache> {
     // of the forces); U^T of a response: the values a single-precision backward solve only
     // approximates, put back exactly.
     Eigen::VectorXd force, moved, t, u, exact;
+    Eigen::VectorXd load;  // the equalities' impulses on the contact nodes (equality_load2)
   };
   // The PCG's preconditioner for body bi: z = P_c^-1 r.
   class CorrectedPreconditioner : public Preconditioner {
@@ -169,6 +170,9 @@ class FactoredMicaSolver : public CachingVelocitySolver<FactoredBodyCache> {
   // out -= S G_E^T x.
   void subtract_row_forces(const std::vector<SolverBody>& bodies, const ContactRows& rows,
                            const Eigen::Ref<const Eigen::VectorXd>& x, std::vector<Vec3List>& out) const;
+  // |S G_E^T x|^2, the equalities' load on the bodies (the scale of constrained_solve's residual).
+  double equality_load2(const std::vector<SolverBody>& bodies, const ContactRows& rows,
+                        const Eigen::Ref<const Eigen::VectorXd>& x);
   // out = G_E y (no bias).
   void rows_times(const ContactRows& rows, const std::vector<Vec3List>& y, Eigen::Ref<Eigen::VectorXd> out) const;
   // out = G_E U u of the bodies' nodes_.u, and each body's force -= U^T G_E^T x.

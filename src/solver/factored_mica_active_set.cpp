@@ -37,6 +37,18 @@ double dot(const std::vector<Vec3List>& a, const std::vector<Vec3List>& b) {
   return s;
 }
 
+// a.b and a.c in one pass.
+std::pair<double, double> dots(const std::vector<Vec3List>& a, const std::vector<Vec3List>& b,
+                               const std::vector<Vec3List>& c) {
+  double ab = 0, ac = 0;
+  for (size_t k = 0; k < a.size(); ++k)
+    for (size_t i = 0; i < a[k].size(); ++i) {
+      ab += a[k][i].dot(b[k][i]);
+      ac += a[k][i].dot(c[k][i]);
+    }
+  return {ab, ac};
+}
+
 void project_free(const Projection& projection, Vec3List& y) {
   for (int32_t i : projection.nodes) y[i] = projection.S[i] * y[i];
 }
@@ -158,6 +170,24 @@ void FactoredMicaSolver::rows_times(const ContactRows& rows, const std::vector<V
   }
 }
 
+double FactoredMicaSolver::equality_load2(const std::vector<SolverBody>& bodies, const ContactRows& rows,
+                                          const Eigen::Ref<const Eigen::VectorXd>& x) {
+  for (ContactNodes& cn : nodes_) cn.load.setZero();
+  for (size_t a = 0; a < eq_.size(); ++a) {
+    const int32_t r = eq_[a];
+    for (int32_t t = rows.start[r]; t < rows.start[r + 1]; ++t) {
+      const RowTerm& term = rows.terms[t];
+      const Projection& p = *bodies[term.body].projection;
+      const Vec3 g = term.coef * x(Eigen::Index(a)) * rows.direction[r];
+      nodes_[term.body].load.segment<3>(3 * term_slot_[t]) +=
+          p.active() && p.is_constrained[term.node] ? Vec3(p.S[term.node] * g) : g;
+    }
+  }
+  double load2 = 0;
+  for (const ContactNodes& cn : nodes_) load2 += cn.load.squaredNorm();
+  return load2;
+}
+
 SolveReport FactoredMicaSolver::constrained_solve(std::vector<SolverBody>& bodies, const ContactRows& rows,
                                                   std::vector<double>& lambda, double tolerance, int32_t cap,
                                                   const std::optional<SolveContext::Clock::time_point>& deadline) {
@@ -229,9 +259,7 @@ SolveReport FactoredMicaSolver::constrained_solve(std::vector<SolverBody>& bodie
     // the residual of a solve far from its factor's system); what is left must be small.
     mu_total += mu;
     subtract_row_forces(bodies, rows, mu, cr_);
-    for (size_t bi = 0; bi < nb; ++bi) ct_[bi].assign(ct_[bi].size(), Vec3::Zero());
-    subtract_row_forces(bodies, rows, mu_total, ct_);
-    const double g2 = dot(cr_, cr_), scale2 = std::max({f2, dot(ct_, ct_), 1e-300});  // the equalities' load included
+    const double g2 = dot(cr_, cr_), scale2 = std::max({f2, equality_load2(bodies, rows, mu_total), 1e-300});
     report.residual = std::sqrt(g2 / scale2);
     if (!std::isfinite(g2)) fail(Errc::Numerical, "the constrained velocity solve diverged (loads or state overflow)");
     report.converged = g2 <= tolerance * tolerance * scale2;
@@ -240,19 +268,19 @@ SolveReport FactoredMicaSolver::constrained_solve(std::vector<SolverBody>& bodie
       report.out_of_time = true;
       break;
     }
-    const double rz_new = dot(cr_, cz_);
+    const auto [rz_new, rz_last] = dots(cr_, cz_, cz_last_);
     if (report.iterations == 0) {
       cp_ = cz_;
     } else {
       // Polak-Ribiere's beta (flexible CG, Notay 2000): the preconditioner solves in single
       // precision, which is not quite the same linear map at every step, and Fletcher-Reeves'
       // rz_new / rz then stalls near float's precision (1.2e-7 on test_friction_physics).
-      const double beta = (rz_new - dot(cr_, cz_last_)) / rz;
+      const double beta = (rz_new - rz_last) / rz;
       for (size_t bi = 0; bi < nb; ++bi)
         for (size_t i = 0; i < cp_[bi].size(); ++i) cp_[bi][i] = cz_[bi][i] + beta * cp_[bi][i];
     }
     rz = rz_new;
-    for (size_t bi = 0; bi < nb; ++bi) cz_last_[bi] = cz_[bi];
+    cz_last_.swap(cz_);  // the next preconditioner step writes all of cz_
     for (size_t bi = 0; bi < nb; ++bi) bodies[bi].projected().apply(cp_[bi], cq_[bi], ct_[bi]);
     const double pq = dot(cp_, cq_);
     if (!(pq > 0)) break;  // breakdown: not positive definite on the equalities' null space

@@ -344,29 +344,18 @@ void WarpedFactorPreconditioner::bind(LaggedFactor* factor, const std::vector<Ma
 }
 
 void WarpedFactorPreconditioner::apply(const Vec3List& r, Vec3List& z) {
-  if (turn_.empty()) {
-    factor_->solve(r, z, true);
-    return;
-  }
-  const size_t n = r.size();
-  rotated_.resize(n);
-  for (size_t i = 0; i < n; ++i) rotated_[i] = turn_[i].transpose() * r[i];
-  factor_->solve(rotated_, z, true);
-  for (size_t i = 0; i < n; ++i) z[i] = turn_[i] * z[i];
+  forward(r);
+  backward(z);
 }
 
 void WarpedFactorPreconditioner::forward(const Vec3List& r) {
-  const size_t n = r.size();
-  rotated_.resize(n);
-  for (size_t i = 0; i < n; ++i) rotated_[i] = turn_.empty() ? r[i] : Vec3(turn_[i].transpose() * r[i]);
-  factor_->halves().forward(flat(rotated_).data(), true);
+  size_ = r.size();
+  factor_->halves().forward(flat(r).data(), true, turn_.empty() ? nullptr : turn_.data());
 }
 
 void WarpedFactorPreconditioner::backward(Vec3List& z) {
-  z.resize(rotated_.size());
-  factor_->halves().backward(flat(z).data());
-  if (turn_.empty()) return;
-  for (size_t i = 0; i < z.size(); ++i) z[i] = turn_[i] * z[i];
+  z.resize(size_);
+  factor_->halves().backward(flat(z).data(), turn_.empty() ? nullptr : turn_.data());
 }
 
 }  // namespace mica

@@ -187,12 +187,13 @@ class WarpedFactorPreconditioner : public Preconditioner {
   void apply(const Vec3List& r, Vec3List& z) override;
   // apply() in halves (LaggedFactor::halves): forward(r) leaves L^-1 P Q^T r in the halves'
   // workspace, where the caller may read and add half columns; backward(z) = Q P^T L^-T of it.
+  // The turns go in the same passes as the factor's permutation (SupernodalSolve::forward).
   void forward(const Vec3List& r);
   void backward(Vec3List& z);
 
  private:
   LaggedFactor* factor_ = nullptr;
-  Vec3List rotated_;
+  size_t size_ = 0;  // nodes of the last forward()
   std::vector<Mat3> turn_;  // empty: no warping (a linear body)
 };
 

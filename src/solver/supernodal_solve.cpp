@@ -66,28 +66,44 @@ struct Supernode {
 
 }  // namespace
 
+// A supernode up to this many columns is kept inverted in the single-precision copy (below);
+// a wider one (the few top separators) as it is: its triangular solves are long enough to run
+// at a product's speed, and inverting it would cost more than the factorization saves.
+constexpr int kInvertedWidth = 64;
+
 void SupernodalSolve::make_single() {
-  // Each supernode's block [D; E] (D its lower-triangular diagonal block) becomes [D^-1; E D^-1]:
-  // then the forward half of a supernode is one product, y = [D^-1; E D^-1] x, and the backward
-  // half x = D^-T x - (E D^-1)^T t another, with no triangular solve in either (a triangular
-  // solve of a few columns runs at a fraction of a product's speed: it was a third of the pair's
-  // time on the nidus). Inverted in double, then rounded.
-  values_single_.resize(size_t(L_->xsize));
-  Eigen::Index widest = 1, tallest = 1;
-  for (Eigen::Index k = 0; k < Eigen::Index(L_->nsuper); ++k) {
-    widest = std::max(widest, Eigen::Index(super_[k + 1] - super_[k]));
-    tallest = std::max(tallest, Eigen::Index(pi_[k + 1] - pi_[k]));
+  // Each narrow supernode's block [D; E] (D its lower-triangular diagonal block) becomes
+  // [D^-1; E D^-1]: then its forward half is one product, y = [D^-1; E D^-1] x, and its backward
+  // half x = D^-T x - (E D^-1)^T t another, with no triangular solve in either (a triangular solve
+  // of a few columns runs at a fraction of a product's speed: it was a third of the pair's time on
+  // the nidus, whose 1078 supernodes have ~7.6 columns). Inverted in double, then rounded.
+  values_single_.assign(values_, values_ + L_->xsize);
+  int widest = 1, tallest = 1;
+  for (int k = 0; k < int(L_->nsuper); ++k) {
+    widest = std::max(widest, super_[k + 1] - super_[k]);
+    tallest = std::max(tallest, pi_[k + 1] - pi_[k]);
   }
-  std::vector<double> inverse(size_t(widest * widest));
-  for (Eigen::Index k = 0; k < Eigen::Index(L_->nsuper); ++k) {
-    const Supernode<double> sn(values_, super_, pi_, px_, s_, k);
-    Eigen::Map<Eigen::MatrixXd> D_inv(inverse.data(), sn.nc, sn.nc);
-    D_inv.setIdentity();
-    sn.X.topRows(sn.nc).triangularView<Eigen::Lower>().solveInPlace(D_inv);
-    Eigen::Map<Eigen::MatrixXf> B(values_single_.data() + px_[k], sn.nc + sn.below, sn.nc);
-    B.topRows(sn.nc) = D_inv.cast<float>();
-    B.topRows(sn.nc).triangularView<Eigen::StrictlyUpper>().setZero();
-    if (sn.below > 0) B.bottomRows(sn.below) = (sn.X.bottomRows(sn.below) * D_inv).cast<float>();
+  // Y D = [I; E], column by column from the last.
+  std::vector<double> Y(size_t(tallest) * size_t(kInvertedWidth));
+  for (int k = 0; k < int(L_->nsuper); ++k) {
+    const int nc = super_[k + 1] - super_[k], nr = pi_[k + 1] - pi_[k];
+    if (nc > kInvertedWidth) continue;
+    const double* X = values_ + px_[k];  // [D; E], column-major, leading dimension nr
+    auto at = [nr](int i, int j) { return size_t(j) * size_t(nr) + size_t(i); };
+    for (int j = 0; j < nc; ++j)
+      for (int i = 0; i < nr; ++i) Y[at(i, j)] = i < nc ? double(i == j) : X[at(i, j)];
+    for (int j = nc - 1; j >= 0; --j) {
+      double* y = Y.data() + at(0, j);
+      for (int i = j + 1; i < nc; ++i) {
+        const double d = X[at(i, j)];
+        const double* yi = Y.data() + at(0, i);
+        for (int r = 0; r < nr; ++r) y[r] -= d * yi[r];
+      }
+      const double inverse = 1 / X[at(j, j)];
+      for (int r = 0; r < nr; ++r) y[r] *= inverse;
+    }
+    float* B = values_single_.data() + px_[k];
+    for (size_t q = 0; q < size_t(nr) * size_t(nc); ++q) B[q] = float(Y[q]);
   }
   x_single_.resize(widest);
   y_single_.resize(tallest);
@@ -100,19 +116,29 @@ struct Supernodes {
   const int *super, *pi, *px, *s;
 };
 
+using ConstMapF = Eigen::Map<const Eigen::MatrixXf>;
+using VectorMapF = Eigen::Map<Eigen::VectorXf>;
+
 void forward_pass(const Supernodes& L, const float* values, float* w, float* x, float* y) {
   for (int k = 0; k < L.count; ++k) {
     const int c0 = L.super[k], nc = L.super[k + 1] - c0, nr = L.pi[k + 1] - L.pi[k];
     const float* B = values + L.px[k];
     const int* rows = L.s + L.pi[k];
-    for (int j = 0; j < nc; ++j) x[j] = w[c0 + j];
-    for (int i = 0; i < nr; ++i) y[i] = 0;
-    for (int j = 0; j < nc; ++j) {  // column j of the top block is zero above row j
-      const float a = x[j];
-      const float* col = B + size_t(j) * size_t(nr);
-      for (int i = j; i < nr; ++i) y[i] += col[i] * a;
+    if (nc > kInvertedWidth) {  // [D; E]: x = D^-1 x, y = E x
+      const ConstMapF X(B, nr, nc);
+      VectorMapF xk(w + c0, nc);
+      X.topRows(nc).triangularView<Eigen::Lower>().solveInPlace(xk);
+      VectorMapF(y + nc, nr - nc).noalias() = X.bottomRows(nr - nc) * xk;
+    } else {  // [D^-1; E D^-1]: y = B x
+      for (int j = 0; j < nc; ++j) x[j] = w[c0 + j];
+      for (int i = 0; i < nr; ++i) y[i] = 0;
+      for (int j = 0; j < nc; ++j) {  // column j of the top block is zero above row j
+        const float a = x[j];
+        const float* col = B + size_t(j) * size_t(nr);
+        for (int i = j; i < nr; ++i) y[i] += col[i] * a;
+      }
+      for (int i = 0; i < nc; ++i) w[c0 + i] = y[i];
     }
-    for (int i = 0; i < nc; ++i) w[c0 + i] = y[i];
     for (int i = nc; i < nr; ++i) w[rows[i]] -= y[i];
   }
 }
@@ -122,7 +148,15 @@ void backward_pass(const Supernodes& L, const float* values, float* w, float* y)
     const int c0 = L.super[k], nc = L.super[k + 1] - c0, nr = L.pi[k + 1] - L.pi[k];
     const float* B = values + L.px[k];
     const int* rows = L.s + L.pi[k];
-    for (int i = 0; i < nc; ++i) y[i] = w[c0 + i];
+    if (nc > kInvertedWidth) {  // [D; E]: x = D^-T (x - E^T t)
+      const ConstMapF X(B, nr, nc);
+      VectorMapF xk(w + c0, nc), t(y, nr - nc);
+      for (int i = nc; i < nr; ++i) t[i - nc] = w[rows[i]];
+      xk.noalias() -= X.bottomRows(nr - nc).transpose() * t;
+      X.topRows(nc).triangularView<Eigen::Lower>().transpose().solveInPlace(xk);
+      continue;
+    }
+    for (int i = 0; i < nc; ++i) y[i] = w[c0 + i];  // [D^-1; E D^-1]: x = B^T [x; -t]
     for (int i = nc; i < nr; ++i) y[i] = -w[rows[i]];
     for (int j = 0; j < nc; ++j) {
       const float* col = B + size_t(j) * size_t(nr);
@@ -235,21 +269,57 @@ Mat3 SupernodalSolve::product(const HalfColumns& a, const HalfColumns& b) {
   return p;
 }
 
-void SupernodalSolve::forward(const double* b, bool single) const {
-  const Eigen::Index n = w_.size();
-  for (Eigen::Index i = 0; i < n; ++i) w_[i] = b[perm_[i]];
+namespace {
+
+// b's node i turned by turn_i^T (none: as it is), into the permuted w.
+template <class T>
+void gather(const double* b, const Mat3* turn, const std::vector<int32_t>& permuted, T* w) {
+  for (size_t i = 0; i < permuted.size() / 3; ++i) {
+    const Eigen::Map<const Vec3> bi(b + 3 * i);
+    const Vec3 v = turn ? Vec3(turn[i].transpose() * bi) : Vec3(bi);
+    for (int c = 0; c < 3; ++c) w[permuted[3 * i + size_t(c)]] = T(v[c]);
+  }
+}
+
+// The permuted w back into x, node i turned by turn_i.
+template <class T>
+void scatter(const T* w, const Mat3* turn, const std::vector<int32_t>& permuted, double* x) {
+  for (size_t i = 0; i < permuted.size() / 3; ++i) {
+    const Vec3 v(double(w[permuted[3 * i]]), double(w[permuted[3 * i + 1]]), double(w[permuted[3 * i + 2]]));
+    Eigen::Map<Vec3>(x + 3 * i) = turn ? Vec3(turn[i] * v) : v;
+  }
+}
+
+}  // namespace
+
+void SupernodalSolve::forward(const double* b, bool single, const Mat3* turn) const {
   halves_single_ = single && this->single();
-  if (!halves_single_) return run_forward(values_, w_, t_);
-  w_single_ = w_.cast<float>();
+  if (!halves_single_) {
+    gather(b, turn, inverse_perm_, w_.data());
+    return run_forward(values_, w_, t_);
+  }
+  gather(b, turn, inverse_perm_, w_single_.data());
   run_forward(values_single_.data(), w_single_, t_single_);
-  w_ = w_single_.cast<double>();  // dot and add in double
 }
 
 Vec3 SupernodalSolve::dot(const HalfColumns& h) const {
   Vec3 d = Vec3::Zero();
   Eigen::Index at = 0;
   for (size_t q = 0; q < h.start.size(); ++q) {
-    d.noalias() += h.values.middleRows(at, h.length[q]).transpose() * w_.segment(h.start[q], h.length[q]);
+    const auto H = h.values.middleRows(at, h.length[q]);
+    if (halves_single_) {  // by hand: a product with a cast would make a temporary
+      const float* w = w_single_.data() + h.start[q];
+      const double *h0 = H.col(0).data(), *h1 = H.col(1).data(), *h2 = H.col(2).data();
+      double d0 = 0, d1 = 0, d2 = 0;
+      for (Eigen::Index r = 0; r < h.length[q]; ++r) {
+        d0 += h0[r] * double(w[r]);
+        d1 += h1[r] * double(w[r]);
+        d2 += h2[r] * double(w[r]);
+      }
+      d += Vec3(d0, d1, d2);
+    } else {
+      d.noalias() += H.transpose() * w_.segment(h.start[q], h.length[q]);
+    }
     at += h.length[q];
   }
   return d;
@@ -258,21 +328,25 @@ Vec3 SupernodalSolve::dot(const HalfColumns& h) const {
 void SupernodalSolve::add(const HalfColumns& h, const Vec3& f) const {
   Eigen::Index at = 0;
   for (size_t q = 0; q < h.start.size(); ++q) {
-    w_.segment(h.start[q], h.length[q]).noalias() += h.values.middleRows(at, h.length[q]) * f;
+    const auto H = h.values.middleRows(at, h.length[q]);
+    if (halves_single_) {
+      float* w = w_single_.data() + h.start[q];
+      const double *h0 = H.col(0).data(), *h1 = H.col(1).data(), *h2 = H.col(2).data();
+      for (Eigen::Index r = 0; r < h.length[q]; ++r) w[r] += float(h0[r] * f[0] + h1[r] * f[1] + h2[r] * f[2]);
+    } else {
+      w_.segment(h.start[q], h.length[q]).noalias() += H * f;
+    }
     at += h.length[q];
   }
 }
 
-void SupernodalSolve::backward(double* x) const {
-  const Eigen::Index n = w_.size();
+void SupernodalSolve::backward(double* x, const Mat3* turn) const {
   if (halves_single_) {
-    w_single_ = w_.cast<float>();
     run_backward(values_single_.data(), w_single_, t_single_);
-    for (Eigen::Index i = 0; i < n; ++i) x[perm_[i]] = double(w_single_[i]);
-    return;
+    return scatter(w_single_.data(), turn, inverse_perm_, x);
   }
   run_backward(values_, w_, t_);
-  for (Eigen::Index i = 0; i < n; ++i) x[perm_[i]] = w_[i];
+  scatter(w_.data(), turn, inverse_perm_, x);
 }
 
 }  // namespace mica

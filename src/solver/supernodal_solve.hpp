@@ -47,17 +47,20 @@ class SupernodalSolve {
   // The solve pair in halves, with what lies between them in the caller's hands (the factored
   // sweep's correction of its preconditioner, factored_mica.cpp): forward(b) keeps w = L^-1 P b;
   // dot(H) = H^T w; add(H, f): w += H f; clear(single): w = 0 instead of forward(); backward(x):
-  // x = P^T L^-T w. With `single` and the copy, the halves run in single precision: x along E
-  // is then H^T w only to single's precision, and a caller that needs it exact puts back the
-  // values it knows.
-  void forward(const double* b, bool single) const;
+  // x = P^T L^-T w. With `single` and the copy, the halves run in single precision (w is kept in
+  // single: dot sums in double, add rounds H f): x along E is then H^T w only to single's
+  // precision, and a caller that needs it exact puts back the values it knows. b and x hold
+  // 3-DOF nodes; with `turn`, b's node i is turned by turn_i^T on the way in and x's by turn_i on
+  // the way out (the warped factor's Q, lagged_factor.hpp), in the same pass as the permutation.
+  void forward(const double* b, bool single, const Mat3* turn = nullptr) const;
   Vec3 dot(const HalfColumns& h) const;
   void add(const HalfColumns& h, const Vec3& f) const;
   void clear(bool single) const {
-    w_.setZero();
     halves_single_ = single && this->single();
+    if (halves_single_) w_single_.setZero();
+    else w_.setZero();
   }
-  void backward(double* x) const;
+  void backward(double* x, const Mat3* turn = nullptr) const;
 
  private:
   // The single-precision copy with each supernode's diagonal block inverted, and its halves.
