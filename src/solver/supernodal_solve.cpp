@@ -66,23 +66,22 @@ struct Supernode {
 
 }  // namespace
 
-// A supernode up to this many columns is kept inverted in the single-precision copy (below);
-// a wider one (the few top separators) as it is: its triangular solves are long enough to run
-// at a product's speed, and inverting it would cost more than the factorization saves.
-constexpr int kInvertedWidth = 64;
+int32_t SupernodalSolve::widest_supernode() const {
+  int32_t widest = 0;
+  for (int k = 0; L_ && k < int(L_->nsuper); ++k) widest = std::max(widest, int32_t(super_[k + 1] - super_[k]));
+  return widest;
+}
 
 void SupernodalSolve::make_single() {
-  // Each narrow supernode's block [D; E] (D its lower-triangular diagonal block) becomes
-  // [D^-1; E D^-1]: then its forward half is one product, y = [D^-1; E D^-1] x, and its backward
-  // half x = D^-T x - (E D^-1)^T t another, with no triangular solve in either (a triangular solve
-  // of a few columns runs at a fraction of a product's speed: it was a third of the pair's time on
-  // the nidus, whose 1078 supernodes have ~7.6 columns). Inverted in double, then rounded.
+  // Each supernode of up to kInvertedWidth columns, [D; E] (D its lower-triangular diagonal
+  // block), becomes [D^-1; E D^-1]: then its forward half is one product, y = [D^-1; E D^-1] x,
+  // and its backward half x = D^-T x - (E D^-1)^T t another, with no triangular solve in either (a
+  // triangular solve of a few columns runs at a fraction of a product's speed: it was a third of
+  // the pair's time on the nidus, whose 1078 supernodes have ~7.6 columns). Inverted in double,
+  // then rounded.
   values_single_.assign(values_, values_ + L_->xsize);
-  int widest = 1, tallest = 1;
-  for (int k = 0; k < int(L_->nsuper); ++k) {
-    widest = std::max(widest, super_[k + 1] - super_[k]);
-    tallest = std::max(tallest, pi_[k + 1] - pi_[k]);
-  }
+  int widest = std::max(1, widest_supernode()), tallest = 1;
+  for (int k = 0; k < int(L_->nsuper); ++k) tallest = std::max(tallest, pi_[k + 1] - pi_[k]);
   // Y D = [I; E], column by column from the last.
   std::vector<double> Y(size_t(tallest) * size_t(kInvertedWidth));
   for (int k = 0; k < int(L_->nsuper); ++k) {
@@ -118,13 +117,14 @@ struct Supernodes {
 
 using ConstMapF = Eigen::Map<const Eigen::MatrixXf>;
 using VectorMapF = Eigen::Map<Eigen::VectorXf>;
+using ConstVectorMapF = Eigen::Map<const Eigen::VectorXf>;
 
 void forward_pass(const Supernodes& L, const float* values, float* w, float* x, float* y) {
   for (int k = 0; k < L.count; ++k) {
     const int c0 = L.super[k], nc = L.super[k + 1] - c0, nr = L.pi[k + 1] - L.pi[k];
     const float* B = values + L.px[k];
     const int* rows = L.s + L.pi[k];
-    if (nc > kInvertedWidth) {  // [D; E]: x = D^-1 x, y = E x
+    if (nc > SupernodalSolve::kInvertedWidth) {  // [D; E]: x = D^-1 x, y = E x
       const ConstMapF X(B, nr, nc);
       VectorMapF xk(w + c0, nc);
       X.topRows(nc).triangularView<Eigen::Lower>().solveInPlace(xk);
@@ -148,7 +148,7 @@ void backward_pass(const Supernodes& L, const float* values, float* w, float* y)
     const int c0 = L.super[k], nc = L.super[k + 1] - c0, nr = L.pi[k + 1] - L.pi[k];
     const float* B = values + L.px[k];
     const int* rows = L.s + L.pi[k];
-    if (nc > kInvertedWidth) {  // [D; E]: x = D^-T (x - E^T t)
+    if (nc > SupernodalSolve::kInvertedWidth) {  // [D; E]: x = D^-T (x - E^T t)
       const ConstMapF X(B, nr, nc);
       VectorMapF xk(w + c0, nc), t(y, nr - nc);
       for (int i = nc; i < nr; ++i) t[i - nc] = w[rows[i]];
@@ -160,7 +160,7 @@ void backward_pass(const Supernodes& L, const float* values, float* w, float* y)
     for (int i = nc; i < nr; ++i) y[i] = -w[rows[i]];
     for (int j = 0; j < nc; ++j) {
       const float* col = B + size_t(j) * size_t(nr);
-      w[c0 + j] = Eigen::Map<const Eigen::VectorXf>(col + j, nr - j).dot(Eigen::Map<const Eigen::VectorXf>(y + j, nr - j));
+      w[c0 + j] = ConstVectorMapF(col + j, nr - j).dot(ConstVectorMapF(y + j, nr - j));
     }
   }
 }

@@ -25,6 +25,12 @@ class SupernodalSolve {
   // when L is not a real supernodal LL^T with int indices; the solves must not be called then.
   bool bind(const cholmod_factor* L, bool single);
   static constexpr double kSingleAgreement = 1e-4;
+  // The single-precision copy keeps supernodes up to this many columns inverted ([D^-1; E D^-1]:
+  // its halves are products) and wider ones as they are (their triangular solves are long enough
+  // to run at a product's speed; inverting them would cost more than the factorization).
+  static constexpr int kInvertedWidth = 64;
+  // The most columns of any supernode (0 unbound).
+  int32_t widest_supernode() const;
   void unbind() { L_ = nullptr; }
   bool bound() const { return L_ != nullptr; }
   bool single() const { return bound() && !values_single_.empty(); }

@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 // The hand-written supernodal solve (solver/supernodal_solve.hpp) against cholmod_solve2 on the
 // same factor: the double solve to round-off, the single-precision one to its precision, the
-// half columns and the solve in halves against A^-1's columns, and a factor of another kind
-// refused.
+// half columns and the solve in halves (also with node turns) against A^-1's columns, and a factor
+// of another kind refused.
 #include "solver/direct_solver.hpp"  // before cmocka (test_util.hpp)
 #include "solver/solver_problem.hpp"
 #include "solver/supernodal_solve.hpp"
@@ -56,6 +56,9 @@ static void test_single_within_its_precision(void**) {
   print_message("single precision against cholmod_solve2: %.3g\n", d);
   assert_true(d > 1e-12);  // it did solve in single precision
   assert_true(d <= 1e-4);  // float's 6e-8 times the growth in the triangular solves
+  // Both kinds of supernode ran: narrow ones inverted, at least one wider kept as a triangle.
+  print_message("widest supernode: %d columns\n", f.direct.by_hand()->widest_supernode());
+  assert_true(f.direct.by_hand()->widest_supernode() > SupernodalSolve::kInvertedWidth);
   // The multi-column solves (the contact columns) stay in double.
   Eigen::MatrixXd B(f.b.size(), 2), X;
   B << f.b, f.b;
@@ -102,6 +105,32 @@ static void test_half_columns_and_halves(void**) {
   }
 }
 
+// The halves with node turns Q (the warped preconditioner's): backward(forward(b, Q), Q) is
+// Q A^-1 Q^T b, in double to round-off and in single to its precision.
+static void test_turned_halves(void**) {
+  for (bool single : {false, true}) {
+    Factored f(single);
+    const int32_t n = f.p.fem.node_count();
+    std::vector<Mat3> turn(static_cast<size_t>(n));
+    Eigen::VectorXd turned_b(3 * n);
+    for (int32_t i = 0; i < n; ++i) {
+      turn[size_t(i)] = Eigen::AngleAxisd(0.1 * i, Vec3(1, 2, 3 + i % 5).normalized()).toRotationMatrix();
+      turned_b.segment<3>(3 * i) = turn[size_t(i)].transpose() * f.b.segment<3>(3 * i);
+    }
+    Eigen::MatrixXd solved;
+    f.direct.solve_raw_cholmod(turned_b, solved);
+    Eigen::VectorXd reference(3 * n), x(3 * n);
+    for (int32_t i = 0; i < n; ++i) reference.segment<3>(3 * i) = turn[size_t(i)] * solved.col(0).segment<3>(3 * i);
+    const SupernodalSolve& halves = *f.direct.by_hand();
+    halves.forward(f.b.data(), true, turn.data());
+    halves.backward(x.data(), turn.data());
+    const double d = relative(x, reference);
+    print_message("single %d: turned halves against Q A^-1 Q^T b %.2g\n", int(single), d);
+    assert_true(d <= (single ? 1e-4 : 1e-13));
+    assert_true(!single || d > 1e-12);
+  }
+}
+
 // A simplicial factor is not a supernodal one: bind refuses it.
 static void test_other_factors_refused(void**) {
   struct Simplicial : Eigen::CholmodSimplicialLLT<Eigen::SparseMatrix<double>, Eigen::Lower> {
@@ -122,6 +151,7 @@ int main(void) {
       cmocka_unit_test(test_double_matches_cholmod),
       cmocka_unit_test(test_single_within_its_precision),
       cmocka_unit_test(test_half_columns_and_halves),
+      cmocka_unit_test(test_turned_halves),
       cmocka_unit_test(test_other_factors_refused),
   };
   return cmocka_run_group_tests(tests, nullptr, nullptr);
