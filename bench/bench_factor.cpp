@@ -4,6 +4,9 @@
 // and 3 right-hand sides, on a mesh file (default: the nidus mesh). The system is that of the
 // body's first step (co-rotational, E = 1e4 Pa, nu = 0.4, rho = 1000, Rayleigh alpha = 2,
 // dt = 10 ms, no constraints). Each figure is the best of 5 (factorizations) or 20 (solves).
+// Then DirectSolver's own factor: its ordering and size, a solve pair by hand in double and in
+// single precision (the factored sweep's preconditioner), and the half columns of 25 nodes (best
+// of 10).
 //
 // usage: bench_factor [mesh | cube:N]
 //   OPENBLAS_NUM_THREADS=1 taskset -c 1 build/bench/bench_factor data/nidus/nidus.msh
@@ -13,9 +16,11 @@
 #include <cstdio>
 #include <cstdlib>
 #include <string>
+#include <vector>
 
 #include "mesh/mesh_io.hpp"
 #include "solver/direct_solver.hpp"
+#include "solver/supernodal_solve.hpp"
 #include "world/world.hpp"
 #include "cli.h"
 
@@ -144,6 +149,21 @@ int main(int argc, char** argv) {
                 "precision %.3f ms (%.2fx, difference %.1e)\n",
                 cholmod, by_hand, by_hand / cholmod, (x1 - x2).norm() / x1.norm(), single, single / cholmod,
                 (x1.col(0) - x3).norm() / x1.norm());
+    // The half columns of 25 nodes spread over the body (a contact set's worth: what the factored
+    // sweep makes for a new factor's contact nodes, in the background or in the step).
+    constexpr int kNodes = 25;
+    std::vector<SupernodalSolve::HalfColumns> columns(kNodes);
+    double half = 1e300;
+    long rows = 0;
+    for (int k = 0; k < 10; ++k) {
+      const auto t = Clock::now();
+      for (int a = 0; a < kNodes; ++a)
+        d.by_hand()->half_columns(3 * int32_t(int64_t(a) * p.rows / kNodes), columns[size_t(a)]);
+      half = std::min(half, ms_since(t));
+    }
+    for (const auto& c : columns) rows += long(c.values.rows());
+    std::printf("half columns:          %d nodes in %.3f ms (%.1f rows each on average)\n", kNodes, half,
+                double(rows) / kNodes);
   }
   return 0;
 }

@@ -225,22 +225,46 @@ void SupernodalSolve::run(const T* values, Eigen::Matrix<T, Eigen::Dynamic, 1>& 
 void SupernodalSolve::half_columns(int32_t first, HalfColumns& out) const {
   out.start.clear();
   out.length.clear();
-  for (int c = 0; c < 3; ++c) w3_(inverse_perm_[size_t(first + c)], c) = 1;
+  double* w[3] = {w3_.col(0).data(), w3_.col(1).data(), w3_.col(2).data()};
+  double* t[3] = {t3_.col(0).data(), t3_.col(1).data(), t3_.col(2).data()};
+  for (int c = 0; c < 3; ++c) w[c][inverse_perm_[size_t(first + c)]] = 1;
   // The forward solve of the unit columns, in double, skipping the supernodes they have not
-  // reached (zero there: nothing to pass on); those they reach are the segments.
+  // reached (zero there: nothing to pass on); those they reach are the segments. Written out for
+  // three columns: Eigen's general products cost more in packing than in arithmetic at these sizes.
   Eigen::Index total = 0;
-  for (Eigen::Index k = 0; k < Eigen::Index(L_->nsuper); ++k) {
-    const Supernode<double> sn(values_, super_, pi_, px_, s_, k);
-    auto xk = w3_.middleRows(sn.c0, sn.nc);
-    if (xk.isZero(0)) continue;
-    sn.X.topRows(sn.nc).triangularView<Eigen::Lower>().solveInPlace(xk);
-    out.start.push_back(int32_t(sn.c0));
-    out.length.push_back(int32_t(sn.nc));
-    total += sn.nc;
-    if (sn.below == 0) continue;
-    auto t = t3_.topRows(sn.below);
-    t.noalias() = sn.X.bottomRows(sn.below) * xk;
-    for (Eigen::Index i = 0; i < sn.below; ++i) w3_.row(sn.rows[i]) -= t.row(i);
+  for (int k = 0; k < int(L_->nsuper); ++k) {
+    const int c0 = super_[k], nc = super_[k + 1] - c0, nr = pi_[k + 1] - pi_[k];
+    bool reached = false;
+    for (int c = 0; c < 3 && !reached; ++c)
+      for (int j = 0; j < nc && !reached; ++j) reached = w[c][c0 + j] != 0;
+    if (!reached) continue;
+    const double* X = values_ + px_[k];  // [D; E], column-major, leading dimension nr
+    const int* rows = s_ + pi_[k];
+    for (int c = 0; c < 3; ++c) {  // D x = x
+      double* x = w[c] + c0;
+      for (int j = 0; j < nc; ++j) {
+        const double* col = X + size_t(j) * size_t(nr);
+        x[j] /= col[j];
+        for (int i = j + 1; i < nc; ++i) x[i] -= col[i] * x[j];
+      }
+    }
+    out.start.push_back(c0);
+    out.length.push_back(nc);
+    total += nc;
+    const int below = nr - nc;
+    if (below == 0) continue;
+    for (int c = 0; c < 3; ++c) std::fill(t[c], t[c] + below, 0.0);
+    for (int j = 0; j < nc; ++j) {  // t = E x, E read once for the three columns
+      const double* e = X + size_t(j) * size_t(nr) + nc;
+      const double a0 = w[0][c0 + j], a1 = w[1][c0 + j], a2 = w[2][c0 + j];
+      for (int i = 0; i < below; ++i) {
+        t[0][i] += e[i] * a0;
+        t[1][i] += e[i] * a1;
+        t[2][i] += e[i] * a2;
+      }
+    }
+    for (int c = 0; c < 3; ++c)
+      for (int i = 0; i < below; ++i) w[c][rows[nc + i]] -= t[c][i];
   }
   out.values.resize(total, 3);
   Eigen::Index at = 0;
