@@ -72,6 +72,12 @@ class FactoredMicaSolver : public CachingVelocitySolver<FactoredBodyCache> {
   void rollback_step() override {
     for_each_cache([](FactoredBodyCache& c) { c.factor.rollback(); });
   }
+  // The active-set loop: once a round's solve is this close (relative residual), it checks its set
+  // at every iteration and gives the set up as soon as it is clearly wrong (a pressing row pulls
+  // or a free one sinks by kWrongSet of the impulses), instead of polishing a solution the next
+  // round replaces. 0: never (each round solves to the tolerance; the tests compare both).
+  void set_check_residual(double residual) { set_check_residual_ = residual; }
+  static constexpr double kSetCheckResidual = 1e-2;
   // Each body's lagged factor (LaggedFactor::save, load).
   void save_body(uint64_t key, ByteWriter& out) const override;
   void restore_bodies(const std::vector<SavedBody>& bodies) override;
@@ -152,9 +158,18 @@ class FactoredMicaSolver : public CachingVelocitySolver<FactoredBodyCache> {
   // pairs), and W_E = G_E P^-1 G_E^T factored; impulses at round-off level set to 0.
   void choose_equalities(const ContactRows& rows, std::vector<double>& lambda);
   // A v = b + G^T lambda with G_E v + bias_E = 0, by projected PCG; lambda_E out, the rest fixed.
+  // Stops early with set_changed when the set is clearly wrong (set_clearly_wrong), impulse_scale2
+  // the squared size of the step's impulses so far.
   SolveReport constrained_solve(std::vector<SolverBody>& bodies, const ContactRows& rows, std::vector<double>& lambda,
                                 double tolerance, int32_t cap,
-                                const std::optional<SolveContext::Clock::time_point>& deadline);
+                                const std::optional<SolveContext::Clock::time_point>& deadline, double impulse_scale2,
+                                bool& set_changed);
+  // During constrained_solve: the complementarity error of its normal rows' impulses and velocities
+  // so far is above kWrongSet of the impulses (it leaves them in lambda_check_ and w_).
+  bool set_clearly_wrong(const std::vector<SolverBody>& bodies, const ContactRows& rows,
+                         const std::vector<double>& lambda, const Eigen::Ref<const Eigen::VectorXd>& mu_total,
+                         double impulse_scale2);
+  static constexpr double kWrongSet = 1e-2;
   // x = W_E^-1 rhs (the least-squares solution where rows are redundant).
   void solve_equalities(const Eigen::Ref<const Eigen::VectorXd>& rhs, Eigen::Ref<Eigen::VectorXd> x);
   // y_ such that S Q y_ = P_c^-1 G^T w on body bi for row weights w (the factor's frame: a
@@ -183,6 +198,7 @@ class FactoredMicaSolver : public CachingVelocitySolver<FactoredBodyCache> {
   void prepare_equality_solvers(Eigen::Index nr);
 
   SolverSettings settings_;
+  double set_check_residual_ = kSetCheckResidual;
   std::vector<FactoredBody> factored_;
   std::vector<PcgSolver> pcg_;
   std::vector<WarpedFactorPreconditioner> warp_;
@@ -213,7 +229,7 @@ class FactoredMicaSolver : public CachingVelocitySolver<FactoredBodyCache> {
   Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd>* W_eq_solver_ = nullptr;  // this set's
   std::vector<int32_t> eq_;
   Eigen::VectorXd mu_, mu_total_, row_scratch_, eq_work_, eq_y_;
-  std::vector<double> fixed_, lambda_prev_;
+  std::vector<double> fixed_, lambda_prev_, lambda_check_;
   std::vector<Vec3List> cy_, cr_, cz_, cp_, cq_, ct_, cf_;  // per body: y, r, z, p, A p, scratch, rhs
   std::vector<Vec3List> cz_last_;                           // per body: the last z (the flexible beta)
 };

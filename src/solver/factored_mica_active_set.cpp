@@ -188,9 +188,44 @@ double FactoredMicaSolver::equality_load2(const std::vector<SolverBody>& bodies,
   return load2;
 }
 
+bool FactoredMicaSolver::set_clearly_wrong(const std::vector<SolverBody>& bodies, const ContactRows& rows,
+                                           const std::vector<double>& lambda, const Eigen::Ref<const Eigen::VectorXd>& mu_total,
+                                           double impulse_scale2) {
+  // The impulses and row velocities of the solve so far: lambda_E from the equalities' share, the
+  // rest as fixed; v = y + z at the rows' nodes.
+  lambda_check_ = lambda;
+  for (size_t a = 0; a < eq_.size(); ++a) lambda_check_[size_t(eq_[a])] = -mu_total(Eigen::Index(a));
+  w_.assign(rows.size(), 0.0);
+  double l2 = 0;
+  for (size_t r = 0; r < rows.size(); ++r) {
+    double c = rows.bias[r];
+    for (int32_t t = rows.start[r]; t < rows.start[r + 1]; ++t) {
+      const RowTerm& term = rows.terms[t];
+      const Projection& p = *bodies[term.body].projection;
+      Vec3 v = cy_[term.body][term.node];
+      if (p.active() && p.is_constrained[term.node]) v += p.z[term.node];
+      c += term.coef * rows.direction[r].dot(v);
+    }
+    w_[r] = c;
+    l2 += lambda_check_[r] * lambda_check_[r];
+  }
+  // A right set of normal rows gives no complementarity error however loosely solved (pressing
+  // rows push, the others do not sink); a wrong one an error of the size of the impulse it gets
+  // wrong. (Not the friction pairs: a sticking pair's impulse wanders across its disk's edge while
+  // the solve is loose.)
+  double e2 = 0;
+  for (size_t r = 0; r < rows.size(); ++r) {
+    if (rows.normal_of[r] >= 0 || diag_[r] == 0) continue;
+    const double next = std::max(0.0, lambda_check_[r] - w_[r] / warped_diag_[r]);
+    e2 += (next - lambda_check_[r]) * (next - lambda_check_[r]);
+  }
+  return e2 > kWrongSet * kWrongSet * std::max({l2, impulse_scale2, 1e-300});
+}
+
 SolveReport FactoredMicaSolver::constrained_solve(std::vector<SolverBody>& bodies, const ContactRows& rows,
                                                   std::vector<double>& lambda, double tolerance, int32_t cap,
-                                                  const std::optional<SolveContext::Clock::time_point>& deadline) {
+                                                  const std::optional<SolveContext::Clock::time_point>& deadline,
+                                                  double impulse_scale2, bool& set_changed) {
   using Clock = SolveContext::Clock;
   const size_t nb = bodies.size();
   for (std::vector<Vec3List>* v : {&cy_, &cr_, &cz_, &cp_, &cq_, &ct_, &cf_, &cz_last_}) v->resize(nb);
@@ -227,6 +262,7 @@ SolveReport FactoredMicaSolver::constrained_solve(std::vector<SolverBody>& bodie
   solve_equalities(gap, mu);
   add_response(bodies, rows, eq_, mu, cy_);
 
+  set_changed = false;
   SolveReport report;
   double f2 = 0;
   for (size_t bi = 0; bi < nb; ++bi) {
@@ -264,6 +300,12 @@ SolveReport FactoredMicaSolver::constrained_solve(std::vector<SolverBody>& bodie
     if (!std::isfinite(g2)) fail(Errc::Numerical, "the constrained velocity solve diverged (loads or state overflow)");
     report.converged = g2 <= tolerance * tolerance * scale2;
     if (report.converged || report.iterations >= cap) break;
+    // A wrong set shows long before the solve is polished: stop, and the caller predicts again.
+    if (report.residual <= set_check_residual_ &&
+        set_clearly_wrong(bodies, rows, lambda, mu_total, impulse_scale2)) {
+      set_changed = true;
+      break;
+    }
     if (deadline && report.iterations > 0 && Clock::now() >= *deadline) {
       report.out_of_time = true;
       break;
@@ -341,11 +383,20 @@ SolveReport FactoredMicaSolver::solve_active_set(const SolveContext& ctx, std::v
     choose_equalities(rows, lambda);
     const int32_t cap = may_refactor ? std::max(1, settings.refactor_after - report.iterations)
                                      : settings.max_iterations - report.iterations;
-    const SolveReport s = constrained_solve(bodies, rows, lambda, tolerance, std::max(cap, 1), deadline);
+    bool set_changed = false;
+    const SolveReport s =
+        constrained_solve(bodies, rows, lambda, tolerance, std::max(cap, 1), deadline, l_scale, set_changed);
     report.iterations += std::max(1, s.iterations);
     report.velocity_change = s.residual;
     report.out_of_time = s.out_of_time;
     if (s.out_of_time) break;
+    if (set_changed) {  // stopped early: predict again around its impulses (no secant pair: not solved)
+      row_velocities(bodies, rows);
+      have_pair = false;
+      if (outer >= kMaxRounds) break;
+      solve_small_lcp(rows, settings.tolerance, lambda, deadline);
+      continue;
+    }
     if (!s.converged) {
       if (may_refactor) continue;  // stopped where refactoring pays: refactor, go on
       break;
