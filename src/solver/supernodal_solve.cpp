@@ -285,7 +285,17 @@ Mat3 SupernodalSolve::product(const HalfColumns& a, const HalfColumns& b) {
     } else if (b.start[qb] < a.start[qa]) {
       ib += b.length[qb++];
     } else {
-      p.noalias() += a.values.middleRows(ia, a.length[qa]).transpose() * b.values.middleRows(ib, b.length[qb]);
+      // Nine dot products down the segment's columns (Eigen's general product packs more than it
+      // computes at these sizes).
+      const Eigen::Index rows = a.length[qa], lda = a.values.rows(), ldb = b.values.rows();
+      const double *A = a.values.data() + ia, *B = b.values.data() + ib;
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) {
+          const double *x = A + i * lda, *y = B + j * ldb;
+          double sum = 0;
+          for (Eigen::Index r = 0; r < rows; ++r) sum += x[r] * y[r];
+          p(i, j) += sum;
+        }
       ia += a.length[qa++];
       ib += b.length[qb++];
     }
