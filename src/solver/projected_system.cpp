@@ -20,8 +20,15 @@ void ProjectedSystem::right_hand_side(const Vec3List& b, Vec3List& rhs, Vec3List
     rhs = b;
     return;
   }
-  block_multiply(pattern, A, projection.z, tmp);
-  for (size_t i = 0; i < b.size(); ++i) rhs[i] = b[i] - tmp[i];
+  // z is zero where free, and on fixed nodes too: A z only when some node is moved.
+  bool moved = false;
+  for (int32_t i : projection.nodes) moved = moved || !projection.z[i].isZero(0);
+  if (moved) {
+    block_multiply(pattern, A, projection.z, tmp);
+    for (size_t i = 0; i < b.size(); ++i) rhs[i] = b[i] - tmp[i];
+  } else {
+    rhs = b;
+  }
   for (int32_t i : projection.nodes) rhs[i] = projection.S[i] * rhs[i];
 }
 
