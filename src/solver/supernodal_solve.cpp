@@ -319,7 +319,8 @@ void gather(const double* b, const Mat3* turn, const std::vector<int32_t>& permu
 template <class T>
 void scatter(const T* w, const Mat3* turn, const std::vector<int32_t>& permuted, double* x) {
   for (size_t i = 0; i < permuted.size() / 3; ++i) {
-    const Vec3 v(double(w[permuted[3 * i]]), double(w[permuted[3 * i + 1]]), double(w[permuted[3 * i + 2]]));
+    const Vec3 v(static_cast<double>(w[permuted[3 * i]]), static_cast<double>(w[permuted[3 * i + 1]]),
+                 static_cast<double>(w[permuted[3 * i + 2]]));
     Eigen::Map<Vec3>(x + 3 * i) = turn ? Vec3(turn[i] * v) : v;
   }
 }
