@@ -3,7 +3,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <type_traits>
 
 namespace mica {
 
@@ -30,7 +29,6 @@ bool SupernodalSolve::bind(const cholmod_factor* L, bool single) {
   if (single) {
     make_single();
     w_single_.resize(n);
-    t_single_.resize(below);
     // Kept only where single precision holds: float's 6e-8 grows with the condition of the
     // system (a nearly incompressible, very stiff body's is far too large), and a preconditioner
     // that far off misleads the solves. Probed on one fixed vector, in double and in single.
@@ -44,24 +42,27 @@ bool SupernodalSolve::bind(const cholmod_factor* L, bool single) {
   return true;
 }
 
-void SupernodalSolve::solve(const double* b, double* x) const { run(values_, w_, t_, b, x); }
+void SupernodalSolve::solve(const double* b, double* x) const {
+  forward(b, false);
+  backward(x);
+}
 
 void SupernodalSolve::solve_single(const double* b, double* x) const {
-  run(values_single_.data(), w_single_, t_single_, b, x);
+  forward(b, true);
+  backward(x);
 }
 
 namespace {
 
 // A supernode k holds columns super[k] .. super[k+1) of L as a dense block (column-major, nr
 // rows, leading dimension nr): its diagonal block on top, then the rows s[pi[k] + nc ..].
-template <class T>
 struct Supernode {
-  Supernode(const T* values, const int* super, const int* pi, const int* px, const int* s, Eigen::Index k)
+  Supernode(const double* values, const int* super, const int* pi, const int* px, const int* s, Eigen::Index k)
       : c0(super[k]), nc(super[k + 1] - c0), below(pi[k + 1] - pi[k] - nc), rows(s + pi[k] + nc),
         X(values + px[k], nc + below, nc, Eigen::OuterStride<>(nc + below)) {}
   Eigen::Index c0, nc, below;
   const int* rows;  // the rows below the diagonal block
-  Eigen::Map<const Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic>, 0, Eigen::OuterStride<>> X;
+  Eigen::Map<const Eigen::MatrixXd, 0, Eigen::OuterStride<>> X;
 };
 
 }  // namespace
@@ -167,59 +168,38 @@ void backward_pass(const Supernodes& L, const float* values, float* w, float* y)
 
 }  // namespace
 
-void SupernodalSolve::forward_inverted(const float* values, float* w) const {
-  forward_pass({int(L_->nsuper), super_, pi_, px_, s_}, values, w, x_single_.data(), y_single_.data());
+void SupernodalSolve::forward_single() const {
+  forward_pass({int(L_->nsuper), super_, pi_, px_, s_}, values_single_.data(), w_single_.data(), x_single_.data(),
+               y_single_.data());
 }
 
-void SupernodalSolve::backward_inverted(const float* values, float* w) const {
-  backward_pass({int(L_->nsuper), super_, pi_, px_, s_}, values, w, y_single_.data());
+void SupernodalSolve::backward_single() const {
+  backward_pass({int(L_->nsuper), super_, pi_, px_, s_}, values_single_.data(), w_single_.data(), y_single_.data());
 }
 
-template <class T>
-void SupernodalSolve::run_forward(const T* values, Eigen::Matrix<T, Eigen::Dynamic, 1>& w,
-                                  Eigen::Matrix<T, Eigen::Dynamic, 1>& t_all) const {
-  if constexpr (std::is_same_v<T, float>) return forward_inverted(values, w.data());
+void SupernodalSolve::forward_double() const {
   for (Eigen::Index k = 0; k < Eigen::Index(L_->nsuper); ++k) {  // L w' = w
-    const Supernode<T> sn(values, super_, pi_, px_, s_, k);
-    const Eigen::Index c0 = sn.c0, nc = sn.nc, below = sn.below;
-    const int* rows = sn.rows;
-    const auto& X = sn.X;
-    auto xk = w.segment(c0, nc);
-    X.topRows(nc).template triangularView<Eigen::Lower>().solveInPlace(xk);
-    if (below == 0) continue;
-    auto t = t_all.head(below);
-    t.noalias() = X.bottomRows(below) * xk;
-    for (Eigen::Index i = 0; i < below; ++i) w[rows[i]] -= t[i];
+    const Supernode sn(values_, super_, pi_, px_, s_, k);
+    auto xk = w_.segment(sn.c0, sn.nc);
+    sn.X.topRows(sn.nc).triangularView<Eigen::Lower>().solveInPlace(xk);
+    if (sn.below == 0) continue;
+    auto t = t_.head(sn.below);
+    t.noalias() = sn.X.bottomRows(sn.below) * xk;
+    for (Eigen::Index i = 0; i < sn.below; ++i) w_[sn.rows[i]] -= t[i];
   }
 }
 
-template <class T>
-void SupernodalSolve::run_backward(const T* values, Eigen::Matrix<T, Eigen::Dynamic, 1>& w,
-                                   Eigen::Matrix<T, Eigen::Dynamic, 1>& t_all) const {
-  if constexpr (std::is_same_v<T, float>) return backward_inverted(values, w.data());
+void SupernodalSolve::backward_double() const {
   for (Eigen::Index k = Eigen::Index(L_->nsuper) - 1; k >= 0; --k) {  // L^T w' = w
-    const Supernode<T> sn(values, super_, pi_, px_, s_, k);
-    const Eigen::Index c0 = sn.c0, nc = sn.nc, below = sn.below;
-    const int* rows = sn.rows;
-    const auto& X = sn.X;
-    auto xk = w.segment(c0, nc);
-    if (below > 0) {
-      auto t = t_all.head(below);
-      for (Eigen::Index i = 0; i < below; ++i) t[i] = w[rows[i]];
-      xk.noalias() -= X.bottomRows(below).transpose() * t;
+    const Supernode sn(values_, super_, pi_, px_, s_, k);
+    auto xk = w_.segment(sn.c0, sn.nc);
+    if (sn.below > 0) {
+      auto t = t_.head(sn.below);
+      for (Eigen::Index i = 0; i < sn.below; ++i) t[i] = w_[sn.rows[i]];
+      xk.noalias() -= sn.X.bottomRows(sn.below).transpose() * t;
     }
-    X.topRows(nc).template triangularView<Eigen::Lower>().transpose().solveInPlace(xk);
+    sn.X.topRows(sn.nc).triangularView<Eigen::Lower>().transpose().solveInPlace(xk);
   }
-}
-
-template <class T>
-void SupernodalSolve::run(const T* values, Eigen::Matrix<T, Eigen::Dynamic, 1>& w,
-                          Eigen::Matrix<T, Eigen::Dynamic, 1>& t_all, const double* b, double* x) const {
-  const Eigen::Index n = w.size();
-  for (Eigen::Index i = 0; i < n; ++i) w[i] = T(b[perm_[i]]);
-  run_forward(values, w, t_all);
-  run_backward(values, w, t_all);
-  for (Eigen::Index i = 0; i < n; ++i) x[perm_[i]] = double(w[i]);
 }
 
 void SupernodalSolve::half_columns(int32_t first, HalfColumns& out) const {
@@ -331,10 +311,10 @@ void SupernodalSolve::forward(const double* b, bool single, const Mat3* turn) co
   halves_single_ = single && this->single();
   if (!halves_single_) {
     gather(b, turn, inverse_perm_, w_.data());
-    return run_forward(values_, w_, t_);
+    return forward_double();
   }
   gather(b, turn, inverse_perm_, w_single_.data());
-  run_forward(values_single_.data(), w_single_, t_single_);
+  forward_single();
 }
 
 Vec3 SupernodalSolve::dot(const HalfColumns& h) const {
@@ -377,10 +357,10 @@ void SupernodalSolve::add(const HalfColumns& h, const Vec3& f) const {
 
 void SupernodalSolve::backward(double* x, const Mat3* turn) const {
   if (halves_single_) {
-    run_backward(values_single_.data(), w_single_, t_single_);
+    backward_single();
     return scatter(w_single_.data(), turn, inverse_perm_, x);
   }
-  run_backward(values_, w_, t_);
+  backward_double();
   scatter(w_.data(), turn, inverse_perm_, x);
 }
 

@@ -69,19 +69,13 @@ class SupernodalSolve {
   void backward(double* x, const Mat3* turn = nullptr) const;
 
  private:
-  // The single-precision copy with each supernode's diagonal block inverted, and its halves.
+  // The single-precision copy, narrow supernodes inverted (kInvertedWidth).
   void make_single();
-  void forward_inverted(const float* values, float* w) const;
-  void backward_inverted(const float* values, float* w) const;
-  template <class T>
-  void run_forward(const T* values, Eigen::Matrix<T, Eigen::Dynamic, 1>& w,
-                   Eigen::Matrix<T, Eigen::Dynamic, 1>& t) const;
-  template <class T>
-  void run_backward(const T* values, Eigen::Matrix<T, Eigen::Dynamic, 1>& w,
-                    Eigen::Matrix<T, Eigen::Dynamic, 1>& t) const;
-  template <class T>
-  void run(const T* values, Eigen::Matrix<T, Eigen::Dynamic, 1>& w, Eigen::Matrix<T, Eigen::Dynamic, 1>& t,
-           const double* b, double* x) const;
+  // The halves on the permuted vector: w_ with L in double, w_single_ with the copy.
+  void forward_double() const;
+  void backward_double() const;
+  void forward_single() const;
+  void backward_single() const;
 
   const cholmod_factor* L_ = nullptr;
   const int *super_ = nullptr, *pi_ = nullptr, *px_ = nullptr, *s_ = nullptr, *perm_ = nullptr;
@@ -90,7 +84,7 @@ class SupernodalSolve {
   std::vector<int32_t> inverse_perm_;  // a DOF's permuted row
   // The permuted vector, and a supernode's rows below its columns (grown, never shrunk).
   mutable Eigen::VectorXd w_, t_;
-  mutable Eigen::VectorXf w_single_, t_single_;
+  mutable Eigen::VectorXf w_single_;
   mutable Eigen::VectorXf x_single_, y_single_;  // a supernode's columns and rows (the inverted halves')
   mutable Eigen::Matrix<double, Eigen::Dynamic, 3> w3_, t3_;  // half_columns' (w3_ zero between calls)
   mutable bool halves_single_ = false;                       // forward() left w in w_single_
