@@ -189,8 +189,8 @@ double FactoredMicaSolver::equality_load2(const std::vector<SolverBody>& bodies,
 }
 
 bool FactoredMicaSolver::set_clearly_wrong(const std::vector<SolverBody>& bodies, const ContactRows& rows,
-                                           const std::vector<double>& lambda, const Eigen::Ref<const Eigen::VectorXd>& mu_total,
-                                           double impulse_scale2) {
+                                           const std::vector<double>& lambda,
+                                           const Eigen::Ref<const Eigen::VectorXd>& mu_total, double impulse_scale2) {
   // The impulses and row velocities of the solve so far: lambda_E from the equalities' share, the
   // rest as fixed; v = y + z at the rows' nodes.
   lambda_check_ = lambda;
