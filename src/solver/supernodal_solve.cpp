@@ -16,7 +16,7 @@ bool SupernodalSolve::bind(const cholmod_factor* L, bool single) {
   pi_ = static_cast<const int*>(L->pi);
   px_ = static_cast<const int*>(L->px);
   s_ = static_cast<const int*>(L->s);
-  perm_ = static_cast<const int*>(L->Perm);
+  const int* perm = static_cast<const int*>(L->Perm);
   values_ = static_cast<const double*>(L->x);
   const Eigen::Index n = Eigen::Index(L->n), below = Eigen::Index(L->maxesize > 0 ? L->maxesize : 1);
   w_.resize(n);
@@ -24,7 +24,7 @@ bool SupernodalSolve::bind(const cholmod_factor* L, bool single) {
   w3_.setZero(n, 3);
   t3_.resize(below, 3);
   inverse_perm_.resize(size_t(n));
-  for (Eigen::Index i = 0; i < n; ++i) inverse_perm_[size_t(perm_[i])] = int32_t(i);
+  for (Eigen::Index i = 0; i < n; ++i) inverse_perm_[size_t(perm[i])] = int32_t(i);
   L_ = L;
   if (single) {
     make_single();
@@ -81,7 +81,7 @@ void SupernodalSolve::make_single() {
   // the pair's time on the nidus, whose 1078 supernodes have ~7.6 columns). Inverted in double,
   // then rounded.
   values_single_.assign(values_, values_ + L_->xsize);
-  int widest = std::max(1, widest_supernode()), tallest = 1;
+  int tallest = 1;
   for (int k = 0; k < int(L_->nsuper); ++k) tallest = std::max(tallest, pi_[k + 1] - pi_[k]);
   // Y D = [I; E], column by column from the last.
   std::vector<double> Y(size_t(tallest) * size_t(kInvertedWidth));
@@ -105,7 +105,6 @@ void SupernodalSolve::make_single() {
     float* B = values_single_.data() + px_[k];
     for (size_t q = 0; q < size_t(nr) * size_t(nc); ++q) B[q] = float(Y[q]);
   }
-  x_single_.resize(widest);
   y_single_.resize(tallest);
 }
 
@@ -120,7 +119,7 @@ using ConstMapF = Eigen::Map<const Eigen::MatrixXf>;
 using VectorMapF = Eigen::Map<Eigen::VectorXf>;
 using ConstVectorMapF = Eigen::Map<const Eigen::VectorXf>;
 
-void forward_pass(const Supernodes& L, const float* values, float* w, float* x, float* y) {
+void forward_pass(const Supernodes& L, const float* values, float* w, float* y) {
   for (int k = 0; k < L.count; ++k) {
     const int c0 = L.super[k], nc = L.super[k + 1] - c0, nr = L.pi[k + 1] - L.pi[k];
     const float* B = values + L.px[k];
@@ -131,10 +130,9 @@ void forward_pass(const Supernodes& L, const float* values, float* w, float* x, 
       X.topRows(nc).triangularView<Eigen::Lower>().solveInPlace(xk);
       VectorMapF(y + nc, nr - nc).noalias() = X.bottomRows(nr - nc) * xk;
     } else {  // [D^-1; E D^-1]: y = B x
-      for (int j = 0; j < nc; ++j) x[j] = w[c0 + j];
       for (int i = 0; i < nr; ++i) y[i] = 0;
       for (int j = 0; j < nc; ++j) {  // column j of the top block is zero above row j
-        const float a = x[j];
+        const float a = w[c0 + j];  // (w's columns are written only after the product)
         const float* col = B + size_t(j) * size_t(nr);
         for (int i = j; i < nr; ++i) y[i] += col[i] * a;
       }
@@ -169,8 +167,7 @@ void backward_pass(const Supernodes& L, const float* values, float* w, float* y)
 }  // namespace
 
 void SupernodalSolve::forward_single() const {
-  forward_pass({int(L_->nsuper), super_, pi_, px_, s_}, values_single_.data(), w_single_.data(), x_single_.data(),
-               y_single_.data());
+  forward_pass({int(L_->nsuper), super_, pi_, px_, s_}, values_single_.data(), w_single_.data(), y_single_.data());
 }
 
 void SupernodalSolve::backward_single() const {

@@ -78,14 +78,14 @@ class SupernodalSolve {
   void backward_single() const;
 
   const cholmod_factor* L_ = nullptr;
-  const int *super_ = nullptr, *pi_ = nullptr, *px_ = nullptr, *s_ = nullptr, *perm_ = nullptr;
+  const int *super_ = nullptr, *pi_ = nullptr, *px_ = nullptr, *s_ = nullptr;
   const double* values_ = nullptr;
   std::vector<float> values_single_;
   std::vector<int32_t> inverse_perm_;  // a DOF's permuted row
   // The permuted vector, and a supernode's rows below its columns (grown, never shrunk).
   mutable Eigen::VectorXd w_, t_;
   mutable Eigen::VectorXf w_single_;
-  mutable Eigen::VectorXf x_single_, y_single_;  // a supernode's columns and rows (the inverted halves')
+  mutable Eigen::VectorXf y_single_;  // a supernode's rows (the single halves')
   mutable Eigen::Matrix<double, Eigen::Dynamic, 3> w3_, t3_;  // half_columns' (w3_ zero between calls)
   mutable bool halves_single_ = false;                       // forward() left w in w_single_
 };
