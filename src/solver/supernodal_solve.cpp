@@ -262,17 +262,34 @@ Mat3 SupernodalSolve::product(const HalfColumns& a, const HalfColumns& b) {
     } else if (b.start[qb] < a.start[qa]) {
       ib += b.length[qb++];
     } else {
-      // Nine dot products down the segment's columns (Eigen's general product packs more than it
-      // computes at these sizes).
+      // Nine dot products down the segment's columns, summed side by side row by row: nine
+      // independent sums keep the adder busy where one sum at a time waits on each addition
+      // (Eigen's general product packs more than it computes at these sizes).
       const Eigen::Index rows = a.length[qa], lda = a.values.rows(), ldb = b.values.rows();
-      const double *A = a.values.data() + ia, *B = b.values.data() + ib;
-      for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) {
-          const double *x = A + i * lda, *y = B + j * ldb;
-          double sum = 0;
-          for (Eigen::Index r = 0; r < rows; ++r) sum += x[r] * y[r];
-          p(i, j) += sum;
-        }
+      const double *a0 = a.values.data() + ia, *a1 = a0 + lda, *a2 = a1 + lda;
+      const double *b0 = b.values.data() + ib, *b1 = b0 + ldb, *b2 = b1 + ldb;
+      double s00 = 0, s01 = 0, s02 = 0, s10 = 0, s11 = 0, s12 = 0, s20 = 0, s21 = 0, s22 = 0;
+      for (Eigen::Index r = 0; r < rows; ++r) {
+        const double x0 = a0[r], x1 = a1[r], x2 = a2[r], y0 = b0[r], y1 = b1[r], y2 = b2[r];
+        s00 += x0 * y0;
+        s01 += x0 * y1;
+        s02 += x0 * y2;
+        s10 += x1 * y0;
+        s11 += x1 * y1;
+        s12 += x1 * y2;
+        s20 += x2 * y0;
+        s21 += x2 * y1;
+        s22 += x2 * y2;
+      }
+      p(0, 0) += s00;
+      p(0, 1) += s01;
+      p(0, 2) += s02;
+      p(1, 0) += s10;
+      p(1, 1) += s11;
+      p(1, 2) += s12;
+      p(2, 0) += s20;
+      p(2, 1) += s21;
+      p(2, 2) += s22;
       ia += a.length[qa++];
       ib += b.length[qb++];
     }
@@ -322,13 +339,25 @@ Vec3 SupernodalSolve::dot(const HalfColumns& h) const {
     if (halves_single_) {  // by hand: a product with a cast would make a temporary
       const float* w = w_single_.data() + h.start[q];
       const double *h0 = H.col(0).data(), *h1 = H.col(1).data(), *h2 = H.col(2).data();
-      double d0 = 0, d1 = 0, d2 = 0;
-      for (Eigen::Index r = 0; r < h.length[q]; ++r) {
+      // Two rows at a time into six sums: one sum per column would wait on each addition.
+      double d0 = 0, d1 = 0, d2 = 0, e0 = 0, e1 = 0, e2 = 0;
+      const Eigen::Index n = h.length[q];
+      Eigen::Index r = 0;
+      for (; r + 1 < n; r += 2) {
+        const double u = w[r], v = w[r + 1];
+        d0 += h0[r] * u;
+        d1 += h1[r] * u;
+        d2 += h2[r] * u;
+        e0 += h0[r + 1] * v;
+        e1 += h1[r + 1] * v;
+        e2 += h2[r + 1] * v;
+      }
+      if (r < n) {
         d0 += h0[r] * double(w[r]);
         d1 += h1[r] * double(w[r]);
         d2 += h2[r] * double(w[r]);
       }
-      d += Vec3(d0, d1, d2);
+      d += Vec3(d0 + e0, d1 + e1, d2 + e2);
     } else {
       d.noalias() += H.transpose() * w_.segment(h.start[q], h.length[q]);
     }
