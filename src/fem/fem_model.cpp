@@ -101,26 +101,20 @@ void assemble_elastic(const FemModel& m, const Vec3List& x, const std::vector<Ma
     for (int32_t i = first; i < last; ++i) f_int[i].setZero();
   });
   const Mat3 I = Mat3::Identity();
-  auto element = [&](int32_t e, Mat3* Ke) {  // Ke: 16 blocks of scratch
-    const TetElement& el = m.elements[e];
-    const Mat3& Re = R ? (*R)[e] : I;
-    add_elastic_forces(el, m.lame[e], Re, deformation_gradient(el, x), f_int);
-    if (!K) return;
-    rotated_stiffness(el, m.lame[e], Re, k_scale, Ke);
-    for (int q = 0; q < 16; ++q) (*K)[m.slots[e][q]] += Ke[q];
+  Mat3* blocks = K ? K->data() : nullptr;
+  auto element = [&](int32_t e) {
+    add_element(m.elements[e], m.lame[e], R ? (*R)[e] : I, x, k_scale, m.slots[e], blocks, f_int);
   };
   if (!coloured) {
-    Mat3 Ke[16];
-    for (int32_t e = 0; e < int32_t(m.elements.size()); ++e) element(e, Ke);
+    for (int32_t e = 0; e < int32_t(m.elements.size()); ++e) element(e);
     return;
   }
   const Colouring& c = *element_colours;
-  auto blocks = [&](int32_t, int32_t first, int32_t last, int32_t) {
-    Mat3 Ke[16];
+  auto colour_blocks = [&](int32_t, int32_t first, int32_t last, int32_t) {
     for (int32_t n = first; n < last; ++n)
-      for (int32_t e = c.block_start[c.order[n]]; e < c.block_start[c.order[n] + 1]; ++e) element(e, Ke);
+      for (int32_t e = c.block_start[c.order[n]]; e < c.block_start[c.order[n] + 1]; ++e) element(e);
   };
-  pool->phased_for(c.start.data(), c.colours(), 1, blocks);
+  pool->phased_for(c.start.data(), c.colours(), 1, colour_blocks);
 }
 
 void set_scaled_mass(const FemModel& m, double scale, BlockValues& A, ThreadPool* pool) {

@@ -161,6 +161,40 @@ static void test_stiffness_matches_finite_difference(void**) {
   check_stiffness(m, rotated, true, 1e-7);
 }
 
+// The fused kernel (add_element) against its reference, rotated_stiffness and add_elastic_forces,
+// on one element turned and strained at random: the same blocks, in the right slots (each its own
+// here, so a block written to its transpose's slot shows), and the same forces.
+static void test_fused_element_matches_reference(void**) {
+  const FemModel m = cube_model();
+  std::mt19937 rng(5);
+  std::normal_distribution<double> normal;
+  for (int trial = 0; trial < 20; ++trial) {
+    const TetElement& el = m.elements[size_t(trial) * 7 % m.elements.size()];
+    const Mat3 Q = rotation_about(Vec3(normal(rng), normal(rng), normal(rng)), 3 * normal(rng));
+    Vec3List x(m.rest.size(), Vec3::Zero());
+    for (int32_t i : el.nodes) x[i] = Q * m.rest[i] + 0.01 * Vec3(normal(rng), normal(rng), normal(rng));
+    const Mat3 R = proper_rotation(deformation_gradient(el, x));
+    const double scale = 1e-4;
+    std::array<int32_t, 16> slots;
+    BlockValues K(16), K_ref(16);
+    for (int q = 0; q < 16; ++q) {
+      slots[q] = (q * 5 + 3) % 16;  // a permutation: every block its own slot
+      K[q] = K_ref[q] = Mat3::Random();
+    }
+    Vec3List f(x.size(), Vec3::Ones()), f_ref = f;
+    add_element(el, m.lame[0], R, x, scale, slots, K.data(), f);
+    Mat3 Ke[16];
+    rotated_stiffness(el, m.lame[0], R, scale, Ke);
+    for (int q = 0; q < 16; ++q) K_ref[slots[q]] += Ke[q];
+    add_elastic_forces(el, m.lame[0], R, deformation_gradient(el, x), f_ref);
+    double k_scale = 0, f_scale = 0;
+    for (int q = 0; q < 16; ++q) k_scale = std::max(k_scale, Ke[q].norm());
+    for (int32_t i : el.nodes) f_scale = std::max(f_scale, (f_ref[i] - Vec3::Ones()).norm());
+    for (int q = 0; q < 16; ++q) assert_le((K[q] - K_ref[q]).norm(), 1e-12 * k_scale);
+    for (int32_t i : el.nodes) assert_le((f[i] - f_ref[i]).norm(), 1e-12 * f_scale);
+  }
+}
+
 static void test_total_mass(void**) {
   for (MassKind kind : {MassKind::Consistent, MassKind::Lumped})
     for (int32_t tpc : {5, 6}) {
@@ -181,6 +215,7 @@ int main(void) {
       cmocka_unit_test(test_rotation_is_proper_for_inverted_elements),
       cmocka_unit_test(test_rotation_matches_the_svd_polar_factor),
       cmocka_unit_test(test_stiffness_matches_finite_difference),
+      cmocka_unit_test(test_fused_element_matches_reference),
       cmocka_unit_test(test_total_mass),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
