@@ -74,10 +74,13 @@ double momentum_residual(const std::vector<SolverBody>& bodies) {
     double r2 = 0, scale2 = 0, terms2 = 0;
     for (int32_t i = 0; i < p.rows; ++i) {
       Vec3 av = Vec3::Zero();
-      double terms = 0;  // sum of |A_ij| |v_j|: what round-off in A v is relative to
+      // What round-off in A v is relative to, sum_j |A_ij| |v_j|, bounded by Cauchy-Schwarz:
+      // its square is at most (sum_j |A_ij|^2)(sum_j |v_j|^2), with no square root per block.
+      double a2 = 0, v2 = 0;
       for (int32_t k = p.row_start[i]; k < p.row_start[i + 1]; ++k) {
         av += A[k] * v[p.col[k]];
-        terms += A[k].norm() * v[p.col[k]].norm();
+        a2 += A[k].squaredNorm();
+        v2 += v[p.col[k]].squaredNorm();
       }
       const Vec3& b = (*body.b)[i];
       const Vec3& g = (*body.contact_impulse)[i];
@@ -85,7 +88,7 @@ double momentum_residual(const std::vector<SolverBody>& bodies) {
       r2 += (projected && body.projection->is_constrained[i] ? body.projection->S[i] * r : r).squaredNorm();
       const double floor = 1e-6 * body.fem->node_mass[i];
       scale2 += std::max({b.squaredNorm(), g.squaredNorm(), av.squaredNorm(), floor * floor});
-      terms2 += terms * terms;
+      terms2 += a2 * v2;
     }
     // A v is a sum of large terms that cancel where the body is driven through its constraints:
     // its rounding (a few hundred ulps of those terms) is no error of the solve.
