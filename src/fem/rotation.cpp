@@ -26,8 +26,7 @@ Mat3 proper_rotation(const Mat3& F) {
   // g = |det X|^(-1/3) (Higham 1986) takes a uniformly scaled rotation (a node's summed element
   // rotations, ~20 R) there in one step, where plain Newton halves the scale per step. Inverted,
   // nearly collapsed or badly stretched elements take the SVD path.
-  const double scale = F.norm();
-  if (!(F.determinant() > 1e-3 * scale * scale * scale)) return rotation_by_svd(F);
+  const double n2 = F.squaredNorm();
   Mat3 X = F;
   for (int k = 0; k < 20; ++k) {
     // X^-T = cof(X) / det X, the cofactors by columns.
@@ -36,6 +35,8 @@ Mat3 proper_rotation(const Mat3& F) {
     cof.col(1) = X.col(2).cross(X.col(0));
     cof.col(2) = X.col(0).cross(X.col(1));
     const double det = X.col(0).dot(cof.col(0));
+    // det F > 1e-3 |F|^3, from the first step's determinant (no square root).
+    if (k == 0 && !(det > 0 && det * det > 1e-6 * n2 * n2 * n2)) return rotation_by_svd(F);
     const double g = std::abs(det - 1) < 1e-2 ? 1.0 : std::cbrt(1 / det);  // near the end, plain Newton
     const Mat3 next = (0.5 * g) * X + (0.5 / (g * det)) * cof;
     const double change = (next - X).lpNorm<Eigen::Infinity>();
