@@ -15,21 +15,27 @@ namespace mica {
 
 class SurfacePseudoNormals {
  public:
-  // The surface's topology (which triangles share an edge); allocates. node_count bounds the node ids.
+  // The surface's topology (which triangles share an edge, which meet at a node); allocates.
+  // node_count bounds the node ids.
   void build(const std::vector<Tri>& triangles, size_t node_count);
 
-  // The normals of the surface at positions x (same triangles as at build); allocates nothing.
-  void update(const Vec3List& x, const std::vector<Tri>& triangles);
-
   // The pseudo-normal (not unit) at the point of triangle `tri` (corners t) with barycentric
-  // weights w, as closest_on_triangle returns them: a zero weight puts the point on the edge
-  // opposite that corner, two zeros on the remaining corner; face is the triangle's unit normal.
-  Vec3 at(int32_t tri, const Tri& t, const Vec3& w, const Vec3& face) const;
+  // weights w, as closest_on_triangle returns them, for the surface at positions x (the triangles
+  // of build): a zero weight puts the point on the edge opposite that corner, two zeros on the
+  // remaining corner; face is the triangle's unit normal. Made from the few triangles around
+  // that edge or corner when asked, not for the whole surface every step (the collision queries
+  // ask for a few dozen a step); the sums run in triangle order, as a pass over the surface
+  // would add them. Allocates nothing.
+  Vec3 at(int32_t tri, const Tri& t, const Vec3& w, const Vec3& face, const Vec3List& x,
+          const std::vector<Tri>& triangles) const;
 
  private:
   std::vector<std::array<int32_t, 3>> triangle_edges_;  // edge k of a triangle joins its corners k and k+1
-  Vec3List edge_;    // per edge: the sum of the unit normals of the faces on it
-  Vec3List vertex_;  // per node: the sum over its faces of the face's angle there times its unit normal
+  // Per edge, the triangles on it; per node, the triangles at it and which corner it is there
+  // (CSR: start per edge or node, then the entries, in triangle order).
+  std::vector<int32_t> edge_start_, edge_triangle_;
+  std::vector<int32_t> node_start_;
+  std::vector<std::array<int32_t, 2>> node_corner_;  // (triangle, corner)
 };
 
 }  // namespace mica

@@ -12,6 +12,7 @@ BodyModel::BodyModel(const TetMesh& mesh, const BodySettings& s, const std::stri
   for (const Tri& t : surface)
     for (int k = 0; k < 3; ++k) surface_edge += (x[t[k]] - x[t[(k + 1) % 3]]).norm();
   surface_edge /= double(3 * surface.size());
+  pseudo_normals.build(surface, x.size());
 }
 
 BodyState::BodyState(const BodyModel& model) {
@@ -22,8 +23,6 @@ BodyState::BodyState(const BodyModel& model) {
   node_forces.assign(n, Vec3::Zero());
   contact_impulse.assign(n, Vec3::Zero());
   bvh.build(x, model.surface);
-  pseudo_normals.build(model.surface, n);
-  pseudo_normals.update(x, model.surface);
 }
 
 BodyScratch::BodyScratch(const BodyModel& model) {

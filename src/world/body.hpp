@@ -39,6 +39,7 @@ struct BodyModel {
   std::vector<Tri> surface;
   std::vector<int32_t> surface_node_list;  // candidates for contact
   double surface_edge = 0;                 // m, mean surface edge length: the deepest penetration looked for
+  SurfacePseudoNormals pseudo_normals;     // the surface's edges and corners: its pseudo-normals at x, when asked
   // For a world with threads > 1 (empty otherwise): blocks of tets that share no node (parallel
   // assembly) and blocks of nodes that share no block of A (the colour-ordered MBGS sweep).
   Colouring element_colours, node_colours;
@@ -58,7 +59,6 @@ struct BodyState {
   uint64_t lpc_version = 0;    // bumped when a constraint on this body is added or removed
   Vec3List contact_impulse;    // G^T lambda of the last step, N s
   TriangleBvh bvh;                         // over the surface triangles at x, refit every step
-  SurfacePseudoNormals pseudo_normals;     // of the surface at x, updated with the tree
 };
 
 // The step's work arrays (and what one step hands the next: R_end at x_end, A of a linear body).

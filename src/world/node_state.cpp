@@ -2,7 +2,7 @@
 // The host sets a body's node positions or velocities (checking a simulation, starting from a
 // computed state). What the world derived from the old positions goes with them:
 //  - the end-of-step rotations kept for the next step (x_end, R_end: recomputed from x);
-//  - the surface tree and pseudo-normals (refitted here: a static body's are not refitted by
+//  - the surface tree (refitted here: a static body's is not refitted by
 //    the step);
 //  - the warm-start impulses of the body's contacts (their features may no longer touch, and a
 //    remembered force would stiffen the next step's contact rows, add_contact_stiffness);
@@ -47,7 +47,6 @@ void World::set_positions(Id id, const Vec3List& x) {
   b.x_end.clear();
   b.relin.u_start_known = false;
   b.bvh.refit(b.x);
-  b.pseudo_normals.update(b.x, b.surface);
   for (uint64_t key : stale) warm_start_.erase(key);
   debt_ = decltype(debt_){};
   if (recorder_) recorder_->write(RecordKind::SetPositions, id, x);

@@ -18,7 +18,6 @@ namespace {
 SurfaceView current_surface(Body& b, Id id) {
   if (b.is_dynamic()) {
     b.bvh.refit(b.x);
-    b.pseudo_normals.update(b.x, b.surface);
   }
   return SurfaceView{-1, id, &b.x, &b.surface, &b.surface_node_list, &b.bvh, &b.pseudo_normals, b.surface_edge, 0};
 }

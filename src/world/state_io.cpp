@@ -452,7 +452,6 @@ void World::restore_state(const uint8_t* data, size_t size) {
     b.relin.u_end = d.u_end;
     b.relin.u_start_known = d.u_start_known != 0;
     b.bvh.refit(b.x);
-    b.pseudo_normals.update(b.x, b.surface);
     // The solvers' factors of the current matrix are redone (the same matrix: the same bits).
     b.matrix_current = false;
     ++b.matrix_version;

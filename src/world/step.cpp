@@ -341,7 +341,6 @@ void World::collide(StepContext& ctx) {
     double speed = 0;
     if (index >= 0) {
       b.bvh.refit(b.x);
-      b.pseudo_normals.update(b.x, b.surface);
       for (int32_t i : b.surface_node_list) speed = std::max(speed, b.v[i].norm());
     }
     views.push_back(SurfaceView{index, id, &b.x, &b.surface, &b.surface_node_list, &b.bvh, &b.pseudo_normals,

@@ -26,7 +26,6 @@ struct Obstacle {
     nodes = surface_nodes(surface);
     bvh.build(x, surface);
     normals.build(surface, x.size());
-    normals.update(x, surface);
   }
   SurfaceView view() const { return {-1, 2, &x, &surface, &nodes, &bvh, &normals, 0.05, 0.0}; }
 };

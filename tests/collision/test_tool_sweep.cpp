@@ -26,7 +26,6 @@ struct Slab {
     nodes = surface_nodes(surface);
     bvh.build(x, surface);
     normals.build(surface, x.size());
-    normals.update(x, surface);
   }
   SurfaceView view() const { return {0, 1, &x, &surface, &nodes, &bvh, &normals, 0.002, 0.0}; }
 };
