@@ -88,15 +88,15 @@ void add_element(const TetElement& e, const Lame& m, const Mat3& R, const Vec3Li
   const double vl = scale * e.volume * m.lambda, vm = scale * e.volume * m.mu;
   for (int a = 0; a < 4; ++a)
     for (int b = a; b < 4; ++b) {
-      const Vec3 u = vl * h[a], w = vm * h[b], p = h[b], q = h[a];
+      const Vec3 u = vl * h[a], w = vm * h[b];
       const double d = vm * e.grad[a].dot(e.grad[b]);
-      Mat3& k = K[slots[4 * a + b]];  // u p^T + w q^T + d I
+      Mat3& k = K[slots[4 * a + b]];  // u h_b^T + w h_a^T + d I
       for (int c = 0; c < 3; ++c)
-        for (int r = 0; r < 3; ++r) k(r, c) += u[r] * p[c] + w[r] * q[c] + (r == c ? d : 0.0);
+        for (int r = 0; r < 3; ++r) k(r, c) += u[r] * h[b][c] + w[r] * h[a][c] + (r == c ? d : 0.0);
       if (b == a) continue;
       Mat3& kt = K[slots[4 * b + a]];  // its transpose
       for (int c = 0; c < 3; ++c)
-        for (int r = 0; r < 3; ++r) kt(r, c) += u[c] * p[r] + w[c] * q[r] + (r == c ? d : 0.0);
+        for (int r = 0; r < 3; ++r) kt(r, c) += u[c] * h[b][r] + w[c] * h[a][r] + (r == c ? d : 0.0);
     }
 }
 
