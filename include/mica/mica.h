@@ -204,8 +204,9 @@ typedef struct mica_world_def {
    *  refresh and kept until the world is destroyed) while the steps go on, and used from
    *  that many solves later (in lockstep: the step waits for a late factorization, so results do
    *  not depend on timing). Meant for bodies that keep turning far from the factor's shape; on the
-   *  nidus benchmark (a tool crushing a few elements) it did not pay reliably (0.83-1.29x in
-   *  five runs, docs/performance.md).
+   *  nidus benchmark (a tool moving in a soft blob), every 4 steps: 6.9 conjugate-gradient
+   *  iterations per step instead of 10.9 and a median step 0.89-0.91x as long, its p95 no
+   *  shorter (three sets of six runs, docs/performance.md).
    *  Default 0: factor when the time step, damping or constraint set changes, and when a solve
    *  drags on. Costs a second core while it runs, and a second factor's memory. (With or
    *  without a refresh, so that a failed step can be undone, a factor replaced within a step
