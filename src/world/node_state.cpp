@@ -2,8 +2,7 @@
 // The host sets a body's node positions or velocities (checking a simulation, starting from a
 // computed state). What the world derived from the old positions goes with them:
 //  - the end-of-step rotations kept for the next step (x_end, R_end: recomputed from x);
-//  - the surface tree (refitted here: a static body's is not refitted by
-//    the step);
+//  - the surface tree (refitted here: a static body's is not refitted by the step);
 //  - the warm-start impulses of the body's contacts (their features may no longer touch, and a
 //    remembered force would stiffen the next step's contact rows, add_contact_stiffness);
 //  - the re-linearisation's energy debt (the host's change is no work of the step).

@@ -16,9 +16,7 @@ namespace {
 
 // A body's surface where it is now (a dynamic body's tree was last refitted by a step's collide).
 SurfaceView current_surface(Body& b, Id id) {
-  if (b.is_dynamic()) {
-    b.bvh.refit(b.x);
-  }
+  if (b.is_dynamic()) b.bvh.refit(b.x);
   return SurfaceView{-1, id, &b.x, &b.surface, &b.surface_node_list, &b.bvh, &b.pseudo_normals, b.surface_edge, 0};
 }
 
