@@ -1,6 +1,9 @@
 // SPDX-License-Identifier: Apache-2.0
 // Angle-weighted pseudo-normals tell inside from outside at every nearest point of a closed
 // surface, faces, edges and corners alike, where one face normal does not.
+#include <map>
+#include <random>
+
 #include "collision/closest_point.hpp"
 #include "collision/pseudo_normals.hpp"
 #include "test_util.hpp"
@@ -111,10 +114,51 @@ static void test_normals_follow_the_surface(void**) {
   assert_true(c.face_wrong > 0);
 }
 
+// Against their definition summed by one pass over the whole surface (Baerentzen and Aanaes: a
+// corner's normal is the sum over its faces of the face's angle there times its unit normal, an
+// edge's the sum of its two faces' unit normals), on a jittered box: every corner and edge of
+// every triangle, to the bit (the same terms in the same triangle order).
+static void test_matches_a_pass_over_the_surface(void**) {
+  ShearedBox box;
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> jitter(-0.004, 0.004);
+  for (Vec3& p : box.x) p += Vec3(jitter(rng), jitter(rng), jitter(rng));
+  SurfacePseudoNormals normals;
+  normals.build(box.surface, box.x.size());
+  Vec3List corner(box.x.size(), Vec3::Zero());
+  std::map<std::pair<int32_t, int32_t>, Vec3> edge;
+  for (const Tri& t : box.surface) {
+    const Vec3 unit = face_normal(box.x, t);
+    for (int k = 0; k < 3; ++k) {
+      const Vec3 u = box.x[t[(k + 1) % 3]] - box.x[t[k]], v = box.x[t[(k + 2) % 3]] - box.x[t[k]];
+      corner[t[k]] += std::atan2(u.cross(v).norm(), u.dot(v)) * unit;
+      const auto key = std::minmax(t[k], t[(k + 1) % 3]);
+      edge.emplace(key, Vec3::Zero()).first->second += unit;
+    }
+  }
+  int checked = 0;
+  for (size_t f = 0; f < box.surface.size(); ++f) {
+    const Tri& t = box.surface[f];
+    const Vec3 face = face_normal(box.x, t);
+    assert_true(normals.at(int32_t(f), t, Vec3(0.2, 0.3, 0.5), face, box.x, box.surface) == face);
+    for (int k = 0; k < 3; ++k) {
+      Vec3 at_corner = Vec3::Zero(), on_edge = Vec3::Constant(0.5);
+      at_corner[k] = 1;
+      on_edge[(k + 2) % 3] = 0;  // the edge from corner k to k + 1
+      assert_true(normals.at(int32_t(f), t, at_corner, face, box.x, box.surface) == corner[t[k]]);
+      const Vec3 e = edge.at(std::minmax(t[k], t[(k + 1) % 3]));
+      assert_true(normals.at(int32_t(f), t, on_edge, face, box.x, box.surface) == e);
+      checked += 2;
+    }
+  }
+  print_message("%d corners and edges of %zu triangles: the same bits\n", checked, box.surface.size());
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_sign_matches_inside_everywhere),
       cmocka_unit_test(test_normals_follow_the_surface),
+      cmocka_unit_test(test_matches_a_pass_over_the_surface),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
