@@ -64,27 +64,12 @@ void rotated_stiffness(const TetElement& e, const Lame& m, const Mat3& R, double
 
 void add_element(const TetElement& e, const Lame& m, const Mat3& R, const Vec3List& x, double scale,
                  const std::array<int32_t, 16>& slots, Mat3* K, Vec3List& f) {
+  add_elastic_forces(e, m, R, deformation_gradient(e, x), f);
+  if (!K) return;
   // h_a = R g_a, the rotated gradients: R Ke_ab R^T = V (lambda h_a h_b^T + mu h_b h_a^T + mu
   // (g_a . g_b) I).
   Vec3 h[4];
   for (int a = 0; a < 4; ++a) h[a] = R * e.grad[a];
-  // F = sum_a x_a g_a^T (the gradients sum to zero), sigma = 2 mu eps + lambda tr(eps) I with
-  // eps = sym(R^T F) - I, and f_a = -V R sigma g_a.
-  Mat3 F = Mat3::Zero();
-  for (int a = 0; a < 4; ++a) F.noalias() += x[e.nodes[a]] * e.grad[a].transpose();
-  const Mat3 G = R.transpose() * F;
-  const double e00 = G(0, 0) - 1, e11 = G(1, 1) - 1, e22 = G(2, 2) - 1;
-  const double tr = m.lambda * (e00 + e11 + e22);
-  Mat3 sigma;
-  sigma(0, 0) = 2 * m.mu * e00 + tr;
-  sigma(1, 1) = 2 * m.mu * e11 + tr;
-  sigma(2, 2) = 2 * m.mu * e22 + tr;
-  sigma(0, 1) = sigma(1, 0) = m.mu * (G(0, 1) + G(1, 0));
-  sigma(0, 2) = sigma(2, 0) = m.mu * (G(0, 2) + G(2, 0));
-  sigma(1, 2) = sigma(2, 1) = m.mu * (G(1, 2) + G(2, 1));
-  const Mat3 P = -e.volume * (R * sigma);
-  for (int a = 0; a < 4; ++a) f[e.nodes[a]].noalias() += P * e.grad[a];
-  if (!K) return;
   const double vl = scale * e.volume * m.lambda, vm = scale * e.volume * m.mu;
   for (int a = 0; a < 4; ++a)
     for (int b = a; b < 4; ++b) {

@@ -37,11 +37,10 @@ void add_elastic_forces(const TetElement& e, const Lame& m, const Mat3& R, const
 // The 16 blocks R Ke_ab R^T, scaled by `scale`, row-major in (a, b).
 void rotated_stiffness(const TetElement& e, const Lame& m, const Mat3& R, double scale, Mat3 K[16]);
 
-// The element's share of the step, fused: f += its elastic forces at x (add_elastic_forces) and,
-// when K is not null, K[slots[4a + b]] += scale * R Ke_ab R^T (rotated_stiffness), written
-// straight into the blocks: the 10 blocks of a <= b are computed once and the other 6 are their
-// transposes. The assembly's kernel, written out for speed; the two functions above are its
-// reference (tests/fem/test_tet_element.cpp).
+// The element's share of the step: f += its elastic forces at x (add_elastic_forces) and, when K
+// is not null, K[slots[4a + b]] += scale * R Ke_ab R^T, written straight into the blocks: the 10
+// blocks of a <= b are computed once and the other 6 are their transposes (no 16-block scratch).
+// The assembly's kernel; rotated_stiffness is its reference (tests/fem/test_tet_element.cpp).
 void add_element(const TetElement& e, const Lame& m, const Mat3& R, const Vec3List& x, double scale,
                  const std::array<int32_t, 16>& slots, Mat3* K, Vec3List& f);
 

@@ -161,9 +161,9 @@ static void test_stiffness_matches_finite_difference(void**) {
   check_stiffness(m, rotated, true, 1e-7);
 }
 
-// The fused kernel (add_element) against its reference, rotated_stiffness and add_elastic_forces,
-// on one element turned and strained at random: the same blocks, in the right slots (each its own
-// here, so a block written to its transpose's slot shows), and the same forces.
+// The assembly's kernel (add_element) against its reference, rotated_stiffness, on one element
+// turned and strained at random: the same blocks, in the right slots (each its own here, so a
+// block written to its transpose's slot shows), and the forces of add_elastic_forces at that F.
 static void test_fused_element_matches_reference(void**) {
   const FemModel m = cube_model();
   std::mt19937 rng(5);
