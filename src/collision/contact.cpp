@@ -216,7 +216,7 @@ void collide_tool(const Tool& tool, int32_t tool_index, uint64_t tool_key, const
     const double out_of_reach = margin + core.radius;
     auto oriented = [&](FeatureHit hit) {
       const FeatureHit as_found = hit;
-      orient_by_surface(body.normals->at(tri, t, hit.weights, face, *body.x, *body.triangles), core.radius, body.depth, hit);
+      orient_by_surface(body.normals->at(tri, hit.weights, face, *body.x, *body.triangles), core.radius, body.depth, hit);
       // Inside, a core point is as deep as its nearest surface point says, not as this pair's: a
       // box's core edge just through the surface once got its pair with a triangle edge 1.5 mm
       // away, 1.8 mm "deep" sideways, and threw the body. Other pairs stay one-sided.

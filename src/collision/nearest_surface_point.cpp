@@ -19,7 +19,7 @@ NearestSurfacePoint nearest_surface_point(const SurfaceView& s, const Vec3& p, d
   if (n.tri < 0) return n;
   const Tri& t = (*s.triangles)[n.tri];
   n.face = (x[t[1]] - x[t[0]]).cross(x[t[2]] - x[t[0]]).normalized();
-  n.outward = s.normals->at(n.tri, t, n.point.weights, n.face, x, *s.triangles);
+  n.outward = s.normals->at(n.tri, n.point.weights, n.face, x, *s.triangles);
   return n;
 }
 

@@ -57,7 +57,7 @@ void SurfacePseudoNormals::build(const std::vector<Tri>& triangles, size_t node_
     }
 }
 
-Vec3 SurfacePseudoNormals::at(int32_t tri, const Tri& t, const Vec3& w, const Vec3& face, const Vec3List& x,
+Vec3 SurfacePseudoNormals::at(int32_t tri, const Vec3& w, const Vec3& face, const Vec3List& x,
                               const std::vector<Tri>& triangles) const {
   const int zeros = int(w[0] == 0) + int(w[1] == 0) + int(w[2] == 0);
   if (zeros == 0) return face;
@@ -72,7 +72,7 @@ Vec3 SurfacePseudoNormals::at(int32_t tri, const Tri& t, const Vec3& w, const Ve
   }
   int corner = 0;  // on a corner: its faces' unit normals weighted by their angles there
   while (w[corner] == 0) ++corner;
-  const int32_t i = t[corner];
+  const int32_t i = triangles[tri][corner];
   for (int32_t q = node_start_[i]; q < node_start_[i + 1]; ++q) {
     const Tri& u = triangles[node_corner_[q][0]];
     const int k = node_corner_[q][1];

@@ -19,15 +19,14 @@ class SurfacePseudoNormals {
   // node_count bounds the node ids.
   void build(const std::vector<Tri>& triangles, size_t node_count);
 
-  // The pseudo-normal (not unit) at the point of triangle `tri` (corners t) with barycentric
-  // weights w, as closest_on_triangle returns them, for the surface at positions x (the triangles
-  // of build): a zero weight puts the point on the edge opposite that corner, two zeros on the
-  // remaining corner; face is the triangle's unit normal. Made from the few triangles around
+  // The pseudo-normal (not unit) at the point of triangle `tri` with barycentric weights w, as
+  // closest_on_triangle returns them, for the surface at positions x (the triangles of build): a
+  // zero weight puts the point on the edge opposite that corner, two zeros on the remaining
+  // corner; face is the triangle's unit normal. Made from the few triangles around
   // that edge or corner when asked, not for the whole surface every step (the collision queries
   // ask for a few dozen a step); the sums run in triangle order, as a pass over the surface
   // would add them. Allocates nothing.
-  Vec3 at(int32_t tri, const Tri& t, const Vec3& w, const Vec3& face, const Vec3List& x,
-          const std::vector<Tri>& triangles) const;
+  Vec3 at(int32_t tri, const Vec3& w, const Vec3& face, const Vec3List& x, const std::vector<Tri>& triangles) const;
 
  private:
   std::vector<std::array<int32_t, 3>> triangle_edges_;  // edge k of a triangle joins its corners k and k+1

@@ -76,7 +76,7 @@ SignCheck check_signs(const ShearedBox& box, const SurfacePseudoNormals& normals
     const Tri& t = box.surface[n.tri];
     const Vec3 face = face_normal(box.x, t);
     const Vec3 d = p - n.point.point;
-    c.wrong += (d.dot(normals.at(n.tri, t, n.point.weights, face, box.x, box.surface)) > 0) == inside(p);
+    c.wrong += (d.dot(normals.at(n.tri, n.point.weights, face, box.x, box.surface)) > 0) == inside(p);
     c.face_wrong += (d.dot(face) > 0) == inside(p);
     c.on_edges += (n.point.weights.array() == 0).any();
     ++c.checked;
@@ -140,14 +140,14 @@ static void test_matches_a_pass_over_the_surface(void**) {
   for (size_t f = 0; f < box.surface.size(); ++f) {
     const Tri& t = box.surface[f];
     const Vec3 face = face_normal(box.x, t);
-    assert_true(normals.at(int32_t(f), t, Vec3(0.2, 0.3, 0.5), face, box.x, box.surface) == face);
+    assert_true(normals.at(int32_t(f), Vec3(0.2, 0.3, 0.5), face, box.x, box.surface) == face);
     for (int k = 0; k < 3; ++k) {
       Vec3 at_corner = Vec3::Zero(), on_edge = Vec3::Constant(0.5);
       at_corner[k] = 1;
       on_edge[(k + 2) % 3] = 0;  // the edge from corner k to k + 1
-      assert_true(normals.at(int32_t(f), t, at_corner, face, box.x, box.surface) == corner[t[k]]);
+      assert_true(normals.at(int32_t(f), at_corner, face, box.x, box.surface) == corner[t[k]]);
       const Vec3 e = edge.at(std::minmax(t[k], t[(k + 1) % 3]));
-      assert_true(normals.at(int32_t(f), t, on_edge, face, box.x, box.surface) == e);
+      assert_true(normals.at(int32_t(f), on_edge, face, box.x, box.surface) == e);
       checked += 2;
     }
   }
