@@ -114,16 +114,24 @@ void FactoredMicaSolver::build_compliance(const std::vector<SolverBody>& bodies,
   row_of.resize(nt);
   for (size_t r = 0; r < nr; ++r)
     for (int32_t t = rows.start[r]; t < rows.start[r + 1]; ++t) row_of[t] = int32_t(r);
-  // W_rs = sum over term pairs on one body of coef_t coef_u d_r^T (Yc)_{slot t, slot u} d_s.
+  // W = D^T Yc D per body, D's column r the row's direction at its terms' slots (coef_t d_r):
+  // first Z = Yc D, the slots' response to each row's unit impulse, then W_rs = sum over the
+  // terms t of row r of coef_t d_r^T Z_{slot t, s}. Term by term, not over pairs of terms: a
+  // box tool teleported into two boxes made 507 rows of 1500 terms, whose 2.3 M pairs took
+  // 50 ms a solve.
+  for (ContactNodes& cn : nodes_) cn.Z.setZero(cn.Yc.rows(), Eigen::Index(nr));
+  for (size_t u = 0; u < nt; ++u) {
+    const RowTerm& b = rows.terms[u];
+    ContactNodes& cn = nodes_[b.body];
+    const Vec3 d = b.coef * rows.direction[row_of[u]];
+    cn.Z.col(row_of[u]).noalias() += cn.Yc.middleCols<3>(3 * term_slot_[u]) * d;
+  }
   W_.setZero(Eigen::Index(nr), Eigen::Index(nr));
-  for (size_t t = 0; t < nt; ++t)
-    for (size_t u = 0; u < nt; ++u) {
-      const RowTerm &a = rows.terms[t], &b = rows.terms[u];
-      if (a.body != b.body) continue;
-      const Mat3 block = nodes_[a.body].Yc.block<3, 3>(3 * term_slot_[t], 3 * term_slot_[u]);
-      W_(row_of[t], row_of[u]) +=
-          a.coef * b.coef * rows.direction[row_of[t]].dot(block * rows.direction[row_of[u]]);
-    }
+  for (size_t t = 0; t < nt; ++t) {
+    const RowTerm& a = rows.terms[t];
+    const Vec3 d = a.coef * rows.direction[row_of[t]];
+    W_.row(row_of[t]).noalias() += d.transpose() * nodes_[a.body].Z.middleRows<3>(3 * term_slot_[t]);
+  }
 }
 
 void FactoredMicaSolver::start_compliance(const std::vector<SolverBody>& bodies, const ContactRows& rows,
@@ -257,12 +265,16 @@ void FactoredMicaSolver::solve_small_lcp(const ContactRows& rows, double toleran
   }
   // Frictionless: Lemke's pivoting, exact (PGS on a few strongly coupled rows, contacts sharing
   // nodes, would crawl and stop far from the answer).
-  if (!friction) {
+  // Its ray (no impulses satisfy the rows: a tool closed around a body) stays one for the rest
+  // of the solve, whose rounds change the problem only by what they learn of W: they go straight
+  // to the sweeps (a pivot costs n^2 too, and 30-50 of them on 507 rows took 15 ms a round).
+  if (!friction && !lemke_failed_) {
     const LcpSolution sol = solve_lcp_lemke(small_M_, small_q_);
     if (sol.solved) {
       for (Eigen::Index a = 0; a < n; ++a) lambda_next_[live_[a]] = sol.z(a);
       return;
     }
+    lemke_failed_ = true;
   }
   // With friction (or if pivoting failed): block Gauss-Seidel over the contacts with the exact
   // local Coulomb solve, from lambda, to well below the tolerance.
@@ -281,7 +293,12 @@ void FactoredMicaSolver::solve_small_lcp(const ContactRows& rows, double toleran
   // Newton step on hundreds of rows (a fuzzed box under a tool, 78 frictional contacts that
   // stall spent 32-92 ms per call in 234 x 234 factorizations, found_frictional_stall_78_contacts;
   // the tests' problems need far fewer sweeps, the largest, test_solve_allocations', 117 rows).
-  fs.max_sweeps = 256;
+  // A sweep costs n^2 (each row's change updates every w), so past 120 rows the sweeps are
+  // bounded by that work, 256 sweeps of 120 rows: a box tool teleported into two boxes made 507
+  // contacts that no impulses satisfy (found_teleported_box_507_contacts), and 512 sweeps of them
+  // per round took 350 ms a step.
+  constexpr double kSweepWork = 256.0 * 120 * 120;
+  fs.max_sweeps = int32_t(std::clamp(kSweepWork / (double(n) * double(n)), 16.0, 256.0));
   fs.max_newton_rows = 120;
   fs.deadline = deadline;
   FrictionalSolution& sol = small_solution_;
@@ -367,6 +384,7 @@ SolveReport FactoredMicaSolver::solve(const SolveContext& ctx, std::vector<Solve
   }
   lambda.resize(nr, 0.0);
   start_compliance(bodies, rows, lambda);
+  lemke_failed_ = false;
   SolveReport report;
   if (settings.active_set && nr > 0) {
     report = solve_active_set(ctx, bodies, rows, lambda);

@@ -100,6 +100,7 @@ class FactoredMicaSolver : public CachingVelocitySolver<FactoredBodyCache> {
     Eigen::MatrixXd C;                            // S U^T (extra stiffness) U S
     Eigen::MatrixXd M;                            // (I + C Y)^-1
     Eigen::MatrixXd Yc;                           // U^T P_c^-1 U = Y M
+    Eigen::MatrixXd Z;                            // Yc D: the slots' response to each row (build_compliance)
     Eigen::PartialPivLU<Eigen::MatrixXd> lu;      // of I + C Y
     // Node forces, M force; t = U^T z of a preconditioner's z = P^-1 r, u = U^T of z corrected (as
     // of the forces); U^T of a response: the values a single-precision backward solve only
@@ -214,6 +215,7 @@ class FactoredMicaSolver : public CachingVelocitySolver<FactoredBodyCache> {
   Eigen::VectorXd small_q_, small_mu_, small_start_;
   std::vector<int32_t> small_normal_;
   FrictionalSolution small_solution_;
+  bool lemke_failed_ = false;  // this solve's small problem had no solution by pivoting (solve_small_lcp)
   FrictionalWorkspace small_workspace_;
   std::vector<double> warped_diag_;  // W_rr before the secant updates
   std::vector<Vec3List> rhs_;
