@@ -35,9 +35,11 @@ static void test_accounts_for_every_deadline(void**) {
   Counter counter;
   ServoThread servo;
   assert_false(servo.running());
+  // Before start(): the loop's grid begins inside it, and a test thread descheduled right after
+  // it would otherwise start its clock late (a flake under load: more deadlines than "elapsed").
+  const auto t0 = std::chrono::steady_clock::now();
   servo.start(count_tick, &counter, 1e-3);
   assert_true(servo.running());
-  const auto t0 = std::chrono::steady_clock::now();
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
   servo.stop();
   const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -91,7 +93,10 @@ static void test_start_stop_bookkeeping(void**) {
   // Restartable.
   const int64_t before = counter.ticks.load();
   servo.start(count_tick, &counter, 1e-3);
-  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  // Until it ticks, however long the scheduler makes it wait (a fixed 20 ms flaked under load).
+  const auto t0 = std::chrono::steady_clock::now();
+  while (counter.ticks.load() == before && std::chrono::steady_clock::now() - t0 < std::chrono::seconds(10))
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
   servo.stop();
   assert_true(counter.ticks.load() > before);
 
