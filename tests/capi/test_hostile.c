@@ -727,6 +727,59 @@ static void test_one_tet_under_a_frictional_sphere(void** state) {
     }
 }
 
+/* A box tool teleported around a small box and onto a larger one (found by the API fuzzer,
+ * found_teleported_box_507_contacts): hundreds of contact rows that no impulses satisfy, since
+ * the tool presses the small box from every side. The factored sweep must give up in bounded
+ * work and say so, not run its rounds to the iteration cap: MICA_WARN_NOT_CONVERGED, finite
+ * results, fewer iterations than the cap (the impulses of such a problem grow by the same step
+ * every round, so only the stall rule stops it). */
+static void test_tool_closed_around_a_body(void** state) {
+  (void)state;
+  mica_world_def wd = mica_world_def_default(); /* the factored sweep, 200 iterations */
+  wd.relinearise_max = 1;                        /* one solve a step: the cap is the step's */
+  mica_world* w = NULL;
+  assert_int_equal(mica_world_create(&wd, &w), MICA_OK);
+  const mica_body_def bd = mica_body_def_default();
+  const int32_t cells_big[3] = {2, 2, 2}, cells_small[3] = {1, 1, 1};
+  const double big_lo[3] = {-0.05, -0.1, -0.05}, big_hi[3] = {0.05, 0, 0.05};
+  const double small_lo[3] = {0, 0, 0}, small_hi[3] = {0.005, 0.005, 0.005};
+  mica_body_id big, small;
+  assert_int_equal(mica_body_create_box(w, &bd, big_lo, big_hi, cells_big, 5, &big), MICA_OK);
+  assert_int_equal(mica_body_create_box(w, &bd, small_lo, small_hi, cells_small, 5, &small), MICA_OK);
+  mica_tool_def td = mica_tool_def_default();
+  td.shape = MICA_TOOL_BOX;
+  td.half_extents[0] = td.half_extents[1] = td.half_extents[2] = 0.01;
+  td.position[0] = -0.126;
+  td.position[1] = -0.128;
+  td.position[2] = 0.001;
+  mica_tool_id tool;
+  assert_int_equal(mica_tool_create(w, &td, &tool), MICA_OK);
+  assert_int_equal(mica_step(w, 0.01) >= 0, 1);
+  const double p[3] = {0.003, 0.005, 0.002}, q[4] = {1, 0, 0, 0};
+  assert_int_equal(mica_tool_set_pose(w, tool, p, q), MICA_OK);
+  assert_int_equal(mica_step(w, 0.01), MICA_WARN_NOT_CONVERGED);
+  mica_world_stats st;
+  memset(&st, 0, sizeof st);
+  st.struct_size = sizeof st;
+  assert_int_equal(mica_world_get_stats(w, &st), MICA_OK);
+  print_message("enclosed body: %d contacts, %d iterations and %d solves, residual %.3g\n", st.contacts,
+                st.solver_iterations, st.solves, st.solver_residual);
+  assert_true(st.contacts > 100);
+  assert_int_equal(st.converged, 0);
+  assert_true(st.solver_iterations < wd.max_iterations);
+  double force[3];
+  assert_int_equal(mica_tool_get_force(w, tool, force, NULL, NULL), MICA_OK);
+  assert_true(isfinite(force[0]) && isfinite(force[1]) && isfinite(force[2]));
+  const mica_body_id bodies[2] = {big, small};
+  for (int b = 0; b < 2; ++b) {
+    double x[3 * 27];
+    int32_t n = 0;
+    assert_int_equal(mica_body_get_positions(w, bodies[b], x, 27, &n), MICA_OK);
+    for (int32_t i = 0; i < 3 * n; ++i) assert_true(isfinite(x[i]));
+  }
+  mica_world_destroy(w);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_duplicate_tets_are_refused),
@@ -739,6 +792,7 @@ int main(void) {
       cmocka_unit_test(test_rate_limit_after_a_stall),
       cmocka_unit_test(test_absurd_nominal_figures),
       cmocka_unit_test(test_one_tet_under_a_frictional_sphere),
+      cmocka_unit_test(test_tool_closed_around_a_body),
   };
   return cmocka_run_group_tests(tests, group_setup, group_teardown);
 }
