@@ -356,12 +356,18 @@ void FactoredMicaSolver::secant_update() {
 
 void FactoredMicaSolver::row_velocities(const std::vector<SolverBody>& bodies, const ContactRows& rows) {
   w_.assign(rows.size(), 0.0);
+  double floor = 0;
   for (size_t r = 0; r < rows.size(); ++r) {
-    double c = rows.bias[r];
-    for (int32_t t = rows.start[r]; t < rows.start[r + 1]; ++t)
-      c += rows.terms[t].coef * rows.direction[r].dot((*bodies[rows.terms[t].body].v)[rows.terms[t].node]);
+    double c = rows.bias[r], speed = 0;
+    for (int32_t t = rows.start[r]; t < rows.start[r + 1]; ++t) {
+      const Vec3& v = (*bodies[rows.terms[t].body].v)[rows.terms[t].node];
+      c += rows.terms[t].coef * rows.direction[r].dot(v);
+      speed += std::abs(rows.terms[t].coef) * v.norm();
+    }
     w_[r] = c;
+    if (warped_diag_[r] > 0) floor = std::max(floor, speed / warped_diag_[r]);
   }
+  impulse_floor2_ = floor * floor;
 }
 
 SolveReport FactoredMicaSolver::solve(const SolveContext& ctx, std::vector<SolverBody>& bodies,
@@ -486,9 +492,10 @@ SolveReport FactoredMicaSolver::solve(const SolveContext& ctx, std::vector<Solve
       l2 += lambda_next_[r] * lambda_next_[r];
     }
     if (outer == 1) l_scale = l2;  // the first correction sets the scale when lambda starts at zero
-    report.impulse_change = dl2 > 0 ? std::sqrt(dl2 / std::max(l2, l_scale)) : 0.0;
+    const double scale2 = std::max({l2, l_scale, impulse_floor2_});
+    report.impulse_change = dl2 > 0 ? std::sqrt(dl2 / scale2) : 0.0;
     if (report.impulse_change <= settings.tolerance && velocities_solved &&
-        complementarity_error(rows, lambda) <= settings.tolerance * std::sqrt(std::max(l2, l_scale))) {
+        complementarity_error(rows, lambda) <= settings.tolerance * std::sqrt(scale2)) {
       // v balances the current impulses and the impulses no longer move: done.
       report.momentum_residual = momentum_residual(bodies);
       report.residual = std::max({report.velocity_change, report.impulse_change, report.momentum_residual});

@@ -149,8 +149,13 @@ class FactoredMicaSolver : public CachingVelocitySolver<FactoredBodyCache> {
   // Two solved velocity fields secant_s_ apart in the impulses measure the true compliance along
   // it, y = w_ - w_prev_: a BFGS update takes that into W_ (kept symmetric positive definite).
   void secant_update();
-  // w_ = G v + bias of the bodies' current velocities.
+  // w_ = G v + bias of the bodies' current velocities, and impulse_floor2_.
   void row_velocities(const std::vector<SolverBody>& bodies, const ContactRows& rows);
+  // The squared impulse that changes a row's velocity by the speed of its nodes (the largest over
+  // the rows): the tests' impulse scale is at least this. Below it a row velocity is zero to the
+  // tolerance, and impulses and their complementarity are the solves' round-off: two bodies that
+  // touch and fall together carry none, and a test relative to their ~1e-23 N s never passed.
+  double impulse_floor2_ = 0;
 
   // The active-set loop (factored_mica_active_set.cpp, SolverSettings::active_set).
   SolveReport solve_active_set(const SolveContext& ctx, std::vector<SolverBody>& bodies, const ContactRows& rows,

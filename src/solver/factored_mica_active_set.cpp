@@ -412,7 +412,7 @@ SolveReport FactoredMicaSolver::solve_active_set(const SolveContext& ctx, std::v
     double l2 = 0;
     for (double l : lambda) l2 += l * l;
     l_scale = std::max(l_scale, l2);
-    report.impulse_change = complementarity_error(rows, lambda) / std::sqrt(std::max(l_scale, 1e-300));
+    report.impulse_change = complementarity_error(rows, lambda) / std::sqrt(std::max({l_scale, impulse_floor2_, 1e-300}));
     if (report.impulse_change <= settings.tolerance) {
       rows.project(lambda);  // a sliding pair kept its impulse while lambda_n was solved: back onto the disk
       scatter_contact_impulses(rows, lambda, bodies);
