@@ -170,12 +170,16 @@ class FactoredMicaSolver : public CachingVelocitySolver<FactoredBodyCache> {
                                 double tolerance, int32_t cap,
                                 const std::optional<SolveContext::Clock::time_point>& deadline, double impulse_scale2,
                                 bool& set_changed);
-  // During constrained_solve: the complementarity error of its normal rows' impulses and velocities
-  // so far is above kWrongSet of the impulses (it leaves them in lambda_check_ and w_).
+  // During constrained_solve, at relative residual `residual`: the complementarity error of its
+  // normal rows' impulses and velocities so far is above min(kWrongSet, kWrongFactor residual) of
+  // the impulses (it leaves them in lambda_check_ and w_). A right set's error shrinks with the
+  // residual (about 1e-16 of the impulses once solved); a wrong set's settles at the size of the
+  // impulse it gets wrong, which may be below kWrongSet.
   bool set_clearly_wrong(const std::vector<SolverBody>& bodies, const ContactRows& rows,
                          const std::vector<double>& lambda, const Eigen::Ref<const Eigen::VectorXd>& mu_total,
-                         double impulse_scale2);
+                         double impulse_scale2, double residual);
   static constexpr double kWrongSet = 1e-2;
+  static constexpr double kWrongFactor = 3;
   // x = W_E^-1 rhs (the least-squares solution where rows are redundant).
   void solve_equalities(const Eigen::Ref<const Eigen::VectorXd>& rhs, Eigen::Ref<Eigen::VectorXd> x);
   // y_ such that S Q y_ = P_c^-1 G^T w on body bi for row weights w (the factor's frame: a

@@ -190,7 +190,8 @@ double FactoredMicaSolver::equality_load2(const std::vector<SolverBody>& bodies,
 
 bool FactoredMicaSolver::set_clearly_wrong(const std::vector<SolverBody>& bodies, const ContactRows& rows,
                                            const std::vector<double>& lambda,
-                                           const Eigen::Ref<const Eigen::VectorXd>& mu_total, double impulse_scale2) {
+                                           const Eigen::Ref<const Eigen::VectorXd>& mu_total, double impulse_scale2,
+                                           double residual) {
   // The impulses and row velocities of the solve so far: lambda_E from the equalities' share, the
   // rest as fixed; v = y + z at the rows' nodes.
   lambda_check_ = lambda;
@@ -219,7 +220,11 @@ bool FactoredMicaSolver::set_clearly_wrong(const std::vector<SolverBody>& bodies
     const double next = std::max(0.0, lambda_check_[r] - w_[r] / warped_diag_[r]);
     e2 += (next - lambda_check_[r]) * (next - lambda_check_[r]);
   }
-  return e2 > kWrongSet * kWrongSet * std::max({l2, impulse_scale2, 1e-300});
+  // The limit follows the residual down: a round that would converge with its set still wrong
+  // (its error settling below kWrongSet) stops when the error no longer shrinks with it, not
+  // after a full solve (8-9 iterations of a nidus step, in about 1 step of 20).
+  const double limit = std::min(kWrongSet, kWrongFactor * residual);
+  return e2 > limit * limit * std::max({l2, impulse_scale2, impulse_floor2_, 1e-300});
 }
 
 SolveReport FactoredMicaSolver::constrained_solve(std::vector<SolverBody>& bodies, const ContactRows& rows,
@@ -302,7 +307,7 @@ SolveReport FactoredMicaSolver::constrained_solve(std::vector<SolverBody>& bodie
     if (report.converged || report.iterations >= cap) break;
     // A wrong set shows long before the solve is polished: stop, and the caller predicts again.
     if (report.residual <= set_check_residual_ &&
-        set_clearly_wrong(bodies, rows, lambda, mu_total, impulse_scale2)) {
+        set_clearly_wrong(bodies, rows, lambda, mu_total, impulse_scale2, report.residual)) {
       set_changed = true;
       break;
     }
