@@ -75,7 +75,8 @@ class FactoredMicaSolver : public CachingVelocitySolver<FactoredBodyCache> {
   // The active-set loop: once a round's solve is this close (relative residual), it checks its set
   // at every iteration and gives the set up as soon as it is clearly wrong (a pressing row pulls
   // or a free one sinks by kWrongSet of the impulses, or by kWrongFactor times the residual once
-  // that is smaller), instead of polishing a solution the next round replaces. 0: never (each round solves to the tolerance; the tests compare both).
+  // that is smaller), instead of polishing a solution the next round replaces. 0: never (each
+  // round solves to the tolerance; the tests compare both).
   void set_check_residual(double residual) { set_check_residual_ = residual; }
   static constexpr double kSetCheckResidual = 1e-2;
   // Each body's lagged factor (LaggedFactor::save, load).
