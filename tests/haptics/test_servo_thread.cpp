@@ -36,7 +36,7 @@ static void test_accounts_for_every_deadline(void**) {
   ServoThread servo;
   assert_false(servo.running());
   // Before start(): the loop's grid begins inside it, and a test thread descheduled right after
-  // it would otherwise start its clock late (a flake under load: more deadlines than "elapsed").
+  // it would otherwise start its clock late and count more deadlines than "elapsed" allows.
   const auto t0 = std::chrono::steady_clock::now();
   servo.start(count_tick, &counter, 1e-3);
   assert_true(servo.running());
@@ -93,7 +93,8 @@ static void test_start_stop_bookkeeping(void**) {
   // Restartable.
   const int64_t before = counter.ticks.load();
   servo.start(count_tick, &counter, 1e-3);
-  // Until it ticks, however long the scheduler makes it wait (a fixed 20 ms flaked under load).
+  // Until it ticks, however long the scheduler makes it wait (a loaded machine may not run the
+  // thread within a fixed 20 ms).
   const auto t0 = std::chrono::steady_clock::now();
   while (counter.ticks.load() == before && std::chrono::steady_clock::now() - t0 < std::chrono::seconds(10))
     std::this_thread::sleep_for(std::chrono::milliseconds(1));
