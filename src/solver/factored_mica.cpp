@@ -5,6 +5,7 @@
 
 #include "solver/friction_cone.hpp"
 #include "solver/frictional_contact.hpp"
+#include "solver/stall_watch.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -415,8 +416,7 @@ SolveReport FactoredMicaSolver::solve(const SolveContext& ctx, std::vector<Solve
   // closed around a body) grows its impulses by the same step every round, a change of 1/k, and
   // took the whole default cap, 200 rounds, 313 ms a step (found_teleported_box_507_contacts).
   constexpr int32_t kStallRounds = 16;
-  double best_change = std::numeric_limits<double>::infinity(), best_at_window = best_change;
-  int32_t window_end = kStallRounds;
+  StallWatch progress(kStallRounds);
   while (report.iterations < settings.max_iterations) {
     if (deadline && outer > 0 && Clock::now() >= *deadline) {
       report.out_of_time = true;
@@ -502,12 +502,8 @@ SolveReport FactoredMicaSolver::solve(const SolveContext& ctx, std::vector<Solve
       report.converged = report.momentum_residual <= settings.tolerance;
       if (report.converged) return report;
     }
-    best_change = std::min(best_change, report.impulse_change);
-    if (outer >= window_end) {
-      if (!(best_change <= 0.5 * best_at_window) && std::isfinite(best_at_window)) break;  // stalled
-      best_at_window = best_change;
-      window_end = outer + kStallRounds;
-    }
+    progress.add(report.impulse_change);
+    if (!progress.progressing(outer)) break;  // stalled
     apply_impulse_change(bodies, rows, dlambda_);
     lambda = lambda_next_;
   }

@@ -4,11 +4,11 @@
 #include <Eigen/QR>
 #include <cmath>
 #include <cstdio>
-#include <limits>
 
 #include "core/error.hpp"
 #include "solver/cod_solve.hpp"
 #include "solver/friction_cone.hpp"
+#include "solver/stall_watch.hpp"
 
 namespace mica {
 
@@ -182,8 +182,7 @@ void solve_frictional_contact(const Eigen::MatrixXd& M, const Eigen::VectorXd& q
   // the default budget, so the rule gives up only on what the budget would not have solved.
   constexpr int32_t kStallWindow = 256;
   bool damped = false, stalled = false;
-  double best = std::numeric_limits<double>::infinity(), best_at_window = best;
-  int32_t window_end = kStallWindow;
+  StallWatch progress(kStallWindow);
   s.solved = converged();
   for (int32_t batch = 8; !s.solved && !stalled && s.sweeps < 2 * settings.max_sweeps;
        batch = std::min(2 * batch, 512)) {
@@ -193,7 +192,7 @@ void solve_frictional_contact(const Eigen::MatrixXd& M, const Eigen::VectorXd& q
       sweep(M, blocks, damped ? 0.5 : 1.0, s.z, s.w);
       ++s.sweeps;
       s.solved = converged_after_sweep();
-      best = std::min(best, s.error / s.scale);
+      progress.add(s.error / s.scale);
     }
     for (int k = 0; k < 20 && newton && !s.solved && !out_of_time(); ++k) {
       natural_map(M, blocks, s.z, s.w, F, &J);
@@ -213,16 +212,12 @@ void solve_frictional_contact(const Eigen::MatrixXd& M, const Eigen::VectorXd& q
       if (!lowered) break;  // back to the sweeps
       s.z.swap(z_trial);
       s.solved = converged();
-      best = std::min(best, s.error / s.scale);
+      progress.add(s.error / s.scale);
     }
     if (s.out_of_time) break;
-    if (s.sweeps >= window_end) {
-      if (!(best <= 0.5 * best_at_window) && std::isfinite(best_at_window)) {
-        stalled = damped;
-        damped = true;
-      }
-      best_at_window = best;
-      window_end = s.sweeps + kStallWindow;
+    if (!progress.progressing(s.sweeps)) {
+      stalled = damped;
+      damped = true;
     }
   }
   // Newton steps may leave a cone by round-off: the impulses returned are admissible.
