@@ -414,7 +414,7 @@ SolveReport FactoredMicaSolver::solve(const SolveContext& ctx, std::vector<Solve
   // impulse change must halve every kStallRounds rounds. At a slower rate no solve reaches a
   // tolerance within a cap of a few hundred rounds; a contact problem with no solution (a tool
   // closed around a body) grows its impulses by the same step every round, a change of 1/k, and
-  // took the whole default cap, 200 rounds, 313 ms a step (found_teleported_box_507_contacts).
+  // took the whole default cap (test_hostile.c: test_tool_closed_around_a_body).
   constexpr int32_t kStallRounds = 16;
   StallWatch progress(kStallRounds);
   while (report.iterations < settings.max_iterations) {
