@@ -113,13 +113,16 @@ int main(int argc, char** argv) {
   }
   {
     // The factored sweep's solve pair, one right-hand side: cholmod_solve2 against the
-    // hand-written supernodal solve (solver/supernodal_solve.hpp) in double and in single
-    // precision, taken in turn, best of 50 each.
+    // hand-written supernodal solve (solver/supernodal_solve.hpp) in double, in single and in
+    // half precision (where this CPU has F16C), taken in turn, best of 50 each.
     Projection none;
     none.reset(p.rows);
-    DirectSolver d;
-    d.set_keep_single(true);
+    DirectSolver d, dh;
+    d.set_copy(SupernodalSolve::Copy::Single);
+    dh.set_copy(SupernodalSolve::Copy::Half);
     d.analyze(p);
+    dh.analyze(p);
+    dh.factorize(ProjectedSystem{p, body.A, none});
     double factor = 1e300;
     for (int k = 0; k < 5; ++k) {
       const auto t = Clock::now();
@@ -132,8 +135,8 @@ int main(int argc, char** argv) {
                 1e-6 * double(d.factor_entries()), 1e-6 * d.factor_nonzeros(), d.factor_flops(), factor);
     const Eigen::VectorXd b = Eigen::VectorXd::Random(3 * p.rows);
     Eigen::MatrixXd x1, x2;
-    Eigen::VectorXd x3;
-    double cholmod = 1e300, by_hand = 1e300, single = 1e300;
+    Eigen::VectorXd x3, x4;
+    double cholmod = 1e300, by_hand = 1e300, single = 1e300, half = 1e300;
     for (int k = 0; k < 50; ++k) {
       auto t = Clock::now();
       d.solve_raw_cholmod(b, x1);
@@ -144,25 +147,31 @@ int main(int argc, char** argv) {
       t = Clock::now();
       d.solve_one(b, x3, true);
       single = std::min(single, ms_since(t));
+      t = Clock::now();
+      dh.solve_one(b, x4, true);
+      half = std::min(half, ms_since(t));
     }
     std::printf("solve pair, 1 rhs:     cholmod_solve2 %.3f ms; by hand %.3f ms (%.2fx, difference %.1e); single "
                 "precision %.3f ms (%.2fx, difference %.1e)\n",
                 cholmod, by_hand, by_hand / cholmod, (x1 - x2).norm() / x1.norm(), single, single / cholmod,
                 (x1.col(0) - x3).norm() / x1.norm());
+    std::printf("                       half precision %.3f ms (%.2fx single, difference %.1e)%s\n", half,
+                half / single, (x1.col(0) - x4).norm() / x1.norm(),
+                dh.by_hand()->half() ? "" : " (no half copy: this CPU lacks F16C, or the probe refused it)");
     // The half columns of 25 nodes spread over the body (a contact set's worth: what the factored
     // sweep makes for a new factor's contact nodes, in the background or in the step).
     constexpr int kNodes = 25;
     std::vector<SupernodalSolve::HalfColumns> columns(kNodes);
-    double half = 1e300;
+    double columns_ms = 1e300;
     long rows = 0;
     for (int k = 0; k < 10; ++k) {
       const auto t = Clock::now();
       for (int a = 0; a < kNodes; ++a)
         d.by_hand()->half_columns(3 * int32_t(int64_t(a) * p.rows / kNodes), columns[size_t(a)]);
-      half = std::min(half, ms_since(t));
+      columns_ms = std::min(columns_ms, ms_since(t));
     }
     for (const auto& c : columns) rows += long(c.values.rows());
-    std::printf("half columns:          %d nodes in %.3f ms (%.1f rows each on average)\n", kNodes, half,
+    std::printf("half columns:          %d nodes in %.3f ms (%.1f rows each on average)\n", kNodes, columns_ms,
                 double(rows) / kNodes);
   }
   return 0;

@@ -103,7 +103,7 @@ void DirectSolver::factorize(const ProjectedSystem& sys) {
   ++factorizations_;
   if (llt_.info() != Eigen::Success)
     fail(Errc::Numerical, "the system matrix is not positive definite (CHOLMOD factorization failed)");
-  by_hand_.bind(llt_.factor(), keep_single_);  // false (cholmod_solve2 then) for a factor of another kind
+  by_hand_.bind(llt_.factor(), copy_);  // false (cholmod_solve2 then) for a factor of another kind
 }
 
 SolveReport DirectSolver::solve(const ProjectedSystem& sys, const Vec3List& b, Vec3List& v) {

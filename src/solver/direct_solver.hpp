@@ -32,9 +32,9 @@ class DirectSolver : public LinearSolver {
   void solve_raw(const Eigen::Ref<const Eigen::MatrixXd>& B, Eigen::MatrixXd& X);
   // The same through cholmod_solve2 only (the reference the hand-written solve is tested against).
   void solve_raw_cholmod(const Eigen::Ref<const Eigen::MatrixXd>& B, Eigen::MatrixXd& X);
-  // With keep_single set (before factorize), each factorization also keeps a single-precision
-  // copy of the factor.
-  void set_keep_single(bool keep) { keep_single_ = keep; }
+  // Set before factorize: each factorization also keeps this copy of the factor for the
+  // preconditioner's solves (supernodal_solve.hpp).
+  void set_copy(SupernodalSolve::Copy copy) { copy_ = copy; }
   // x = (S A S + I - S)^-1 b for one right-hand side; with `single` and a single-precision copy,
   // solved with the copy (a preconditioner's solve), else as solve_raw.
   void solve_one(const Eigen::Ref<const Eigen::VectorXd>& b, Eigen::VectorXd& x, bool single);
@@ -62,7 +62,7 @@ class DirectSolver : public LinearSolver {
   };
   Factor llt_;
   SupernodalSolve by_hand_;  // bound to llt_'s factor after each factorization
-  bool keep_single_ = false;
+  SupernodalSolve::Copy copy_ = SupernodalSolve::Copy::None;
   cholmod_dense *x_ = nullptr, *y_ = nullptr, *e_ = nullptr;  // cholmod_solve2's solution and workspaces
   Vec3List rhs_, tmp_, check_;
   Eigen::MatrixXd y_flat_;

@@ -196,9 +196,10 @@ class FactoredMicaSolver : public CachingVelocitySolver<FactoredBodyCache> {
   // out -= S G_E^T x.
   void subtract_row_forces(const std::vector<SolverBody>& bodies, const ContactRows& rows,
                            const Eigen::Ref<const Eigen::VectorXd>& x, std::vector<Vec3List>& out) const;
-  // |S G_E^T x|^2, the equalities' load on the bodies (the scale of constrained_solve's residual).
-  double equality_load2(const std::vector<SolverBody>& bodies, const ContactRows& rows,
-                        const Eigen::Ref<const Eigen::VectorXd>& x);
+  // nodes_[b].load = S G_E^T x on body b's contact nodes, the equalities' load on the bodies (part
+  // of the scale of constrained_solve's residual).
+  void equality_loads(const std::vector<SolverBody>& bodies, const ContactRows& rows,
+                      const Eigen::Ref<const Eigen::VectorXd>& x);
   // out = G_E y (no bias).
   void rows_times(const ContactRows& rows, const std::vector<Vec3List>& y, Eigen::Ref<Eigen::VectorXd> out) const;
   // out = G_E U u of the bodies' nodes_.u, and each body's force -= U^T G_E^T x.
@@ -228,6 +229,7 @@ class FactoredMicaSolver : public CachingVelocitySolver<FactoredBodyCache> {
   bool lemke_failed_ = false;  // this solve's small problem had no solution by pivoting (solve_small_lcp)
   FrictionalWorkspace small_workspace_;
   std::vector<double> warped_diag_;  // W_rr before the secant updates
+  std::vector<double> body_scale2_;  // constrained_solve: each body's |f|^2 (or its mass floor)
   std::vector<Vec3List> rhs_;
   Eigen::VectorXd y_;
   std::vector<double> row_weight_;  // add_response's row weights

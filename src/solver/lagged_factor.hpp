@@ -105,7 +105,7 @@ class LaggedFactor {
 
  private:
   struct Slot {
-    Slot() { direct.set_keep_single(true); }  // the preconditioner solves in single precision
+    Slot() { direct.set_copy(SupernodalSolve::Copy::Half); }  // the preconditioner's solves: half or single
     DirectSolver direct;
     BlockValues A;            // the system factored (a copy: the worker factors it; a saved state keeps it)
     Projection projection;

@@ -4,11 +4,14 @@
 #include <algorithm>
 #include <cmath>
 
+#include "solver/half_products.hpp"
+
 namespace mica {
 
-bool SupernodalSolve::bind(const cholmod_factor* L, bool single) {
+bool SupernodalSolve::bind(const cholmod_factor* L, Copy copy) {
   L_ = nullptr;
   values_single_.clear();
+  values_half_.clear();
   if (!L || !L->is_super || !L->is_ll || L->xtype != CHOLMOD_REAL || L->dtype != CHOLMOD_DOUBLE ||
       L->itype != CHOLMOD_INT || !L->x)
     return false;
@@ -26,20 +29,28 @@ bool SupernodalSolve::bind(const cholmod_factor* L, bool single) {
   inverse_perm_.resize(size_t(n));
   for (Eigen::Index i = 0; i < n; ++i) inverse_perm_[size_t(perm[i])] = int32_t(i);
   L_ = L;
-  if (single) {
-    make_single();
-    w_single_.resize(n);
-    // Kept only where single precision holds: float's 6e-8 grows with the condition of the
-    // system (a nearly incompressible, very stiff body's is far too large), and a preconditioner
-    // that far off misleads the solves. Probed on one fixed vector, in double and in single.
-    Eigen::VectorXd probe(n), in_double(n), in_single(n);
-    for (Eigen::Index i = 0; i < n; ++i) probe[i] = std::sin(0.7 * double(i)) + 0.5;
-    solve(probe.data(), in_double.data());
-    solve_single(probe.data(), in_single.data());
-    const double error = (in_single - in_double).norm(), size = in_double.norm();
-    if (!(error <= kSingleAgreement * size)) values_single_.clear();
+  if (copy == Copy::None) return true;
+  // A copy is kept only where its precision holds: float's 6e-8 (half's 5e-4) grows with the
+  // condition of the system (a nearly incompressible, very stiff body's is far too large), and a
+  // preconditioner that far off misleads the solves.
+  make_single();
+  w_single_.resize(n);
+  if (copy == Copy::Half && half_products_supported()) {
+    make_half();
+    if (probe_copy() <= kHalfAgreement) return true;
+    values_half_.clear();
   }
+  if (!(probe_copy() <= kSingleAgreement)) values_single_.clear();
   return true;
+}
+
+double SupernodalSolve::probe_copy() const {
+  const Eigen::Index n = Eigen::Index(L_->n);
+  Eigen::VectorXd probe(n), in_double(n), in_copy(n);
+  for (Eigen::Index i = 0; i < n; ++i) probe[i] = std::sin(0.7 * double(i)) + 0.5;
+  solve(probe.data(), in_double.data());
+  solve_single(probe.data(), in_copy.data());
+  return (in_copy - in_double).norm() / in_double.norm();
 }
 
 void SupernodalSolve::solve(const double* b, double* x) const {
@@ -108,12 +119,36 @@ void SupernodalSolve::make_single() {
   y_single_.resize(tallest);
 }
 
-namespace {
+void SupernodalSolve::make_half() {
+  values_half_.assign(values_single_.size(), 0);
+  half_unscale_.assign(size_t(L_->nsuper), 1.0f);
+  for (int k = 0; k < int(L_->nsuper); ++k) {
+    const int nc = super_[k + 1] - super_[k], nr = pi_[k + 1] - pi_[k];
+    const int top = nc > kInvertedWidth ? nc : 0;  // a wide supernode's diagonal block stays single
+    const float* B = values_single_.data() + px_[k];
+    float largest = 0;
+    for (int j = 0; j < nc; ++j)
+      for (int i = top; i < nr; ++i) largest = std::max(largest, std::fabs(B[size_t(j) * size_t(nr) + size_t(i)]));
+    int exponent = 0;
+    std::frexp(largest, &exponent);  // largest < 2^exponent
+    const int shift = largest > 0 ? 15 - exponent : 0;  // largest * 2^shift in [2^14, 2^15)
+    half_unscale_[size_t(k)] = std::ldexp(1.0f, -shift);
+    for (int j = 0; j < nc; ++j) {
+      const size_t at = size_t(px_[k]) + size_t(j) * size_t(nr) + size_t(top);
+      to_half(values_single_.data() + at, size_t(nr - top), std::ldexp(1.0f, shift), values_half_.data() + at);
+    }
+  }
+}
 
+// The copy's supernodes, as the passes below read them.
 struct Supernodes {
   int count;
   const int *super, *pi, *px, *s;
+  const uint16_t* half;  // the half copy (make_half), or null
+  const float* unscale;
 };
+
+namespace {
 
 using ConstMapF = Eigen::Map<const Eigen::MatrixXf>;
 using VectorMapF = Eigen::Map<Eigen::VectorXf>;
@@ -128,7 +163,11 @@ void forward_pass(const Supernodes& L, const float* values, float* w, float* y) 
       const ConstMapF X(B, nr, nc);
       VectorMapF xk(w + c0, nc);
       X.topRows(nc).triangularView<Eigen::Lower>().solveInPlace(xk);
-      VectorMapF(y + nc, nr - nc).noalias() = X.bottomRows(nr - nc) * xk;
+      if (L.half) half_product(L.half + L.px[k] + nc, nr, nr - nc, nc, xk.data(), L.unscale[k], y + nc);
+      else VectorMapF(y + nc, nr - nc).noalias() = X.bottomRows(nr - nc) * xk;
+    } else if (L.half) {  // [D^-1; E D^-1]: y = B x (zero above the diagonal)
+      half_product(L.half + L.px[k], nr, nr, nc, w + c0, L.unscale[k], y);
+      for (int i = 0; i < nc; ++i) w[c0 + i] = y[i];
     } else {  // [D^-1; E D^-1]: y = B x
       for (int i = 0; i < nr; ++i) y[i] = 0;
       for (int j = 0; j < nc; ++j) {  // column j of the top block is zero above row j
@@ -151,12 +190,22 @@ void backward_pass(const Supernodes& L, const float* values, float* w, float* y)
       const ConstMapF X(B, nr, nc);
       VectorMapF xk(w + c0, nc), t(y, nr - nc);
       for (int i = nc; i < nr; ++i) t[i - nc] = w[rows[i]];
-      xk.noalias() -= X.bottomRows(nr - nc).transpose() * t;
+      if (L.half) {
+        VectorMapF e(y + (nr - nc), nc);  // past t: y holds the tallest supernode's rows
+        half_transposed_product(L.half + L.px[k] + nc, nr, nr - nc, nc, t.data(), L.unscale[k], e.data());
+        xk -= e;
+      } else {
+        xk.noalias() -= X.bottomRows(nr - nc).transpose() * t;
+      }
       X.topRows(nc).triangularView<Eigen::Lower>().transpose().solveInPlace(xk);
       continue;
     }
     for (int i = 0; i < nc; ++i) y[i] = w[c0 + i];  // [D^-1; E D^-1]: x = B^T [x; -t]
     for (int i = nc; i < nr; ++i) y[i] = -w[rows[i]];
+    if (L.half) {
+      half_transposed_product(L.half + L.px[k], nr, nr, nc, y, L.unscale[k], w + c0);
+      continue;
+    }
     for (int j = 0; j < nc; ++j) {
       const float* col = B + size_t(j) * size_t(nr);
       w[c0 + j] = ConstVectorMapF(col + j, nr - j).dot(ConstVectorMapF(y + j, nr - j));
@@ -166,12 +215,18 @@ void backward_pass(const Supernodes& L, const float* values, float* w, float* y)
 
 }  // namespace
 
+Supernodes SupernodalSolve::single_supernodes() const {
+  const bool half = !values_half_.empty();
+  return {int(L_->nsuper), super_, pi_, px_, s_, half ? values_half_.data() : nullptr,
+          half ? half_unscale_.data() : nullptr};
+}
+
 void SupernodalSolve::forward_single() const {
-  forward_pass({int(L_->nsuper), super_, pi_, px_, s_}, values_single_.data(), w_single_.data(), y_single_.data());
+  forward_pass(single_supernodes(), values_single_.data(), w_single_.data(), y_single_.data());
 }
 
 void SupernodalSolve::backward_single() const {
-  backward_pass({int(L_->nsuper), super_, pi_, px_, s_}, values_single_.data(), w_single_.data(), y_single_.data());
+  backward_pass(single_supernodes(), values_single_.data(), w_single_.data(), y_single_.data());
 }
 
 void SupernodalSolve::forward_double() const {

@@ -17,14 +17,22 @@
 
 namespace mica {
 
+struct Supernodes;
+
 class SupernodalSolve {
  public:
-  // Reads L's structure (pointers into it: L must outlive the binding and not change) and, with
-  // `single`, copies its values to single precision, kept when a solve with the copy agrees with
-  // the double one to kSingleAgreement on a probe vector (single() says whether it was). False
-  // when L is not a real supernodal LL^T with int indices; the solves must not be called then.
-  bool bind(const cholmod_factor* L, bool single);
+  // The copy of the factor the "single" solves read: none, single precision, or half precision
+  // where the CPU has the instructions for it (half_products.hpp; single otherwise).
+  enum class Copy : uint8_t { None, Single, Half };
+  // Reads L's structure (pointers into it: L must outlive the binding and not change) and makes
+  // the copy, kept when a solve with it agrees with the double one on a probe vector to
+  // kSingleAgreement (single precision) or kHalfAgreement (half; the single copy is tried then).
+  // single() says whether a copy was kept, half() whether it is the half one. False when L is not
+  // a real supernodal LL^T with int indices; the solves must not be called then.
+  bool bind(const cholmod_factor* L, Copy copy);
   static constexpr double kSingleAgreement = 1e-4;
+  // Half precision's 5e-4 times the system's condition: on the nidus the probe agrees to 2.3e-4.
+  static constexpr double kHalfAgreement = 1e-3;
   // The single-precision copy keeps supernodes up to this many columns inverted ([D^-1; E D^-1]:
   // its halves are products) and wider ones as they are (their triangular solves are long enough
   // to run at a product's speed; inverting them would cost more than the factorization).
@@ -34,6 +42,7 @@ class SupernodalSolve {
   void unbind() { L_ = nullptr; }
   bool bound() const { return L_ != nullptr; }
   bool single() const { return bound() && !values_single_.empty(); }
+  bool half() const { return single() && !values_half_.empty(); }
   // x = A^-1 b for the factored A = P^T L L^T P; b and x may be the same array.
   void solve(const double* b, double* x) const;
   // The same with the single-precision copy (bind(L, true)): relative error ~1e-7 times A's
@@ -71,9 +80,16 @@ class SupernodalSolve {
  private:
   // The single-precision copy, narrow supernodes inverted (kInvertedWidth).
   void make_single();
+  // The half-precision copy of the single one: the narrow supernodes and the wide ones' rows below
+  // their diagonal blocks (those blocks' triangular solves stay in single), each supernode scaled
+  // by a power of two that puts its largest entry at half's top binade (its range is 6e-5..65504).
+  void make_half();
+  // The relative difference of solve_single from solve on a fixed vector.
+  double probe_copy() const;
   // The halves on the permuted vector: w_ with L in double, w_single_ with the copy.
   void forward_double() const;
   void backward_double() const;
+  Supernodes single_supernodes() const;  // the copy's, for the passes
   void forward_single() const;
   void backward_single() const;
 
@@ -81,6 +97,8 @@ class SupernodalSolve {
   const int *super_ = nullptr, *pi_ = nullptr, *px_ = nullptr, *s_ = nullptr;
   const double* values_ = nullptr;
   std::vector<float> values_single_;
+  std::vector<uint16_t> values_half_;  // empty: the single copy alone
+  std::vector<float> half_unscale_;    // per supernode: value = stored half * unscale
   std::vector<int32_t> inverse_perm_;  // a DOF's permuted row
   // The permuted vector, and a supernode's rows below its columns (grown, never shrunk).
   mutable Eigen::VectorXd w_, t_;
