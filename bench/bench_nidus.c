@@ -14,7 +14,10 @@
  * wall-clock time taken around the call.
  *
  * Memory: VmRSS (/proc/self/status) before and after mica_body_create_from_file, and after the
- * first step (when the solver's buffers exist), divided by the tets.
+ * first step (when the solver's buffers exist), divided by the tets; and what the world holds
+ * after that step, VmRSS once glibc's malloc_trim has returned the heap's free pages (what
+ * the allocator keeps of the analysis's and factorization's temporaries for reuse is not the
+ * world's). The baseline is taken after a trim too.
  *
  * Per step (mica_world_stats): CG iterations, velocity solves (the factored sweep's rounds) and
  * factorizations made or started; the timed steps by kind (one solve, two or more, with a
@@ -42,6 +45,7 @@
  *   OMP_THREAD_LIMIT=1 OPENBLAS_NUM_THREADS=1 taskset -c 1 build/bench/bench_nidus --scaling out/scaling.csv
  */
 #define _GNU_SOURCE
+#include <malloc.h>
 #include <math.h>
 #include <sched.h>
 #include <stdio.h>
@@ -89,7 +93,8 @@ static long status_kb(const char* key) {
   } while (0)
 
 typedef struct {
-  double median, p95, max, mean, cpu_median, iterations, solves, mem_create_b_per_tet, mem_step_b_per_tet, force;
+  double median, p95, max, mean, cpu_median, iterations, solves, mem_create_b_per_tet, mem_step_b_per_tet,
+      mem_held_b_per_tet, force;
   double reversals; /* fraction of contact nodes' velocity changes that reverse from step to step */
   double stage_ms[MICA_STAGE_COUNT]; /* mean wall-clock ms per timed step in each stage */
   int32_t nodes, tets, capped, contacts;
@@ -217,6 +222,7 @@ static int nidus(const char* path, const mica_world_def* wd, int steps, int warm
   bd.model = model;
   figures fig;
   memset(&fig, 0, sizeof fig);
+  malloc_trim(0);
   const long rss0 = status_kb("VmRSS:");
   mica_body_id body;
   CHECK(mica_body_create_from_file(world, &bd, path, &body));
@@ -242,9 +248,12 @@ static int nidus(const char* path, const mica_world_def* wd, int steps, int warm
   CHECK(mica_tool_create(world, &td, &tool));
   CHECK(mica_step(world, dt) < 0 ? -1 : MICA_OK); /* the first step allocates the solver's buffers */
   const long rss2 = status_kb("VmRSS:");
+  malloc_trim(0);
+  const long held = status_kb("VmRSS:");
   if (press(world, body, tool, c, y0, 0.0025, 0.01, 0.001, R + td.margin, dt, warmup - 1, steps, &fig)) return 1;
   fig.mem_create_b_per_tet = 1024.0 * (double)(rss1 - rss0) / fig.tets;
   fig.mem_step_b_per_tet = 1024.0 * (double)(rss2 - rss0) / fig.tets;
+  fig.mem_held_b_per_tet = 1024.0 * (double)(held - rss0) / fig.tets;
   char m[300];
   machine(m, sizeof m);
   const long threads = status_kb("Threads:");
@@ -282,7 +291,8 @@ static int nidus(const char* path, const mica_world_def* wd, int steps, int warm
   printf("velocity reversals    %.1f %% of the contact nodes' velocity changes (issue: at most 25 %%; 0.4: 73 %%)\n",
          100 * fig.reversals);
   printf("memory, body creation %.0f B/tet (VmRSS %ld -> %ld kB)\n", fig.mem_create_b_per_tet, rss0, rss1);
-  printf("memory, after 1 step  %.0f B/tet (VmRSS %ld kB)\n", fig.mem_step_b_per_tet, rss2);
+  printf("memory, after 1 step  %.0f B/tet (VmRSS %ld kB); held %.0f B/tet (VmRSS %ld kB after malloc_trim)\n",
+         fig.mem_step_b_per_tet, rss2, fig.mem_held_b_per_tet, held);
   mica_world_destroy(world);
   *result = fig;
   return 0;
@@ -298,13 +308,13 @@ static int scaling(const char* csv_path, int max_tets, int32_t sweep) {
   machine(m, sizeof m);
   fprintf(csv, "# bench_nidus --scaling: %s; MICA %s sweep\n", m, sweep_name(sweep));
   fprintf(csv, "cells,nodes,tets,ms_median,ms_p95,iterations,ms_per_iteration,mem_B_per_tet,force_N,ms_rotations,"
-               "ms_elements,ms_solve\n");
+               "ms_elements,ms_solve,mem_held_B_per_tet\n");
   printf("# bench_nidus --scaling: %s\n", m);
   printf("# command: OMP_THREAD_LIMIT=1 OPENBLAS_NUM_THREADS=1 taskset -c 1 build/bench/bench_nidus --scaling %s %d %s\n", csv_path, max_tets,
          sweep_name(sweep));
   /* The last three columns: mean ms per step of the stages rotations, elements and solve. */
-  printf("%6s %8s %8s %10s %10s %10s %12s %10s %9s %9s %9s\n", "cells", "nodes", "tets", "median ms", "p95 ms", "iters",
-         "ms/iter", "B/tet", "rot ms", "elem ms", "solve ms");
+  printf("%6s %8s %8s %10s %10s %10s %12s %10s %9s %9s %9s %10s\n", "cells", "nodes", "tets", "median ms", "p95 ms",
+         "iters", "ms/iter", "B/tet", "rot ms", "elem ms", "solve ms", "held B/tet");
   const int sizes[] = {6, 8, 11, 14, 18, 22, 26, 30};
   for (int s = 0; s < 8; ++s) {
     const int n = sizes[s];
@@ -328,6 +338,7 @@ static int scaling(const char* csv_path, int max_tets, int32_t sweep) {
     def.tool_position[2] = c[2];
     figures fig;
     memset(&fig, 0, sizeof fig);
+    malloc_trim(0);
     const long rss0 = status_kb("VmRSS:");
     box_scene scene;
     CHECK(box_scene_create(world, &def, &scene));
@@ -341,14 +352,16 @@ static int scaling(const char* csv_path, int max_tets, int32_t sweep) {
     if (press(world, body, tool, c, y0, 0.007, 0.1, 0.003, def.tool_radius + def.tool_margin, 0.01, 9, steps, &fig))
       return 1;
     fig.mem_step_b_per_tet = 1024.0 * (double)(rss1 - rss0) / fig.tets;
+    malloc_trim(0);
+    fig.mem_held_b_per_tet = 1024.0 * (double)(status_kb("VmRSS:") - rss0) / fig.tets;
     const double* st = fig.stage_ms;
-    fprintf(csv, "%d,%d,%d,%.4f,%.4f,%.1f,%.5f,%.0f,%.5g,%.4f,%.4f,%.4f\n", n, fig.nodes, fig.tets, fig.median, fig.p95,
-            fig.iterations, fig.iterations > 0 ? fig.median / fig.iterations : NAN, fig.mem_step_b_per_tet, fig.force,
-            st[MICA_STAGE_ROTATIONS], st[MICA_STAGE_ELEMENTS], st[MICA_STAGE_SOLVE]);
+    fprintf(csv, "%d,%d,%d,%.4f,%.4f,%.1f,%.5f,%.0f,%.5g,%.4f,%.4f,%.4f,%.0f\n", n, fig.nodes, fig.tets, fig.median,
+            fig.p95, fig.iterations, fig.iterations > 0 ? fig.median / fig.iterations : NAN, fig.mem_step_b_per_tet,
+            fig.force, st[MICA_STAGE_ROTATIONS], st[MICA_STAGE_ELEMENTS], st[MICA_STAGE_SOLVE], fig.mem_held_b_per_tet);
     fflush(csv);
-    printf("%6d %8d %8d %10.3f %10.3f %10.1f %12.5f %10.0f %9.3f %9.3f %9.3f\n", n, fig.nodes, fig.tets, fig.median,
+    printf("%6d %8d %8d %10.3f %10.3f %10.1f %12.5f %10.0f %9.3f %9.3f %9.3f %10.0f\n", n, fig.nodes, fig.tets, fig.median,
            fig.p95, fig.iterations, fig.iterations > 0 ? fig.median / fig.iterations : NAN, fig.mem_step_b_per_tet,
-           st[MICA_STAGE_ROTATIONS], st[MICA_STAGE_ELEMENTS], st[MICA_STAGE_SOLVE]);
+           st[MICA_STAGE_ROTATIONS], st[MICA_STAGE_ELEMENTS], st[MICA_STAGE_SOLVE], fig.mem_held_b_per_tet);
     fflush(stdout);
     fprintf(stderr, "progress %d %d\n", s + 1, 8);
     mica_world_destroy(world);

@@ -37,8 +37,12 @@ bool SupernodalSolve::bind(const cholmod_factor* L, Copy copy) {
   w_single_.resize(n);
   if (copy == Copy::Half && half_products_supported()) {
     make_half();
-    if (probe_copy() <= kHalfAgreement) return true;
+    if (probe_copy() <= kHalfAgreement) {
+      std::vector<float>().swap(values_single_);  // the half copy replaces it (its memory returned)
+      return true;
+    }
     values_half_.clear();
+    diagonals_.clear();
   }
   if (!(probe_copy() <= kSingleAgreement)) values_single_.clear();
   return true;
@@ -122,10 +126,16 @@ void SupernodalSolve::make_single() {
 void SupernodalSolve::make_half() {
   values_half_.assign(values_single_.size(), 0);
   half_unscale_.assign(size_t(L_->nsuper), 1.0f);
+  diagonal_at_.assign(size_t(L_->nsuper), 0);
+  diagonals_.clear();
   for (int k = 0; k < int(L_->nsuper); ++k) {
     const int nc = super_[k + 1] - super_[k], nr = pi_[k + 1] - pi_[k];
     const int top = nc > kInvertedWidth ? nc : 0;  // a wide supernode's diagonal block stays single
     const float* B = values_single_.data() + px_[k];
+    if (top > 0) {  // into diagonals_, nc x nc
+      diagonal_at_[size_t(k)] = diagonals_.size();
+      for (int j = 0; j < nc; ++j) diagonals_.insert(diagonals_.end(), B + size_t(j) * size_t(nr), B + size_t(j) * size_t(nr) + nc);
+    }
     float largest = 0;
     for (int j = 0; j < nc; ++j)
       for (int i = top; i < nr; ++i) largest = std::max(largest, std::fabs(B[size_t(j) * size_t(nr) + size_t(i)]));
@@ -146,6 +156,8 @@ struct Supernodes {
   const int *super, *pi, *px, *s;
   const uint16_t* half;  // the half copy (make_half), or null
   const float* unscale;
+  const float* diagonals;  // with the half copy: the wide supernodes' diagonal blocks
+  const size_t* diagonal_at;
 };
 
 namespace {
@@ -153,18 +165,25 @@ namespace {
 using ConstMapF = Eigen::Map<const Eigen::MatrixXf>;
 using VectorMapF = Eigen::Map<Eigen::VectorXf>;
 using ConstVectorMapF = Eigen::Map<const Eigen::VectorXf>;
+using DiagonalMapF = Eigen::Map<const Eigen::MatrixXf, 0, Eigen::OuterStride<>>;
+
+// A wide supernode's diagonal block: the half copy keeps it apart, the single copy atop E.
+DiagonalMapF diagonal_block(const Supernodes& L, const float* values, int k, int nc, int nr) {
+  if (L.half) return DiagonalMapF(L.diagonals + L.diagonal_at[k], nc, nc, Eigen::OuterStride<>(nc));
+  return DiagonalMapF(values + L.px[k], nc, nc, Eigen::OuterStride<>(nr));
+}
 
 void forward_pass(const Supernodes& L, const float* values, float* w, float* y) {
   for (int k = 0; k < L.count; ++k) {
     const int c0 = L.super[k], nc = L.super[k + 1] - c0, nr = L.pi[k + 1] - L.pi[k];
-    const float* B = values + L.px[k];
+    const float* B = L.half ? nullptr : values + L.px[k];  // the single copy (none with the half one)
     const int* rows = L.s + L.pi[k];
     if (nc > SupernodalSolve::kInvertedWidth) {  // [D; E]: x = D^-1 x, y = E x
-      const ConstMapF X(B, nr, nc);
       VectorMapF xk(w + c0, nc);
-      X.topRows(nc).triangularView<Eigen::Lower>().solveInPlace(xk);
+      const DiagonalMapF D = diagonal_block(L, values, k, nc, nr);
+      D.triangularView<Eigen::Lower>().solveInPlace(xk);
       if (L.half) half_product(L.half + L.px[k] + nc, nr, nr - nc, nc, xk.data(), L.unscale[k], y + nc);
-      else VectorMapF(y + nc, nr - nc).noalias() = X.bottomRows(nr - nc) * xk;
+      else VectorMapF(y + nc, nr - nc).noalias() = ConstMapF(B, nr, nc).bottomRows(nr - nc) * xk;
     } else if (L.half) {  // [D^-1; E D^-1]: y = B x (zero above the diagonal)
       half_product(L.half + L.px[k], nr, nr, nc, w + c0, L.unscale[k], y);
       for (int i = 0; i < nc; ++i) w[c0 + i] = y[i];
@@ -184,10 +203,9 @@ void forward_pass(const Supernodes& L, const float* values, float* w, float* y) 
 void backward_pass(const Supernodes& L, const float* values, float* w, float* y) {
   for (int k = L.count - 1; k >= 0; --k) {
     const int c0 = L.super[k], nc = L.super[k + 1] - c0, nr = L.pi[k + 1] - L.pi[k];
-    const float* B = values + L.px[k];
+    const float* B = L.half ? nullptr : values + L.px[k];  // the single copy (none with the half one)
     const int* rows = L.s + L.pi[k];
     if (nc > SupernodalSolve::kInvertedWidth) {  // [D; E]: x = D^-T (x - E^T t)
-      const ConstMapF X(B, nr, nc);
       VectorMapF xk(w + c0, nc), t(y, nr - nc);
       for (int i = nc; i < nr; ++i) t[i - nc] = w[rows[i]];
       if (L.half) {
@@ -195,9 +213,10 @@ void backward_pass(const Supernodes& L, const float* values, float* w, float* y)
         half_transposed_product(L.half + L.px[k] + nc, nr, nr - nc, nc, t.data(), L.unscale[k], e.data());
         xk -= e;
       } else {
-        xk.noalias() -= X.bottomRows(nr - nc).transpose() * t;
+        xk.noalias() -= ConstMapF(B, nr, nc).bottomRows(nr - nc).transpose() * t;
       }
-      X.topRows(nc).triangularView<Eigen::Lower>().transpose().solveInPlace(xk);
+      const DiagonalMapF D = diagonal_block(L, values, k, nc, nr);
+      D.triangularView<Eigen::Lower>().transpose().solveInPlace(xk);
       continue;
     }
     for (int i = 0; i < nc; ++i) y[i] = w[c0 + i];  // [D^-1; E D^-1]: x = B^T [x; -t]
@@ -217,8 +236,8 @@ void backward_pass(const Supernodes& L, const float* values, float* w, float* y)
 
 Supernodes SupernodalSolve::single_supernodes() const {
   const bool half = !values_half_.empty();
-  return {int(L_->nsuper), super_, pi_, px_, s_, half ? values_half_.data() : nullptr,
-          half ? half_unscale_.data() : nullptr};
+  return {int(L_->nsuper), super_, pi_, px_, s_, half ? values_half_.data() : nullptr, half_unscale_.data(),
+          diagonals_.data(), diagonal_at_.data()};
 }
 
 void SupernodalSolve::forward_single() const {

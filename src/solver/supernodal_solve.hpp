@@ -41,8 +41,8 @@ class SupernodalSolve {
   int32_t widest_supernode() const;
   void unbind() { L_ = nullptr; }
   bool bound() const { return L_ != nullptr; }
-  bool single() const { return bound() && !values_single_.empty(); }
-  bool half() const { return single() && !values_half_.empty(); }
+  bool single() const { return bound() && (!values_single_.empty() || !values_half_.empty()); }
+  bool half() const { return bound() && !values_half_.empty(); }
   // x = A^-1 b for the factored A = P^T L L^T P; b and x may be the same array.
   void solve(const double* b, double* x) const;
   // The same with the single-precision copy (bind(L, true)): relative error ~1e-7 times A's
@@ -81,8 +81,9 @@ class SupernodalSolve {
   // The single-precision copy, narrow supernodes inverted (kInvertedWidth).
   void make_single();
   // The half-precision copy of the single one: the narrow supernodes and the wide ones' rows below
-  // their diagonal blocks (those blocks' triangular solves stay in single), each supernode scaled
-  // by a power of two that puts its largest entry at half's top binade (its range is 6e-5..65504).
+  // their diagonal blocks (those blocks' triangular solves stay in single, kept apart), each
+  // supernode scaled by a power of two that puts its largest entry at half's top binade (its
+  // range is 6e-5..65504).
   void make_half();
   // The relative difference of solve_single from solve on a fixed vector.
   double probe_copy() const;
@@ -97,8 +98,13 @@ class SupernodalSolve {
   const int *super_ = nullptr, *pi_ = nullptr, *px_ = nullptr, *s_ = nullptr;
   const double* values_ = nullptr;
   std::vector<float> values_single_;
-  std::vector<uint16_t> values_half_;  // empty: the single copy alone
-  std::vector<float> half_unscale_;    // per supernode: value = stored half * unscale
+  // The half copy (empty: the single copy alone), in place of the single one once kept: per
+  // supernode value = stored half * unscale; the wide ones' diagonal blocks in single, nc x nc at
+  // diagonal_at_.
+  std::vector<uint16_t> values_half_;
+  std::vector<float> half_unscale_;
+  std::vector<float> diagonals_;
+  std::vector<size_t> diagonal_at_;
   std::vector<int32_t> inverse_perm_;  // a DOF's permuted row
   // The permuted vector, and a supernode's rows below its columns (grown, never shrunk).
   mutable Eigen::VectorXd w_, t_;
