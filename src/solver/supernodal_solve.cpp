@@ -37,24 +37,52 @@ bool SupernodalSolve::bind(const cholmod_factor* L, Copy copy) {
   w_single_.resize(n);
   if (copy == Copy::Half && half_products_supported()) {
     make_half();
-    if (probe_copy() <= kHalfAgreement) {
+    const Probe half = probe_copy();
+    if (half.difference <= kHalfAgreement && half.residual <= kHalfResidual) {
       std::vector<float>().swap(values_single_);  // the half copy replaces it (its memory returned)
       return true;
     }
     values_half_.clear();
-    diagonals_.clear();
   }
-  if (!(probe_copy() <= kSingleAgreement)) values_single_.clear();
+  if (!(probe_copy().difference <= kSingleAgreement)) values_single_.clear();
   return true;
 }
 
-double SupernodalSolve::probe_copy() const {
+SupernodalSolve::Probe SupernodalSolve::probe_copy() const {
   const Eigen::Index n = Eigen::Index(L_->n);
-  Eigen::VectorXd probe(n), in_double(n), in_copy(n);
+  Eigen::VectorXd probe(n), in_double(n), in_copy(n), product(n);
   for (Eigen::Index i = 0; i < n; ++i) probe[i] = std::sin(0.7 * double(i)) + 0.5;
   solve(probe.data(), in_double.data());
   solve_single(probe.data(), in_copy.data());
-  return (in_copy - in_double).norm() / in_double.norm();
+  multiply(in_copy.data(), product.data());
+  return {(in_copy - in_double).norm() / in_double.norm(), (probe - product).norm() / probe.norm()};
+}
+
+void SupernodalSolve::multiply(const double* x, double* y) const {
+  // A supernode's rows in L->s start with its own columns: column c0 + j is row s[pi + j].
+  const Eigen::Index n = Eigen::Index(L_->n);
+  Eigen::VectorXd& u = w_;  // P x, then L L^T P x
+  Eigen::VectorXd v = Eigen::VectorXd::Zero(n);
+  for (Eigen::Index i = 0; i < n; ++i) u[inverse_perm_[size_t(i)]] = x[i];
+  for (int k = 0; k < int(L_->nsuper); ++k) {  // v = L^T u
+    const int c0 = super_[k], nc = super_[k + 1] - c0, nr = pi_[k + 1] - pi_[k];
+    const double* X = values_ + px_[k];
+    const int* rows = s_ + pi_[k];
+    for (int j = 0; j < nc; ++j) {
+      double sum = 0;
+      for (int i = j; i < nr; ++i) sum += X[size_t(j) * size_t(nr) + size_t(i)] * u[rows[i]];
+      v[c0 + j] = sum;
+    }
+  }
+  u.setZero();
+  for (int k = 0; k < int(L_->nsuper); ++k) {  // u = L v
+    const int c0 = super_[k], nc = super_[k + 1] - c0, nr = pi_[k + 1] - pi_[k];
+    const double* X = values_ + px_[k];
+    const int* rows = s_ + pi_[k];
+    for (int j = 0; j < nc; ++j)
+      for (int i = j; i < nr; ++i) u[rows[i]] += X[size_t(j) * size_t(nr) + size_t(i)] * v[c0 + j];
+  }
+  for (Eigen::Index i = 0; i < n; ++i) y[i] = u[inverse_perm_[size_t(i)]];
 }
 
 void SupernodalSolve::solve(const double* b, double* x) const {
@@ -89,163 +117,134 @@ int32_t SupernodalSolve::widest_supernode() const {
 }
 
 void SupernodalSolve::make_single() {
-  // Each supernode of up to kInvertedWidth columns, [D; E] (D its lower-triangular diagonal
-  // block), becomes [D^-1; E D^-1]: then its forward half is one product, y = [D^-1; E D^-1] x,
-  // and its backward half x = D^-T x - (E D^-1)^T t another, with no triangular solve in either (a
-  // triangular solve of a few columns runs at a fraction of a product's speed: it was a third of
-  // the pair's time on the nidus, whose 1078 supernodes have ~7.6 columns). Inverted in double,
-  // then rounded.
-  values_single_.assign(values_, values_ + L_->xsize);
+  // Each panel [D; E] of a supernode (D its lower-triangular diagonal block) becomes
+  // [D^-1; E D^-1]: then its forward half is one product, y = [D^-1; E D^-1] x, and its backward
+  // half x = D^-T x - (E D^-1)^T t another, with no triangular solve in either. A triangular solve
+  // of a few columns runs at a fraction of a product's speed: it was a third of the pair's time on
+  // the nidus, whose 1101 supernodes have ~7.5 columns. A wide supernode (a top separator, up to
+  // 459 columns on the nidus) is a chain of panels of kInvertedWidth columns, each inverted alone:
+  // inverting all of D would cost more than the factorization, and its triangular solve, in
+  // Eigen, took 9 % of a nidus step with the half copy. Inverted in double, then rounded.
+  panels_.clear();
   int tallest = 1;
-  for (int k = 0; k < int(L_->nsuper); ++k) tallest = std::max(tallest, pi_[k + 1] - pi_[k]);
-  // Y D = [I; E], column by column from the last.
-  std::vector<double> Y(size_t(tallest) * size_t(kInvertedWidth));
   for (int k = 0; k < int(L_->nsuper); ++k) {
-    const int nc = super_[k + 1] - super_[k], nr = pi_[k + 1] - pi_[k];
-    if (nc > kInvertedWidth) continue;
-    const double* X = values_ + px_[k];  // [D; E], column-major, leading dimension nr
-    auto at = [nr](int i, int j) { return size_t(j) * size_t(nr) + size_t(i); };
+    const int c0 = super_[k], nc = super_[k + 1] - c0, nr = pi_[k + 1] - pi_[k];
+    tallest = std::max(tallest, nr);
+    for (int a = 0; a < nc; a += kInvertedWidth)
+      panels_.push_back({c0 + a, std::min(kInvertedWidth, nc - a), nr - a, nr,
+                         int64_t(px_[k]) + int64_t(a) * nr + a, pi_[k] + a});
+  }
+  values_single_.assign(values_, values_ + L_->xsize);
+  // Y D = [I; E], column by column from the last (Y compact: leading dimension the panel's rows).
+  std::vector<double> Y(size_t(tallest) * size_t(kInvertedWidth));
+  for (const SupernodePanel& p : panels_) {
+    const int nc = p.width, nr = p.rows;
+    const double* X = values_ + p.at;
+    auto in_L = [&p](int i, int j) { return size_t(j) * size_t(p.ld) + size_t(i); };
+    auto in_Y = [nr](int i, int j) { return size_t(j) * size_t(nr) + size_t(i); };
     for (int j = 0; j < nc; ++j)
-      for (int i = 0; i < nr; ++i) Y[at(i, j)] = i < nc ? double(i == j) : X[at(i, j)];
+      for (int i = 0; i < nr; ++i) Y[in_Y(i, j)] = i < nc ? double(i == j) : X[in_L(i, j)];
     for (int j = nc - 1; j >= 0; --j) {
-      double* y = Y.data() + at(0, j);
+      double* y = Y.data() + in_Y(0, j);
       for (int i = j + 1; i < nc; ++i) {
-        const double d = X[at(i, j)];
-        const double* yi = Y.data() + at(0, i);
+        const double d = X[in_L(i, j)];
+        const double* yi = Y.data() + in_Y(0, i);
         for (int r = 0; r < nr; ++r) y[r] -= d * yi[r];
       }
-      const double inverse = 1 / X[at(j, j)];
+      const double inverse = 1 / X[in_L(j, j)];
       for (int r = 0; r < nr; ++r) y[r] *= inverse;
     }
-    float* B = values_single_.data() + px_[k];
-    for (size_t q = 0; q < size_t(nr) * size_t(nc); ++q) B[q] = float(Y[q]);
+    float* B = values_single_.data() + p.at;
+    for (int j = 0; j < nc; ++j)
+      for (int i = 0; i < nr; ++i) B[in_L(i, j)] = float(Y[in_Y(i, j)]);
   }
   y_single_.resize(tallest);
 }
 
 void SupernodalSolve::make_half() {
   values_half_.assign(values_single_.size(), 0);
-  half_unscale_.assign(size_t(L_->nsuper), 1.0f);
-  diagonal_at_.assign(size_t(L_->nsuper), 0);
-  diagonals_.clear();
-  for (int k = 0; k < int(L_->nsuper); ++k) {
-    const int nc = super_[k + 1] - super_[k], nr = pi_[k + 1] - pi_[k];
-    const int top = nc > kInvertedWidth ? nc : 0;  // a wide supernode's diagonal block stays single
-    const float* B = values_single_.data() + px_[k];
-    if (top > 0) {  // into diagonals_, nc x nc
-      diagonal_at_[size_t(k)] = diagonals_.size();
-      for (int j = 0; j < nc; ++j) diagonals_.insert(diagonals_.end(), B + size_t(j) * size_t(nr), B + size_t(j) * size_t(nr) + nc);
-    }
+  half_unscale_.assign(panels_.size(), 1.0f);
+  for (size_t q = 0; q < panels_.size(); ++q) {
+    const SupernodePanel& p = panels_[q];
+    const float* B = values_single_.data() + p.at;
     float largest = 0;
-    for (int j = 0; j < nc; ++j)
-      for (int i = top; i < nr; ++i) largest = std::max(largest, std::fabs(B[size_t(j) * size_t(nr) + size_t(i)]));
+    for (int j = 0; j < p.width; ++j)
+      for (int i = 0; i < p.rows; ++i) largest = std::max(largest, std::fabs(B[size_t(j) * size_t(p.ld) + size_t(i)]));
     int exponent = 0;
     std::frexp(largest, &exponent);  // largest < 2^exponent
     const int shift = largest > 0 ? 15 - exponent : 0;  // largest * 2^shift in [2^14, 2^15)
-    half_unscale_[size_t(k)] = std::ldexp(1.0f, -shift);
-    for (int j = 0; j < nc; ++j) {
-      const size_t at = size_t(px_[k]) + size_t(j) * size_t(nr) + size_t(top);
-      to_half(values_single_.data() + at, size_t(nr - top), std::ldexp(1.0f, shift), values_half_.data() + at);
+    half_unscale_[q] = std::ldexp(1.0f, -shift);
+    for (int j = 0; j < p.width; ++j) {
+      const size_t at = size_t(p.at) + size_t(j) * size_t(p.ld);
+      to_half(values_single_.data() + at, size_t(p.rows), std::ldexp(1.0f, shift), values_half_.data() + at);
     }
   }
 }
 
-// The copy's supernodes, as the passes below read them.
-struct Supernodes {
-  int count;
-  const int *super, *pi, *px, *s;
-  const uint16_t* half;  // the half copy (make_half), or null
+// The copy, as the passes below read it: the single one, or the half one with its scales.
+struct CopyView {
+  const std::vector<SupernodePanel>& panels;
+  const int* s;
+  const float* single;
+  const uint16_t* half;  // null: the single copy
   const float* unscale;
-  const float* diagonals;  // with the half copy: the wide supernodes' diagonal blocks
-  const size_t* diagonal_at;
 };
 
 namespace {
 
-using ConstMapF = Eigen::Map<const Eigen::MatrixXf>;
-using VectorMapF = Eigen::Map<Eigen::VectorXf>;
-using ConstVectorMapF = Eigen::Map<const Eigen::VectorXf>;
-using DiagonalMapF = Eigen::Map<const Eigen::MatrixXf, 0, Eigen::OuterStride<>>;
-
-// A wide supernode's diagonal block: the half copy keeps it apart, the single copy atop E.
-DiagonalMapF diagonal_block(const Supernodes& L, const float* values, int k, int nc, int nr) {
-  if (L.half) return DiagonalMapF(L.diagonals + L.diagonal_at[k], nc, nc, Eigen::OuterStride<>(nc));
-  return DiagonalMapF(values + L.px[k], nc, nc, Eigen::OuterStride<>(nr));
-}
-
-void forward_pass(const Supernodes& L, const float* values, float* w, float* y) {
-  for (int k = 0; k < L.count; ++k) {
-    const int c0 = L.super[k], nc = L.super[k + 1] - c0, nr = L.pi[k + 1] - L.pi[k];
-    const float* B = L.half ? nullptr : values + L.px[k];  // the single copy (none with the half one)
-    const int* rows = L.s + L.pi[k];
-    if (nc > SupernodalSolve::kInvertedWidth) {  // [D; E]: x = D^-1 x, y = E x
-      VectorMapF xk(w + c0, nc);
-      const DiagonalMapF D = diagonal_block(L, values, k, nc, nr);
-      D.triangularView<Eigen::Lower>().solveInPlace(xk);
-      if (L.half) half_product(L.half + L.px[k] + nc, nr, nr - nc, nc, xk.data(), L.unscale[k], y + nc);
-      else VectorMapF(y + nc, nr - nc).noalias() = ConstMapF(B, nr, nc).bottomRows(nr - nc) * xk;
-    } else if (L.half) {  // [D^-1; E D^-1]: y = B x (zero above the diagonal)
-      half_product(L.half + L.px[k], nr, nr, nc, w + c0, L.unscale[k], y);
-      for (int i = 0; i < nc; ++i) w[c0 + i] = y[i];
-    } else {  // [D^-1; E D^-1]: y = B x
-      for (int i = 0; i < nr; ++i) y[i] = 0;
-      for (int j = 0; j < nc; ++j) {  // column j of the top block is zero above row j
-        const float a = w[c0 + j];  // (w's columns are written only after the product)
-        const float* col = B + size_t(j) * size_t(nr);
-        for (int i = j; i < nr; ++i) y[i] += col[i] * a;
+void forward_pass(const CopyView& c, float* w, float* y) {
+  for (size_t q = 0; q < c.panels.size(); ++q) {  // [D^-1; E D^-1]: y = B x (zero above the diagonal)
+    const SupernodePanel& p = c.panels[q];
+    float* x = w + p.column;
+    if (c.half) {
+      half_product(c.half + p.at, p.ld, p.rows, p.width, x, c.unscale[q], y);
+    } else {
+      const float* B = c.single + p.at;
+      for (int i = 0; i < p.rows; ++i) y[i] = 0;
+      for (int j = 0; j < p.width; ++j) {  // column j of the top block is zero above row j
+        const float a = x[j];  // (x is written only after the product)
+        const float* col = B + size_t(j) * size_t(p.ld);
+        for (int i = j; i < p.rows; ++i) y[i] += col[i] * a;
       }
-      for (int i = 0; i < nc; ++i) w[c0 + i] = y[i];
     }
-    for (int i = nc; i < nr; ++i) w[rows[i]] -= y[i];
+    for (int i = 0; i < p.width; ++i) x[i] = y[i];
+    const int* rows = c.s + p.row_at;
+    for (int i = p.width; i < p.rows; ++i) w[rows[i]] -= y[i];
   }
 }
 
-void backward_pass(const Supernodes& L, const float* values, float* w, float* y) {
-  for (int k = L.count - 1; k >= 0; --k) {
-    const int c0 = L.super[k], nc = L.super[k + 1] - c0, nr = L.pi[k + 1] - L.pi[k];
-    const float* B = L.half ? nullptr : values + L.px[k];  // the single copy (none with the half one)
-    const int* rows = L.s + L.pi[k];
-    if (nc > SupernodalSolve::kInvertedWidth) {  // [D; E]: x = D^-T (x - E^T t)
-      VectorMapF xk(w + c0, nc), t(y, nr - nc);
-      for (int i = nc; i < nr; ++i) t[i - nc] = w[rows[i]];
-      if (L.half) {
-        VectorMapF e(y + (nr - nc), nc);  // past t: y holds the tallest supernode's rows
-        half_transposed_product(L.half + L.px[k] + nc, nr, nr - nc, nc, t.data(), L.unscale[k], e.data());
-        xk -= e;
-      } else {
-        xk.noalias() -= ConstMapF(B, nr, nc).bottomRows(nr - nc).transpose() * t;
-      }
-      const DiagonalMapF D = diagonal_block(L, values, k, nc, nr);
-      D.triangularView<Eigen::Lower>().transpose().solveInPlace(xk);
+void backward_pass(const CopyView& c, float* w, float* y) {
+  for (size_t q = c.panels.size(); q-- > 0;) {  // [D^-1; E D^-1]: x = B^T [x; -t]
+    const SupernodePanel& p = c.panels[q];
+    float* x = w + p.column;
+    const int* rows = c.s + p.row_at;
+    for (int i = 0; i < p.width; ++i) y[i] = x[i];
+    for (int i = p.width; i < p.rows; ++i) y[i] = -w[rows[i]];
+    if (c.half) {
+      half_transposed_product(c.half + p.at, p.ld, p.rows, p.width, y, c.unscale[q], x);
       continue;
     }
-    for (int i = 0; i < nc; ++i) y[i] = w[c0 + i];  // [D^-1; E D^-1]: x = B^T [x; -t]
-    for (int i = nc; i < nr; ++i) y[i] = -w[rows[i]];
-    if (L.half) {
-      half_transposed_product(L.half + L.px[k], nr, nr, nc, y, L.unscale[k], w + c0);
-      continue;
-    }
-    for (int j = 0; j < nc; ++j) {
-      const float* col = B + size_t(j) * size_t(nr);
-      w[c0 + j] = ConstVectorMapF(col + j, nr - j).dot(ConstVectorMapF(y + j, nr - j));
+    const float* B = c.single + p.at;
+    for (int j = 0; j < p.width; ++j) {
+      const float* col = B + size_t(j) * size_t(p.ld);
+      x[j] = Eigen::Map<const Eigen::VectorXf>(col + j, p.rows - j).dot(Eigen::Map<const Eigen::VectorXf>(y + j, p.rows - j));
     }
   }
 }
 
 }  // namespace
 
-Supernodes SupernodalSolve::single_supernodes() const {
+CopyView SupernodalSolve::copy_view() const {
   const bool half = !values_half_.empty();
-  return {int(L_->nsuper), super_, pi_, px_, s_, half ? values_half_.data() : nullptr, half_unscale_.data(),
-          diagonals_.data(), diagonal_at_.data()};
+  return {panels_, s_, values_single_.data(), half ? values_half_.data() : nullptr, half_unscale_.data()};
 }
 
 void SupernodalSolve::forward_single() const {
-  forward_pass(single_supernodes(), values_single_.data(), w_single_.data(), y_single_.data());
+  forward_pass(copy_view(), w_single_.data(), y_single_.data());
 }
 
 void SupernodalSolve::backward_single() const {
-  backward_pass(single_supernodes(), values_single_.data(), w_single_.data(), y_single_.data());
+  backward_pass(copy_view(), w_single_.data(), y_single_.data());
 }
 
 void SupernodalSolve::forward_double() const {

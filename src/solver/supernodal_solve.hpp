@@ -17,7 +17,15 @@
 
 namespace mica {
 
-struct Supernodes;
+// The copies' unit of work: a run of at most SupernodalSolve::kInvertedWidth columns of one
+// supernode with the supernode's rows from its first column down, [D; E] with D lower triangular.
+// In the copies D is inverted: [D^-1; E D^-1].
+struct SupernodePanel {
+  int32_t column, width, rows, ld;  // its first (permuted) column, columns, rows, leading dimension
+  int64_t at;                        // its first value, in L->x's layout
+  int32_t row_at;                    // its first row's index in L->s
+};
+struct CopyView;
 
 class SupernodalSolve {
  public:
@@ -26,17 +34,25 @@ class SupernodalSolve {
   enum class Copy : uint8_t { None, Single, Half };
   // Reads L's structure (pointers into it: L must outlive the binding and not change) and makes
   // the copy, kept when a solve with it agrees with the double one on a probe vector to
-  // kSingleAgreement (single precision) or kHalfAgreement (half; the single copy is tried then).
+  // kSingleAgreement (single precision) or kHalfAgreement with a residual below kHalfResidual
+  // (half; the single copy is tried when it does not).
   // single() says whether a copy was kept, half() whether it is the half one. False when L is not
   // a real supernodal LL^T with int indices; the solves must not be called then.
   bool bind(const cholmod_factor* L, Copy copy);
   static constexpr double kSingleAgreement = 1e-4;
-  // Half precision's 5e-4 times the system's condition: on the nidus the probe agrees to 2.3e-4.
+  // Half precision's 5e-4 times the system's condition: on the nidus the probe agrees to 2e-4.
   static constexpr double kHalfAgreement = 1e-3;
-  // The single-precision copy keeps supernodes up to this many columns inverted ([D^-1; E D^-1]:
-  // its halves are products) and wider ones as they are (their triangular solves are long enough
-  // to run at a product's speed; inverting them would cost more than the factorization).
+  // And the half copy's residual must be below the probe's own size: a preconditioner that
+  // overshoots the stiff directions (a nearly incompressible body's, 3e5 times the probe, where
+  // the single copy's is 250) slows the conjugate gradients to hundreds of iterations. The
+  // nidus's is 0.18, a 35k-tet cube's 0.011.
+  static constexpr double kHalfResidual = 0.5;
+  // The copies split each supernode into panels of up to this many columns and keep each panel
+  // inverted, [D^-1; E D^-1]: both halves of the pair are then products, with no triangular solve
+  // (make_single says why).
   static constexpr int kInvertedWidth = 64;
+  // y = A x = P^T L L^T P x, from the double factor (x and y distinct).
+  void multiply(const double* x, double* y) const;
   // The most columns of any supernode (0 unbound).
   int32_t widest_supernode() const;
   void unbind() { L_ = nullptr; }
@@ -78,38 +94,38 @@ class SupernodalSolve {
   void backward(double* x, const Mat3* turn = nullptr) const;
 
  private:
-  // The single-precision copy, narrow supernodes inverted (kInvertedWidth).
+  // The single-precision copy, its panels inverted (kInvertedWidth).
   void make_single();
-  // The half-precision copy of the single one: the narrow supernodes and the wide ones' rows below
-  // their diagonal blocks (those blocks' triangular solves stay in single, kept apart), each
-  // supernode scaled by a power of two that puts its largest entry at half's top binade (its
-  // range is 6e-5..65504).
+  // The half-precision copy of the single one, each panel scaled by a power of two that puts its
+  // largest entry at half's top binade (half's range is 6e-5..65504).
   void make_half();
-  // The relative difference of solve_single from solve on a fixed vector.
-  double probe_copy() const;
+  // How the copy's solve x = solve_single(b) of a fixed vector b fares: its relative difference
+  // from the double solve, and its relative residual |b - A x| / |b|.
+  struct Probe {
+    double difference, residual;
+  };
+  Probe probe_copy() const;
   // The halves on the permuted vector: w_ with L in double, w_single_ with the copy.
   void forward_double() const;
   void backward_double() const;
-  Supernodes single_supernodes() const;  // the copy's, for the passes
+  CopyView copy_view() const;  // the copy, as the passes read it
   void forward_single() const;
   void backward_single() const;
 
   const cholmod_factor* L_ = nullptr;
   const int *super_ = nullptr, *pi_ = nullptr, *px_ = nullptr, *s_ = nullptr;
   const double* values_ = nullptr;
+  std::vector<SupernodePanel> panels_;
   std::vector<float> values_single_;
-  // The half copy (empty: the single copy alone), in place of the single one once kept: per
-  // supernode value = stored half * unscale; the wide ones' diagonal blocks in single, nc x nc at
-  // diagonal_at_.
+  // The half copy (empty: the single copy alone), in place of the single one once kept: a
+  // panel's value = stored half * its unscale.
   std::vector<uint16_t> values_half_;
   std::vector<float> half_unscale_;
-  std::vector<float> diagonals_;
-  std::vector<size_t> diagonal_at_;
   std::vector<int32_t> inverse_perm_;  // a DOF's permuted row
   // The permuted vector, and a supernode's rows below its columns (grown, never shrunk).
   mutable Eigen::VectorXd w_, t_;
   mutable Eigen::VectorXf w_single_;
-  mutable Eigen::VectorXf y_single_;  // a supernode's rows (the single halves')
+  mutable Eigen::VectorXf y_single_;  // a panel's rows (the single halves')
   mutable Eigen::Matrix<double, Eigen::Dynamic, 3> w3_, t3_;  // half_columns' (w3_ zero between calls)
   mutable bool halves_single_ = false;                       // forward() left w in w_single_
 };

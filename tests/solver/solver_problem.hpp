@@ -26,9 +26,10 @@ struct SolverProblem {
   std::vector<double> lambda;
   std::vector<TriangleStiffness> extra;  // what of A the solver is told is contact stiffness
 
-  explicit SolverProblem(double friction = 0, int32_t cells = 3, bool contact = true) {
+  explicit SolverProblem(double friction = 0, int32_t cells = 3, bool contact = true,
+                         const Material& material = Material{2e4, 0.3, 1000}) {
     const TetMesh mesh = make_box_grid(Vec3(0, 0, 0), Vec3(0.1, 0.1, 0.1), {cells, cells, cells}, 6);
-    fem = build_fem_model(mesh, Material{2e4, 0.3, 1000}, MassKind::Consistent, "test body");
+    fem = build_fem_model(mesh, material, MassKind::Consistent, "test body");
     const int32_t n = fem.node_count();
     x = fem.rest;
     for (Vec3& p : x) p += Vec3(0.08 * p.y() * p.y(), 0, 0.03 * p.y());  // sheared: R != I

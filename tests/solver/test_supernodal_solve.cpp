@@ -16,10 +16,11 @@ namespace {
 // A factored system of the shared problem (a sheared 8^3-cell cube, its base fixed) and a
 // right-hand side.
 struct Factored {
-  SolverProblem p{0, 8, false};
+  SolverProblem p;
   DirectSolver direct;
   Eigen::VectorXd b;
-  explicit Factored(SupernodalSolve::Copy copy) {
+  explicit Factored(SupernodalSolve::Copy copy, const Material& material = Material{2e4, 0.3, 1000})
+      : p(0, 8, false, material) {
     direct.set_copy(copy);
     direct.analyze(p.fem.pattern);
     direct.factorize(ProjectedSystem{p.fem.pattern, p.A, p.projection});
@@ -65,7 +66,7 @@ static void test_single_within_its_precision(void**) {
   print_message("single precision against cholmod_solve2: %.3g\n", d);
   assert_true(d > 1e-12);  // it did solve in single precision
   assert_true(d <= 1e-4);  // float's 6e-8 times the growth in the triangular solves
-  // Both kinds of supernode ran: narrow ones inverted, at least one wider kept as a triangle.
+  // Wide supernodes ran too, as chains of panels.
   print_message("widest supernode: %d columns\n", f.direct.by_hand()->widest_supernode());
   assert_true(f.direct.by_hand()->widest_supernode() > SupernodalSolve::kInvertedWidth);
   // The multi-column solves (the contact columns) stay in double.
@@ -93,8 +94,44 @@ static void test_half_within_its_precision(void**) {
   print_message("half precision against cholmod_solve2: %.3g\n", d);
   assert_true(d > 1e-6);  // it did solve in half precision (single's difference is ~1e-7)
   assert_true(d <= SupernodalSolve::kHalfAgreement);
-  // Both kinds of supernode ran in half.
+  // Wide supernodes ran too, as chains of panels.
   assert_true(f.direct.by_hand()->widest_supernode() > SupernodalSolve::kInvertedWidth);
+}
+
+// A nearly incompressible, very stiff body (E = 1e9 Pa, nu = 0.499): the half copy's solve agrees
+// with the double one to 1e-3 on the probe, but its residual is far above the probe, and the
+// conjugate gradients it preconditions took hundreds of iterations (the stress matrix's scenario
+// a). It is refused, and the single copy serves.
+static void test_half_refused_where_its_residual_is_large(void**) {
+  Factored soft(Copy::Half), stiff(Copy::Half, Material{1e9, 0.499, 1000});
+  if (!half_products_supported()) skip();
+  assert_true(soft.direct.by_hand()->half());
+  assert_false(stiff.direct.by_hand()->half());
+  assert_true(stiff.direct.by_hand()->single());
+  Eigen::MatrixXd reference;
+  stiff.direct.solve_raw_cholmod(stiff.b, reference);
+  Eigen::VectorXd x;
+  stiff.direct.solve_one(stiff.b, x, true);
+  const double d = relative(x, reference.col(0));
+  print_message("stiff body: the single copy against cholmod_solve2 %.3g\n", d);
+  assert_true(d > 1e-12 && d <= SupernodalSolve::kSingleAgreement);
+}
+
+// A x from the factor (the probe's residual) against the system it factored, S A S + I - S.
+static void test_multiply_is_the_factored_system(void**) {
+  Factored f(Copy::None);
+  const int32_t n = f.p.fem.node_count();
+  const size_t count = static_cast<size_t>(n);
+  Vec3List x(count), ax(count), tmp(count);
+  Eigen::VectorXd flat_x(3 * n), by_factor(3 * n), by_system(3 * n);
+  for (int32_t i = 0; i < n; ++i) x[size_t(i)] = Vec3(std::sin(i), std::cos(0.3 * i), 0.5);
+  for (int32_t i = 0; i < n; ++i) flat_x.segment<3>(3 * i) = x[size_t(i)];
+  ProjectedSystem{f.p.fem.pattern, f.p.A, f.p.projection}.apply(x, ax, tmp);
+  for (int32_t i = 0; i < n; ++i) by_system.segment<3>(3 * i) = ax[size_t(i)];
+  f.direct.by_hand()->multiply(flat_x.data(), by_factor.data());
+  const double d = relative(by_factor, by_system);
+  print_message("L L^T x against S A S + I - S: %.3g\n", d);
+  assert_true(d <= 1e-13);
 }
 
 // The half products against the same products in double from the same halves.
@@ -221,6 +258,8 @@ int main(void) {
       cmocka_unit_test(test_single_within_its_precision),
       cmocka_unit_test(test_half_within_its_precision),
       cmocka_unit_test(test_half_products),
+      cmocka_unit_test(test_half_refused_where_its_residual_is_large),
+      cmocka_unit_test(test_multiply_is_the_factored_system),
       cmocka_unit_test(test_half_columns_and_halves),
       cmocka_unit_test(test_turned_halves),
       cmocka_unit_test(test_other_factors_refused),
