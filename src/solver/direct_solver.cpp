@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/error.hpp"
+#include "fem/block_matrix.hpp"
 
 namespace mica {
 
@@ -103,7 +104,16 @@ void DirectSolver::factorize(const ProjectedSystem& sys) {
   ++factorizations_;
   if (llt_.info() != Eigen::Success)
     fail(Errc::Numerical, "the system matrix is not positive definite (CHOLMOD factorization failed)");
-  by_hand_.bind(llt_.factor(), copy_);  // false (cholmod_solve2 then) for a factor of another kind
+  // The half copy's probe multiplies by the factored system itself (the blocks just copied).
+  auto multiply = [&](const double* x, double* y) {
+    const size_t n = size_t(p.rows);
+    Vec3List xs(n), ys(n);
+    for (size_t i = 0; i < n; ++i) xs[i] = Vec3(x[3 * i], x[3 * i + 1], x[3 * i + 2]);
+    block_multiply(p, projected_, xs, ys);
+    for (size_t i = 0; i < n; ++i)
+      for (int r = 0; r < 3; ++r) y[3 * i + size_t(r)] = ys[i][r];
+  };
+  by_hand_.bind(llt_.factor(), copy_, multiply);  // false (cholmod_solve2 then) for a factor of another kind
 }
 
 SolveReport DirectSolver::solve(const ProjectedSystem& sys, const Vec3List& b, Vec3List& v) {

@@ -8,7 +8,7 @@
 
 namespace mica {
 
-bool SupernodalSolve::bind(const cholmod_factor* L, Copy copy) {
+bool SupernodalSolve::bind(const cholmod_factor* L, Copy copy, const Multiply& multiply) {
   L_ = nullptr;
   values_single_.clear();
   values_half_.clear();
@@ -33,56 +33,31 @@ bool SupernodalSolve::bind(const cholmod_factor* L, Copy copy) {
   // A copy is kept only where its precision holds: float's 6e-8 (half's 5e-4) grows with the
   // condition of the system (a nearly incompressible, very stiff body's is far too large), and a
   // preconditioner that far off misleads the solves.
-  make_single();
+  make_panels();
   w_single_.resize(n);
-  if (copy == Copy::Half && half_products_supported()) {
-    make_half();
-    const Probe half = probe_copy();
-    if (half.difference <= kHalfAgreement && half.residual <= kHalfResidual) {
-      std::vector<float>().swap(values_single_);  // the half copy replaces it (its memory returned)
-      return true;
-    }
+  if (copy == Copy::Half && multiply && half_products_supported()) {
+    make_copy(Copy::Half);
+    const Probe half = probe_copy(multiply);
+    if (half.difference <= kHalfAgreement && half.residual <= kHalfResidual) return true;
     values_half_.clear();
   }
-  if (!(probe_copy().difference <= kSingleAgreement)) values_single_.clear();
+  make_copy(Copy::Single);
+  if (!(probe_copy(nullptr).difference <= kSingleAgreement)) values_single_.clear();
   return true;
 }
 
-SupernodalSolve::Probe SupernodalSolve::probe_copy() const {
+SupernodalSolve::Probe SupernodalSolve::probe_copy(const Multiply& multiply) const {
   const Eigen::Index n = Eigen::Index(L_->n);
   Eigen::VectorXd probe(n), in_double(n), in_copy(n), product(n);
   for (Eigen::Index i = 0; i < n; ++i) probe[i] = std::sin(0.7 * double(i)) + 0.5;
   solve(probe.data(), in_double.data());
   solve_single(probe.data(), in_copy.data());
-  multiply(in_copy.data(), product.data());
-  return {(in_copy - in_double).norm() / in_double.norm(), (probe - product).norm() / probe.norm()};
-}
-
-void SupernodalSolve::multiply(const double* x, double* y) const {
-  // A supernode's rows in L->s start with its own columns: column c0 + j is row s[pi + j].
-  const Eigen::Index n = Eigen::Index(L_->n);
-  Eigen::VectorXd& u = w_;  // P x, then L L^T P x
-  Eigen::VectorXd v = Eigen::VectorXd::Zero(n);
-  for (Eigen::Index i = 0; i < n; ++i) u[inverse_perm_[size_t(i)]] = x[i];
-  for (int k = 0; k < int(L_->nsuper); ++k) {  // v = L^T u
-    const int c0 = super_[k], nc = super_[k + 1] - c0, nr = pi_[k + 1] - pi_[k];
-    const double* X = values_ + px_[k];
-    const int* rows = s_ + pi_[k];
-    for (int j = 0; j < nc; ++j) {
-      double sum = 0;
-      for (int i = j; i < nr; ++i) sum += X[size_t(j) * size_t(nr) + size_t(i)] * u[rows[i]];
-      v[c0 + j] = sum;
-    }
+  Probe out{(in_copy - in_double).norm() / in_double.norm(), 0};
+  if (multiply) {
+    multiply(in_copy.data(), product.data());
+    out.residual = (probe - product).norm() / probe.norm();
   }
-  u.setZero();
-  for (int k = 0; k < int(L_->nsuper); ++k) {  // u = L v
-    const int c0 = super_[k], nc = super_[k + 1] - c0, nr = pi_[k + 1] - pi_[k];
-    const double* X = values_ + px_[k];
-    const int* rows = s_ + pi_[k];
-    for (int j = 0; j < nc; ++j)
-      for (int i = j; i < nr; ++i) u[rows[i]] += X[size_t(j) * size_t(nr) + size_t(i)] * v[c0 + j];
-  }
-  for (Eigen::Index i = 0; i < n; ++i) y[i] = u[inverse_perm_[size_t(i)]];
+  return out;
 }
 
 void SupernodalSolve::solve(const double* b, double* x) const {
@@ -116,15 +91,7 @@ int32_t SupernodalSolve::widest_supernode() const {
   return widest;
 }
 
-void SupernodalSolve::make_single() {
-  // Each panel [D; E] of a supernode (D its lower-triangular diagonal block) becomes
-  // [D^-1; E D^-1]: then its forward half is one product, y = [D^-1; E D^-1] x, and its backward
-  // half x = D^-T x - (E D^-1)^T t another, with no triangular solve in either. A triangular solve
-  // of a few columns runs at a fraction of a product's speed: it was a third of the pair's time on
-  // the nidus, whose 1101 supernodes have ~7.5 columns. A wide supernode (a top separator, up to
-  // 459 columns on the nidus) is a chain of panels of kInvertedWidth columns, each inverted alone:
-  // inverting all of D would cost more than the factorization, and its triangular solve, in
-  // Eigen, took 9 % of a nidus step with the half copy. Inverted in double, then rounded.
+void SupernodalSolve::make_panels() {
   panels_.clear();
   int tallest = 1;
   for (int k = 0; k < int(L_->nsuper); ++k) {
@@ -134,50 +101,58 @@ void SupernodalSolve::make_single() {
       panels_.push_back({c0 + a, std::min(kInvertedWidth, nc - a), nr - a, nr,
                          int64_t(px_[k]) + int64_t(a) * nr + a, pi_[k] + a});
   }
-  values_single_.assign(values_, values_ + L_->xsize);
-  // Y D = [I; E], column by column from the last (Y compact: leading dimension the panel's rows).
-  std::vector<double> Y(size_t(tallest) * size_t(kInvertedWidth));
-  for (const SupernodePanel& p : panels_) {
-    const int nc = p.width, nr = p.rows;
-    const double* X = values_ + p.at;
-    auto in_L = [&p](int i, int j) { return size_t(j) * size_t(p.ld) + size_t(i); };
-    auto in_Y = [nr](int i, int j) { return size_t(j) * size_t(nr) + size_t(i); };
-    for (int j = 0; j < nc; ++j)
-      for (int i = 0; i < nr; ++i) Y[in_Y(i, j)] = i < nc ? double(i == j) : X[in_L(i, j)];
-    for (int j = nc - 1; j >= 0; --j) {
-      double* y = Y.data() + in_Y(0, j);
-      for (int i = j + 1; i < nc; ++i) {
-        const double d = X[in_L(i, j)];
-        const double* yi = Y.data() + in_Y(0, i);
-        for (int r = 0; r < nr; ++r) y[r] -= d * yi[r];
-      }
-      const double inverse = 1 / X[in_L(j, j)];
-      for (int r = 0; r < nr; ++r) y[r] *= inverse;
-    }
-    float* B = values_single_.data() + p.at;
-    for (int j = 0; j < nc; ++j)
-      for (int i = 0; i < nr; ++i) B[in_L(i, j)] = float(Y[in_Y(i, j)]);
-  }
   y_single_.resize(tallest);
 }
 
-void SupernodalSolve::make_half() {
-  values_half_.assign(values_single_.size(), 0);
-  half_unscale_.assign(panels_.size(), 1.0f);
+void SupernodalSolve::make_copy(Copy kind) {
+  // Each panel [D; E] of a supernode (D its lower-triangular diagonal block) becomes
+  // [D^-1; E D^-1]: then its forward half is one product, y = [D^-1; E D^-1] x, and its backward
+  // half x = D^-T x - (E D^-1)^T t another, with no triangular solve in either. A triangular solve
+  // of a few columns runs at a fraction of a product's speed: it was a third of the pair's time on
+  // the nidus, whose 1101 supernodes have ~7.5 columns. A wider supernode (a top separator, up to
+  // 459 columns on the nidus) is a chain of panels of kInvertedWidth columns, each inverted alone:
+  // a panel costs its rows times its width squared, where inverting all of D would cost more than
+  // the factorization; and D's triangular solve, in Eigen, took 9 % of a nidus step.
+  const bool half = kind == Copy::Half;
+  const Eigen::Index tallest = y_single_.size();
+  Eigen::MatrixXd Yd(half ? 0 : tallest, kInvertedWidth);
+  Eigen::MatrixXf Yf(half ? tallest : 0, kInvertedWidth), Df(kInvertedWidth, kInvertedWidth);
+  if (half) {
+    values_half_.assign(L_->xsize, 0);
+    half_unscale_.assign(panels_.size(), 1.0f);
+  } else {
+    values_single_.assign(L_->xsize, 0.0f);
+  }
   for (size_t q = 0; q < panels_.size(); ++q) {
     const SupernodePanel& p = panels_[q];
-    const float* B = values_single_.data() + p.at;
-    float largest = 0;
-    for (int j = 0; j < p.width; ++j)
-      for (int i = 0; i < p.rows; ++i) largest = std::max(largest, std::fabs(B[size_t(j) * size_t(p.ld) + size_t(i)]));
+    const int nc = p.width, nr = p.rows;
+    const Eigen::Map<const Eigen::MatrixXd, 0, Eigen::OuterStride<>> X(values_ + p.at, nr, nc,
+                                                                          Eigen::OuterStride<>(p.ld));
+    if (!half) {  // Y = [I; E] D^-1 in double (Eigen's blocked triangular solve), then rounded
+      auto y = Yd.topLeftCorner(nr, nc);
+      y.topRows(nc).setIdentity();
+      y.bottomRows(nr - nc) = X.bottomRows(nr - nc);
+      X.topRows(nc).triangularView<Eigen::Lower>().solveInPlace<Eigen::OnTheRight>(y);
+      Eigen::Map<Eigen::MatrixXf, 0, Eigen::OuterStride<>>(values_single_.data() + p.at, nr, nc,
+                                                           Eigen::OuterStride<>(p.ld)) = y.cast<float>();
+      continue;
+    }
+    // The half copy: the same in single (it is rounded to half after, and a background refresh has
+    // to make it between two adoptions: 2.0 against 2.9 ms on the nidus), scaled by a power of two
+    // that puts the largest entry in [2^14, 2^15).
+    auto y = Yf.topLeftCorner(nr, nc);
+    auto d = Df.topLeftCorner(nc, nc);
+    d = X.topRows(nc).cast<float>();
+    y.topRows(nc).setIdentity();
+    y.bottomRows(nr - nc) = X.bottomRows(nr - nc).cast<float>();
+    d.triangularView<Eigen::Lower>().solveInPlace<Eigen::OnTheRight>(y);
+    const float largest = y.cwiseAbs().maxCoeff();
     int exponent = 0;
     std::frexp(largest, &exponent);  // largest < 2^exponent
-    const int shift = largest > 0 ? 15 - exponent : 0;  // largest * 2^shift in [2^14, 2^15)
+    const int shift = largest > 0 ? 15 - exponent : 0;
     half_unscale_[q] = std::ldexp(1.0f, -shift);
-    for (int j = 0; j < p.width; ++j) {
-      const size_t at = size_t(p.at) + size_t(j) * size_t(p.ld);
-      to_half(values_single_.data() + at, size_t(p.rows), std::ldexp(1.0f, shift), values_half_.data() + at);
-    }
+    for (int j = 0; j < nc; ++j)
+      to_half(y.col(j).data(), size_t(nr), std::ldexp(1.0f, shift), values_half_.data() + p.at + int64_t(j) * p.ld);
   }
 }
 

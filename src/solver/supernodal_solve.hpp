@@ -11,6 +11,7 @@
 #include <cholmod.h>
 
 #include <Eigen/Dense>
+#include <functional>
 #include <vector>
 
 #include "core/types.hpp"
@@ -38,21 +39,22 @@ class SupernodalSolve {
   // (half; the single copy is tried when it does not).
   // single() says whether a copy was kept, half() whether it is the half one. False when L is not
   // a real supernodal LL^T with int indices; the solves must not be called then.
-  bool bind(const cholmod_factor* L, Copy copy);
+  // multiply(x, y): y = A x for the factored A (the half copy's residual; without it no half copy).
+  using Multiply = std::function<void(const double* x, double* y)>;
+  bool bind(const cholmod_factor* L, Copy copy, const Multiply& multiply = nullptr);
   static constexpr double kSingleAgreement = 1e-4;
   // Half precision's 5e-4 times the system's condition: on the nidus the probe agrees to 2e-4.
   static constexpr double kHalfAgreement = 1e-3;
-  // And the half copy's residual must be below the probe's own size: a preconditioner that
+  // And the half copy's residual must be below half the probe's size: a preconditioner that
   // overshoots the stiff directions (a nearly incompressible body's, 3e5 times the probe, where
   // the single copy's is 250) slows the conjugate gradients to hundreds of iterations. The
   // nidus's is 0.18, a 35k-tet cube's 0.011.
   static constexpr double kHalfResidual = 0.5;
   // The copies split each supernode into panels of up to this many columns and keep each panel
   // inverted, [D^-1; E D^-1]: both halves of the pair are then products, with no triangular solve
-  // (make_single says why).
-  static constexpr int kInvertedWidth = 64;
-  // y = A x = P^T L L^T P x, from the double factor (x and y distinct).
-  void multiply(const double* x, double* y) const;
+  // (make_copy says why). 16 rather than 64: a quarter of the inversion's work, the same pair
+  // (0.231 against 0.251 ms on the nidus).
+  static constexpr int kInvertedWidth = 16;
   // The most columns of any supernode (0 unbound).
   int32_t widest_supernode() const;
   void unbind() { L_ = nullptr; }
@@ -94,17 +96,17 @@ class SupernodalSolve {
   void backward(double* x, const Mat3* turn = nullptr) const;
 
  private:
-  // The single-precision copy, its panels inverted (kInvertedWidth).
-  void make_single();
-  // The half-precision copy of the single one, each panel scaled by a power of two that puts its
-  // largest entry at half's top binade (half's range is 6e-5..65504).
-  void make_half();
+  // The panels of L's supernodes (kInvertedWidth).
+  void make_panels();
+  // The single- or half-precision copy, its panels inverted; a half panel is scaled by a power of
+  // two that puts its largest entry at half's top binade (half's range is 6e-5..65504).
+  void make_copy(Copy kind);
   // How the copy's solve x = solve_single(b) of a fixed vector b fares: its relative difference
-  // from the double solve, and its relative residual |b - A x| / |b|.
+  // from the double solve, and (with multiply) its relative residual |b - A x| / |b|.
   struct Probe {
     double difference, residual;
   };
-  Probe probe_copy() const;
+  Probe probe_copy(const Multiply& multiply) const;
   // The halves on the permuted vector: w_ with L in double, w_single_ with the copy.
   void forward_double() const;
   void backward_double() const;

@@ -117,23 +117,6 @@ static void test_half_refused_where_its_residual_is_large(void**) {
   assert_true(d > 1e-12 && d <= SupernodalSolve::kSingleAgreement);
 }
 
-// A x from the factor (the probe's residual) against the system it factored, S A S + I - S.
-static void test_multiply_is_the_factored_system(void**) {
-  Factored f(Copy::None);
-  const int32_t n = f.p.fem.node_count();
-  const size_t count = static_cast<size_t>(n);
-  Vec3List x(count), ax(count), tmp(count);
-  Eigen::VectorXd flat_x(3 * n), by_factor(3 * n), by_system(3 * n);
-  for (int32_t i = 0; i < n; ++i) x[size_t(i)] = Vec3(std::sin(i), std::cos(0.3 * i), 0.5);
-  for (int32_t i = 0; i < n; ++i) flat_x.segment<3>(3 * i) = x[size_t(i)];
-  ProjectedSystem{f.p.fem.pattern, f.p.A, f.p.projection}.apply(x, ax, tmp);
-  for (int32_t i = 0; i < n; ++i) by_system.segment<3>(3 * i) = ax[size_t(i)];
-  f.direct.by_hand()->multiply(flat_x.data(), by_factor.data());
-  const double d = relative(by_factor, by_system);
-  print_message("L L^T x against S A S + I - S: %.3g\n", d);
-  assert_true(d <= 1e-13);
-}
-
 // The half products against the same products in double from the same halves.
 static void test_half_products(void**) {
   if (!half_products_supported()) skip();
@@ -259,7 +242,6 @@ int main(void) {
       cmocka_unit_test(test_half_within_its_precision),
       cmocka_unit_test(test_half_products),
       cmocka_unit_test(test_half_refused_where_its_residual_is_large),
-      cmocka_unit_test(test_multiply_is_the_factored_system),
       cmocka_unit_test(test_half_columns_and_halves),
       cmocka_unit_test(test_turned_halves),
       cmocka_unit_test(test_other_factors_refused),
