@@ -1,12 +1,12 @@
 // SPDX-License-Identifier: Apache-2.0
 // The triangular solve pair with CHOLMOD's supernodal LL^T factor, for one right-hand side,
-// written out by hand, in double or, from a single-precision copy of the factor, in single.
+// written out by hand, in double or from a copy of the factor in single or half precision.
 // cholmod_solve2 makes two BLAS-2 calls per supernode and triangle; the velocity systems here
-// have about a thousand supernodes of a few columns each (the nidus: 1078 of ~7.6), and the
-// pair is bound by reading the factor from memory (9.4 MB on the nidus). The factored sweep's
-// preconditioner needs no more than single precision (its projection and residuals stay in
-// double): half the bytes to read. bench_factor prints all three; tests/solver/
-// test_supernodal_solve.cpp holds them to cholmod_solve2.
+// have about a thousand supernodes of a few columns each (the nidus: 1101 of ~7.5), and the
+// pair is bound by reading the factor from memory (8.6 MB on the nidus). The factored sweep's
+// preconditioner needs no more than the copy's precision (its projection and residuals stay in
+// double): a half or a quarter of the bytes to read. bench_factor prints all four;
+// tests/solver/test_supernodal_solve.cpp holds them to cholmod_solve2.
 #pragma once
 #include <cholmod.h>
 
@@ -43,7 +43,7 @@ class SupernodalSolve {
   using Multiply = std::function<void(const double* x, double* y)>;
   bool bind(const cholmod_factor* L, Copy copy, const Multiply& multiply = nullptr);
   static constexpr double kSingleAgreement = 1e-4;
-  // Half precision's 5e-4 times the system's condition: on the nidus the probe agrees to 2e-4.
+  // Half precision's 5e-4 times the system's condition: on the nidus the probe agrees to 2.8e-4.
   static constexpr double kHalfAgreement = 1e-3;
   // And the half copy's residual must be below half the probe's size: a preconditioner that
   // overshoots the stiff directions (a nearly incompressible body's, 3e5 times the probe, where
@@ -63,8 +63,8 @@ class SupernodalSolve {
   bool half() const { return bound() && !values_half_.empty(); }
   // x = A^-1 b for the factored A = P^T L L^T P; b and x may be the same array.
   void solve(const double* b, double* x) const;
-  // The same with the single-precision copy (bind(L, true)): relative error ~1e-7 times A's
-  // condition number.
+  // The same with the copy (bind with Copy::Single or Copy::Half): relative error ~1e-7 (single)
+  // or ~5e-4 (half) times A's condition number.
   void solve_single(const double* b, double* x) const;
 
   // A node's half columns L^-1 P E, E the three unit columns of DOFs first .. first + 2: nonzero
