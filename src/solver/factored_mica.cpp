@@ -269,8 +269,13 @@ void FactoredMicaSolver::solve_small_lcp(const ContactRows& rows, double toleran
   // Its ray (no impulses satisfy the rows: a tool closed around a body) stays one for the rest
   // of the solve, whose rounds change the problem only by what they learn of W: they go straight
   // to the sweeps (a pivot costs n^2 too, and 30-50 of them on 507 rows took 15 ms a round).
+  // Past 120 rows its pivots are bounded by their work, that of 50 n pivots on 120 rows (at least
+  // n): on the same fuzzed box, 506 rows with the half-precision copy's W, it cycled through its
+  // 50 n = 25300 pivots twice, 2.4 s a step (found_lemke_cycling_506_rows).
   if (!friction && !lemke_failed_) {
-    const LcpSolution sol = solve_lcp_lemke(small_M_, small_q_);
+    constexpr double kPivotWork = 50.0 * 120 * 120 * 120;
+    const double max_pivots = std::clamp(kPivotWork / (double(n) * double(n)), double(n), 50.0 * double(n));
+    const LcpSolution sol = solve_lcp_lemke(small_M_, small_q_, int32_t(std::max(max_pivots, 1.0)));
     if (sol.solved) {
       for (Eigen::Index a = 0; a < n; ++a) lambda_next_[live_[a]] = sol.z(a);
       return;
