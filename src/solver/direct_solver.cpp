@@ -3,6 +3,7 @@
 
 #include <cmath>
 
+#include "core/assert.hpp"
 #include "core/error.hpp"
 #include "fem/block_matrix.hpp"
 
@@ -32,6 +33,7 @@ void DirectSolver::solve_one(const Eigen::Ref<const Eigen::VectorXd>& b, Eigen::
 }
 
 void DirectSolver::solve_raw_cholmod(const Eigen::Ref<const Eigen::MatrixXd>& B, Eigen::MatrixXd& X) {
+  MICA_ASSERT(!by_hand_.bound() || by_hand_.double_kept(), "cholmod_solve2 needs the double factor");
   cholmod_dense b{};  // a view of B (CHOLMOD reads it only)
   b.nrow = size_t(B.rows());
   b.ncol = size_t(B.cols());
@@ -114,6 +116,12 @@ void DirectSolver::factorize(const ProjectedSystem& sys) {
       for (int r = 0; r < 3; ++r) y[3 * i + size_t(r)] = ys[i][r];
   };
   by_hand_.bind(llt_.factor(), copy_, multiply);  // false (cholmod_solve2 then) for a factor of another kind
+  if (keep_double_ || !by_hand_.single()) return;
+  // Back to CHOLMOD's symbolic supernodal factor: the values go, the structure the copy's panels
+  // point into stays.
+  if (!cholmod_change_factor(CHOLMOD_PATTERN, true, true, true, true, llt_.factor(), &llt_.cholmod()))
+    fail(Errc::Internal, "CHOLMOD could not free the double factor");
+  by_hand_.release_double();
 }
 
 SolveReport DirectSolver::solve(const ProjectedSystem& sys, const Vec3List& b, Vec3List& v) {

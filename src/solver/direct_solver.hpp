@@ -33,8 +33,14 @@ class DirectSolver : public LinearSolver {
   // The same through cholmod_solve2 only (the reference the hand-written solve is tested against).
   void solve_raw_cholmod(const Eigen::Ref<const Eigen::MatrixXd>& B, Eigen::MatrixXd& X);
   // Set before factorize: each factorization also keeps this copy of the factor for the
-  // preconditioner's solves (supernodal_solve.hpp).
-  void set_copy(SupernodalSolve::Copy copy) { copy_ = copy; }
+  // preconditioner's solves (supernodal_solve.hpp). Without keep_double, a factorization whose
+  // copy was kept then frees the double factor's values (CHOLMOD keeps its structure, and the
+  // next factorization fills it again): every solve reads the copy, in a quarter (half copy) or a
+  // half (single) of the memory. Only the hand-written solves of one right-hand side are left then.
+  void set_copy(SupernodalSolve::Copy copy, bool keep_double = true) {
+    copy_ = copy;
+    keep_double_ = keep_double;
+  }
   // x = (S A S + I - S)^-1 b for one right-hand side; with `single` and a single-precision copy,
   // solved with the copy (a preconditioner's solve), else as solve_raw.
   void solve_one(const Eigen::Ref<const Eigen::VectorXd>& b, Eigen::VectorXd& x, bool single);
@@ -63,6 +69,7 @@ class DirectSolver : public LinearSolver {
   Factor llt_;
   SupernodalSolve by_hand_;  // bound to llt_'s factor after each factorization
   SupernodalSolve::Copy copy_ = SupernodalSolve::Copy::None;
+  bool keep_double_ = true;
   cholmod_dense *x_ = nullptr, *y_ = nullptr, *e_ = nullptr;  // cholmod_solve2's solution and workspaces
   Vec3List rhs_, tmp_, check_;
   Eigen::MatrixXd y_flat_;

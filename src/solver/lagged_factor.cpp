@@ -318,12 +318,6 @@ void LaggedFactor::load(ByteReader& in, const BlockPattern& pattern) {
   }
 }
 
-void LaggedFactor::solve(const Vec3List& in, Vec3List& out, bool single) const {
-  active_->direct.solve_one(flat(in), x_, single);
-  out.resize(in.size());
-  flat(out) = x_;
-}
-
 void LaggedFactor::prepare_columns(const std::vector<int32_t>& nodes) {
   for (int32_t node : nodes) {
     const auto [at, added] = columns_.try_emplace(node);

@@ -60,9 +60,6 @@ class LaggedFactor {
   // dropped at adoption as older than this one.
   void refactor_now(const BlockPattern& pattern, const BlockValues& A, const Projection& projection,
                     const std::vector<Mat3>* node_rotation, const std::vector<TriangleStiffness>* extra = nullptr);
-  // out = K_f^-1 in (the factor's frame, no warping); with `single`, from the factor's single-
-  // precision copy (a preconditioner's solve: relative error ~1e-7).
-  void solve(const Vec3List& in, Vec3List& out, bool single = false) const;
   // Computes the half columns (SupernodalSolve::HalfColumns) of all these nodes not yet cached.
   void prepare_columns(const std::vector<int32_t>& nodes);
   // A prepared node's half columns H = L^-1 P E (E its unit columns; K_f = P^T L L^T P), kept
@@ -105,7 +102,8 @@ class LaggedFactor {
 
  private:
   struct Slot {
-    Slot() { direct.set_copy(SupernodalSolve::Copy::Half); }  // the preconditioner's solves: half or single
+    // The preconditioner's solves: half or single, and only the copy kept (see set_copy).
+    Slot() { direct.set_copy(SupernodalSolve::Copy::Half, false); }
     DirectSolver direct;
     BlockValues A;            // the system factored (a copy: the worker factors it; a saved state keeps it)
     Projection projection;
@@ -163,7 +161,6 @@ class LaggedFactor {
   int64_t step_ = 0, launched_at_ = -1;
   int64_t factorizations_ = 0;
   int32_t node_count_ = 0;
-  mutable Eigen::VectorXd x_;
   // The half columns, each marked with the factor it was made from: a new factor marks them all
   // stale instead of freeing them, and prepare_columns() makes them again in the same buffers (a
   // refresh adopted allocates nothing). In a step that may be undone, the first new factor swaps

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/assert.hpp"
 #include "solver/half_products.hpp"
 
 namespace mica {
@@ -35,6 +36,7 @@ bool SupernodalSolve::bind(const cholmod_factor* L, Copy copy, const Multiply& m
   // preconditioner that far off misleads the solves.
   make_panels();
   w_single_.resize(n);
+  w3_single_.setZero(n, 3);
   if (copy == Copy::Half && multiply && half_products_supported()) {
     make_copy(Copy::Half);
     const Probe half = probe_copy(multiply);
@@ -44,6 +46,15 @@ bool SupernodalSolve::bind(const cholmod_factor* L, Copy copy, const Multiply& m
   make_copy(Copy::Single);
   if (!(probe_copy(nullptr).difference <= kSingleAgreement)) values_single_.clear();
   return true;
+}
+
+void SupernodalSolve::release_double() {
+  MICA_ASSERT(single(), "the double factor is released only where a copy serves the solves");
+  values_ = nullptr;
+  w_.resize(0);  // the double halves' workspaces
+  t_.resize(0);
+  w3_.resize(0, 3);
+  t3_.resize(0, 3);
 }
 
 SupernodalSolve::Probe SupernodalSolve::probe_copy(const Multiply& multiply) const {
@@ -167,25 +178,28 @@ struct CopyView {
 
 namespace {
 
-void forward_pass(const CopyView& c, float* w, float* y) {
-  for (size_t q = 0; q < c.panels.size(); ++q) {  // [D^-1; E D^-1]: y = B x (zero above the diagonal)
-    const SupernodePanel& p = c.panels[q];
-    float* x = w + p.column;
-    if (c.half) {
-      half_product(c.half + p.at, p.ld, p.rows, p.width, x, c.unscale[q], y);
-    } else {
-      const float* B = c.single + p.at;
-      for (int i = 0; i < p.rows; ++i) y[i] = 0;
-      for (int j = 0; j < p.width; ++j) {  // column j of the top block is zero above row j
-        const float a = x[j];  // (x is written only after the product)
-        const float* col = B + size_t(j) * size_t(p.ld);
-        for (int i = j; i < p.rows; ++i) y[i] += col[i] * a;
-      }
+// Panel q's part of the forward half on w: [D^-1; E D^-1] x = y, x its columns' entries of w.
+void forward_panel(const CopyView& c, size_t q, float* w, float* y) {
+  const SupernodePanel& p = c.panels[q];
+  float* x = w + p.column;
+  if (c.half) {
+    half_product(c.half + p.at, p.ld, p.rows, p.width, x, c.unscale[q], y);
+  } else {
+    const float* B = c.single + p.at;
+    for (int i = 0; i < p.rows; ++i) y[i] = 0;
+    for (int j = 0; j < p.width; ++j) {  // column j of the top block is zero above row j
+      const float a = x[j];  // (x is written only after the product)
+      const float* col = B + size_t(j) * size_t(p.ld);
+      for (int i = j; i < p.rows; ++i) y[i] += col[i] * a;
     }
-    for (int i = 0; i < p.width; ++i) x[i] = y[i];
-    const int* rows = c.s + p.row_at;
-    for (int i = p.width; i < p.rows; ++i) w[rows[i]] -= y[i];
   }
+  for (int i = 0; i < p.width; ++i) x[i] = y[i];
+  const int* rows = c.s + p.row_at;
+  for (int i = p.width; i < p.rows; ++i) w[rows[i]] -= y[i];
+}
+
+void forward_pass(const CopyView& c, float* w, float* y) {
+  for (size_t q = 0; q < c.panels.size(); ++q) forward_panel(c, q, w, y);
 }
 
 void backward_pass(const CopyView& c, float* w, float* y) {
@@ -248,6 +262,41 @@ void SupernodalSolve::backward_double() const {
 }
 
 void SupernodalSolve::half_columns(int32_t first, HalfColumns& out) const {
+  if (single()) return half_columns_copy(first, out);
+  half_columns_double(first, out);
+}
+
+void SupernodalSolve::half_columns_copy(int32_t first, HalfColumns& out) const {
+  // The copy's forward half of the three unit columns, panel by panel, skipping the panels they
+  // have not reached; those they reach are the segments.
+  out.start.clear();
+  out.length.clear();
+  const CopyView c = copy_view();
+  float* w[3] = {w3_single_.col(0).data(), w3_single_.col(1).data(), w3_single_.col(2).data()};
+  for (int k = 0; k < 3; ++k) w[k][inverse_perm_[size_t(first + k)]] = 1;
+  Eigen::Index total = 0;
+  for (size_t q = 0; q < panels_.size(); ++q) {
+    const SupernodePanel& p = panels_[q];
+    bool reached = false;
+    for (int k = 0; k < 3 && !reached; ++k)
+      for (int j = 0; j < p.width && !reached; ++j) reached = w[k][p.column + j] != 0;
+    if (!reached) continue;
+    for (int k = 0; k < 3; ++k) forward_panel(c, q, w[k], y_single_.data());
+    out.start.push_back(p.column);
+    out.length.push_back(p.width);
+    total += p.width;
+  }
+  out.values.resize(total, 3);
+  Eigen::Index at = 0;
+  for (size_t q = 0; q < out.start.size(); ++q) {
+    auto segment = w3_single_.middleRows(out.start[q], out.length[q]);
+    out.values.middleRows(at, out.length[q]) = segment.cast<double>();
+    segment.setZero();  // every row it touched lies in a segment
+    at += out.length[q];
+  }
+}
+
+void SupernodalSolve::half_columns_double(int32_t first, HalfColumns& out) const {
   out.start.clear();
   out.length.clear();
   double* w[3] = {w3_.col(0).data(), w3_.col(1).data(), w3_.col(2).data()};
@@ -370,7 +419,7 @@ void scatter(const T* w, const Mat3* turn, const std::vector<int32_t>& permuted,
 }  // namespace
 
 void SupernodalSolve::forward(const double* b, bool single, const Mat3* turn) const {
-  halves_single_ = single && this->single();
+  halves_single_ = (single || !values_) && this->single();
   if (!halves_single_) {
     gather(b, turn, inverse_perm_, w_.data());
     return forward_double();

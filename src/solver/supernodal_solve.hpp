@@ -61,7 +61,13 @@ class SupernodalSolve {
   bool bound() const { return L_ != nullptr; }
   bool single() const { return bound() && (!values_single_.empty() || !values_half_.empty()); }
   bool half() const { return bound() && !values_half_.empty(); }
-  // x = A^-1 b for the factored A = P^T L L^T P; b and x may be the same array.
+  // Forgets L's values (bound, with a copy kept): the owner frees them, keeping L's structure, and
+  // from then on every solve, the half columns included, reads the copy (DirectSolver::factorize
+  // with keep_double false: the factored sweep's factor is a quarter of the memory).
+  void release_double();
+  bool double_kept() const { return bound() && values_ != nullptr; }
+  // x = A^-1 b for the factored A = P^T L L^T P (with the copy once the double is released); b and
+  // x may be the same array.
   void solve(const double* b, double* x) const;
   // The same with the copy (bind with Copy::Single or Copy::Half): relative error ~1e-7 (single)
   // or ~5e-4 (half) times A's condition number.
@@ -70,6 +76,8 @@ class SupernodalSolve {
   // A node's half columns L^-1 P E, E the three unit columns of DOFs first .. first + 2: nonzero
   // only on the supernodes of their path up the elimination tree (a few hundred of the nidus's
   // 8208 rows), kept as those segments. With them, A^-1 E = P^T L^-T H and E^T A^-1 E' = H^T H'.
+  // With a copy, they are the copy's (its panels are the segments): the compliance H^T H' is then
+  // that of the preconditioner whose halves they correct, and the double factor is not needed.
   struct HalfColumns {
     std::vector<int32_t> start, length;              // the segments' first permuted row, rows
     Eigen::Matrix<double, Eigen::Dynamic, 3> values;  // their rows, one segment after another
@@ -89,7 +97,7 @@ class SupernodalSolve {
   Vec3 dot(const HalfColumns& h) const;
   void add(const HalfColumns& h, const Vec3& f) const;
   void clear(bool single) const {
-    halves_single_ = single && this->single();
+    halves_single_ = (single || !values_) && this->single();
     if (halves_single_) w_single_.setZero();
     else w_.setZero();
   }
@@ -113,6 +121,8 @@ class SupernodalSolve {
   CopyView copy_view() const;  // the copy, as the passes read it
   void forward_single() const;
   void backward_single() const;
+  void half_columns_double(int32_t first, HalfColumns& out) const;
+  void half_columns_copy(int32_t first, HalfColumns& out) const;
 
   const cholmod_factor* L_ = nullptr;
   const int *super_ = nullptr, *pi_ = nullptr, *px_ = nullptr, *s_ = nullptr;
@@ -129,6 +139,7 @@ class SupernodalSolve {
   mutable Eigen::VectorXf w_single_;
   mutable Eigen::VectorXf y_single_;  // a panel's rows (the single halves')
   mutable Eigen::Matrix<double, Eigen::Dynamic, 3> w3_, t3_;  // half_columns' (w3_ zero between calls)
+  mutable Eigen::Matrix<float, Eigen::Dynamic, 3> w3_single_;  // the copy's half columns' (zero between calls)
   mutable bool halves_single_ = false;                       // forward() left w in w_single_
 };
 

@@ -19,9 +19,10 @@ struct Factored {
   SolverProblem p;
   DirectSolver direct;
   Eigen::VectorXd b;
-  explicit Factored(SupernodalSolve::Copy copy, const Material& material = Material{2e4, 0.3, 1000})
+  explicit Factored(SupernodalSolve::Copy copy, const Material& material = Material{2e4, 0.3, 1000},
+                    bool keep_double = true)
       : p(0, 8, false, material) {
-    direct.set_copy(copy);
+    direct.set_copy(copy, keep_double);
     direct.analyze(p.fem.pattern);
     direct.factorize(ProjectedSystem{p.fem.pattern, p.A, p.projection});
     b = Eigen::VectorXd::LinSpaced(3 * p.fem.node_count(), -1, 2).array().sin();
@@ -170,9 +171,19 @@ static void test_half_columns_and_halves(void**) {
     E.middleRows<3>(3 * b).setIdentity();
     f.direct.solve_raw_cholmod(E, columns);  // A^-1 E_b
     const Mat3 block = columns.middleRows<3>(3 * a), ab = SupernodalSolve::product(Ha, Hb);
-    print_message("copy %d: H_a^T H_b against A^-1's block %.2g (rows kept: %ld and %ld of %d)\n", int(copy),
-                  (ab - block).norm() / block.norm(), long(Ha.values.rows()), long(Hb.values.rows()), 3 * n);
-    assert_true(block.norm() > 0 && (ab - block).norm() <= 1e-12 * block.norm());
+    // With a copy they are the copy's: its compliance, to float's rounding, and A^-1's to the
+    // copy's precision.
+    Eigen::VectorXd copy_column(3 * n);
+    Mat3 copy_block;
+    for (int c = 0; c < 3; ++c) {
+      halves.solve_single(E.col(c).data(), copy_column.data());
+      copy_block.col(c) = copy_column.segment<3>(3 * a);
+    }
+    const double d_exact = (ab - block).norm() / block.norm(), d_copy = (ab - copy_block).norm() / copy_block.norm();
+    print_message("copy %d: H_a^T H_b against A^-1's block %.2g, the copy's %.2g (rows kept: %ld and %ld of %d)\n",
+                  int(copy), d_exact, d_copy, long(Ha.values.rows()), long(Hb.values.rows()), 3 * n);
+    assert_true(block.norm() > 0 && d_exact <= (halves.single() ? allowed(halves) : 1e-12));
+    assert_true(d_copy <= (halves.single() ? 1e-5 : 1e-12));
     assert_true(Ha.values.rows() < 3 * n / 2);
     const Vec3 f_b(0.3, -1, 2);
     halves.forward(f.b.data(), true);
@@ -217,6 +228,36 @@ static void test_turned_halves(void**) {
   }
 }
 
+// A factorization that keeps only its copy: CHOLMOD's values freed, every solve and half column
+// from the copy, the same bits as with the double kept; and the next factorization fills the
+// factor again.
+static void test_released_double(void**) {
+  for (Copy copy : {Copy::Single, Copy::Half}) {
+    Factored kept(copy), released(copy, Material{2e4, 0.3, 1000}, false);
+    const SupernodalSolve &k = *kept.direct.by_hand(), &r = *released.direct.by_hand();
+    assert_true(k.double_kept());
+    assert_false(r.double_kept());
+    assert_true(r.single() && r.half() == k.half());
+    for (int round = 0; round < 2; ++round) {
+      Eigen::VectorXd from_kept, from_released, exact;
+      kept.direct.solve_one(kept.b, from_kept, true);
+      released.direct.solve_one(released.b, from_released, false);  // asked in double: the copy answers
+      assert_true(from_released == from_kept);
+      SupernodalSolve::HalfColumns hk, hr;
+      const int32_t node = released.p.fem.node_count() - 2;
+      k.half_columns(3 * node, hk);
+      r.half_columns(3 * node, hr);
+      assert_true(hr.start == hk.start && hr.values == hk.values);
+      kept.direct.solve_one(kept.b, exact, false);
+      print_message("copy %d, factorization %d: released against the double solve %.2g\n", int(copy), round + 1,
+                    relative(from_released, exact));
+      assert_true(relative(from_released, exact) <= allowed(r));
+      released.direct.factorize(ProjectedSystem{released.p.fem.pattern, released.p.A, released.p.projection});
+      assert_false(released.direct.by_hand()->double_kept());
+    }
+  }
+}
+
 // A simplicial factor is not a supernodal one: bind refuses it.
 static void test_other_factors_refused(void**) {
   struct Simplicial : Eigen::CholmodSimplicialLLT<Eigen::SparseMatrix<double>, Eigen::Lower> {
@@ -241,6 +282,7 @@ int main(void) {
       cmocka_unit_test(test_half_refused_where_its_residual_is_large),
       cmocka_unit_test(test_half_columns_and_halves),
       cmocka_unit_test(test_turned_halves),
+      cmocka_unit_test(test_released_double),
       cmocka_unit_test(test_other_factors_refused),
   };
   return cmocka_run_group_tests(tests, nullptr, nullptr);
