@@ -35,7 +35,7 @@ void FactoredMicaSolver::update_factors(const std::vector<SolverBody>& bodies) {
     const LaggedFactor::Key key{b.system.h, b.system.alpha, b.system.beta, b.constraint_version};
     cache.factor.update(*b.fem, key, *b.A, *b.projection, rotation, rotation ? settings_.refactor_interval : 0,
                         b.extra_stiffness);
-    factored_[k] = {&cache.factor, rotation, b.projection};
+    factored_[k] = {&cache.factor, &cache, rotation, b.projection};
   }
 }
 
@@ -48,6 +48,7 @@ void FactoredMicaSolver::prepare_contact_nodes(const std::vector<SolverBody>& bo
     const FactoredBody& f = factored_[bi];
     ContactNodes& cn = nodes_[bi];
     if (slot_of_.size() < size_t(body.node_count())) slot_of_.resize(size_t(body.node_count()), -1);
+    if (last_slot_.size() < size_t(body.node_count())) last_slot_.resize(size_t(body.node_count()), -1);
     cn.node.clear();
     const auto slot = [&](int32_t i) {
       if (slot_of_[i] < 0) {
@@ -72,15 +73,30 @@ void FactoredMicaSolver::prepare_contact_nodes(const std::vector<SolverBody>& bo
       cn.columns[size_t(a)] = &f.factor->columns(i);
       cn.to_world[size_t(a)] = projector(body, i) * f.factor->turn(f.node_rotation, i);
     }
+    // Y from the products H_a^T H_b, those of nodes the last solve had (with these columns) kept.
+    FactoredBodyCache::Products &last = f.cache->products, &next = f.cache->products_next;
+    const bool columns_kept = last.columns == f.factor->columns_id();
+    if (columns_kept)
+      for (size_t a = 0; a < last.node.size(); ++a) last_slot_[last.node[a]] = int32_t(a);
+    next.blocks.resize(3 * m, 3 * m);
     cn.Y.resize(3 * m, 3 * m);
     for (Eigen::Index a = 0; a < m; ++a)
       for (Eigen::Index b = a; b < m; ++b) {
-        const Mat3 block = cn.to_world[size_t(a)] *
-                           SupernodalSolve::product(*cn.columns[size_t(a)], *cn.columns[size_t(b)]) *
-                           cn.to_world[size_t(b)].transpose();
+        const int32_t la = last_slot_[cn.node[size_t(a)]], lb = last_slot_[cn.node[size_t(b)]];
+        const Mat3 product = la >= 0 && lb >= 0
+                                 ? Mat3(last.blocks.block<3, 3>(3 * la, 3 * lb))
+                                 : SupernodalSolve::product(*cn.columns[size_t(a)], *cn.columns[size_t(b)]);
+        next.blocks.block<3, 3>(3 * a, 3 * b) = product;
+        next.blocks.block<3, 3>(3 * b, 3 * a) = product.transpose();
+        const Mat3 block = cn.to_world[size_t(a)] * product * cn.to_world[size_t(b)].transpose();
         cn.Y.block<3, 3>(3 * a, 3 * b) = block;
         cn.Y.block<3, 3>(3 * b, 3 * a) = block.transpose();
       }
+    if (columns_kept)
+      for (int32_t i : last.node) last_slot_[i] = -1;
+    next.node = cn.node;
+    next.columns = f.factor->columns_id();
+    std::swap(last, next);
     cn.force.setZero(3 * m);
     cn.t.setZero(3 * m);
     cn.u.setZero(3 * m);

@@ -42,6 +42,14 @@ namespace mica {
 struct FactoredBodyCache {
   LaggedFactor factor;
   std::vector<Mat3> node_rotation;  // per node, for warping the factor
+  // H_a^T H_b among the last solve's contact nodes (the factor's frame, 3 x 3 blocks by slot), of
+  // the factor's columns `columns` (LaggedFactor::columns_id): the next solve copies the blocks of
+  // the nodes it still has (the same bits) and makes only the new ones' (prepare_contact_nodes).
+  struct Products {
+    std::vector<int32_t> node;
+    Eigen::MatrixXd blocks;
+    uint64_t columns = 0;  // 0: none
+  } products, products_next;
   int64_t factorizations() const { return factor.factorizations(); }
 };
 
@@ -87,6 +95,7 @@ class FactoredMicaSolver : public CachingVelocitySolver<FactoredBodyCache> {
   // What the loop needs beyond SolverBody, per body of a solve.
   struct FactoredBody {
     LaggedFactor* factor;                     // updated for this solve's system and constraints
+    FactoredBodyCache* cache;                 // the body's (factor is its)
     const std::vector<Mat3>* node_rotation;   // null: the linear model (no warping)
     const Projection* projection;
   };
@@ -218,7 +227,7 @@ class FactoredMicaSolver : public CachingVelocitySolver<FactoredBodyCache> {
   std::vector<ContactNodes> nodes_;                   // per body
   std::vector<int32_t> term_slot_;                    // per row term: its node's slot in its body's nodes_
   std::vector<int32_t> term_row_;                     // per row term: its row
-  std::vector<int32_t> slot_of_;                      // per node, -1 (scratch of prepare_contact_nodes)
+  std::vector<int32_t> slot_of_, last_slot_;          // per node, -1 (scratch of prepare_contact_nodes)
   Eigen::MatrixXd W_;                                 // G P_c^-1 G^T
   std::vector<double> w_, w_prev_, lambda_next_, dlambda_, diag_;
   std::vector<int32_t> live_, live_at_, contact_nodes_;

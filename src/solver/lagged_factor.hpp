@@ -73,6 +73,8 @@ class LaggedFactor {
     return active_->rotation.empty() ? (*node_rotation)[i] : Mat3((*node_rotation)[i] * active_->rotation[i].transpose());
   }
   int64_t factorizations() const { return factorizations_; }
+  // The mark of the factor in use's half columns: another mark, other columns.
+  uint64_t columns_id() const { return columns_id_; }
   // Whether a background refresh also makes half columns (on; a test turns it off to compare),
   // and how many adoptions have taken from it so far.
   void set_background_columns(bool on) { background_columns_ = on; }
