@@ -56,6 +56,12 @@ MICA_F16C void half_product(const uint16_t* B, int ld, int rows, int nc, const f
     _mm256_storeu_ps(y + i, _mm256_mul_ps(a0, scale));
     _mm256_storeu_ps(y + i + 8, _mm256_mul_ps(a1, scale));
   }
+  if (i + 8 <= rows) {  // 8 rows more
+    __m256 a = _mm256_setzero_ps();
+    for (int j = 0; j < nc; ++j) a = _mm256_fmadd_ps(load8(B + size_t(j) * size_t(ld) + i), _mm256_set1_ps(x[j]), a);
+    _mm256_storeu_ps(y + i, _mm256_mul_ps(a, _mm256_set1_ps(s)));
+    i += 8;
+  }
   for (; i < rows; ++i) {
     float sum = 0;
     for (int j = 0; j < nc; ++j) sum += _cvtsh_ss(B[size_t(j) * size_t(ld) + i]) * x[j];

@@ -104,15 +104,18 @@ int32_t SupernodalSolve::widest_supernode() const {
 
 void SupernodalSolve::make_panels() {
   panels_.clear();
+  copy_size_ = 0;
   int tallest = 1;
   for (int k = 0; k < int(L_->nsuper); ++k) {
     const int c0 = super_[k], nc = super_[k + 1] - c0, nr = pi_[k + 1] - pi_[k];
     tallest = std::max(tallest, nr);
-    for (int a = 0; a < nc; a += kInvertedWidth)
-      panels_.push_back({c0 + a, std::min(kInvertedWidth, nc - a), nr - a, nr,
-                         int64_t(px_[k]) + int64_t(a) * nr + a, pi_[k] + a});
+    for (int a = 0; a < nc; a += kInvertedWidth) {
+      const int width = std::min(kInvertedWidth, nc - a), rows = nr - a, padded = (rows + 7) / 8 * 8;
+      panels_.push_back({c0 + a, width, rows, nr, int64_t(px_[k]) + int64_t(a) * nr + a, pi_[k] + a, copy_size_, padded});
+      copy_size_ += int64_t(padded) * width;
+    }
   }
-  y_single_.resize(tallest);
+  y_single_.resize((tallest + 7) / 8 * 8);
 }
 
 void SupernodalSolve::make_copy(Copy kind) {
@@ -129,10 +132,10 @@ void SupernodalSolve::make_copy(Copy kind) {
   Eigen::MatrixXd Yd(half ? 0 : tallest, kInvertedWidth);
   Eigen::MatrixXf Yf(half ? tallest : 0, kInvertedWidth), Df(kInvertedWidth, kInvertedWidth);
   if (half) {
-    values_half_.assign(L_->xsize, 0);
+    values_half_.assign(size_t(copy_size_), 0);
     half_unscale_.assign(panels_.size(), 1.0f);
   } else {
-    values_single_.assign(L_->xsize, 0.0f);
+    values_single_.assign(size_t(copy_size_), 0.0f);
   }
   for (size_t q = 0; q < panels_.size(); ++q) {
     const SupernodePanel& p = panels_[q];
@@ -144,8 +147,8 @@ void SupernodalSolve::make_copy(Copy kind) {
       y.topRows(nc).setIdentity();
       y.bottomRows(nr - nc) = X.bottomRows(nr - nc);
       X.topRows(nc).triangularView<Eigen::Lower>().solveInPlace<Eigen::OnTheRight>(y);
-      Eigen::Map<Eigen::MatrixXf, 0, Eigen::OuterStride<>>(values_single_.data() + p.at, nr, nc,
-                                                           Eigen::OuterStride<>(p.ld)) = y.cast<float>();
+      Eigen::Map<Eigen::MatrixXf, 0, Eigen::OuterStride<>>(values_single_.data() + p.copy_at, nr, nc,
+                                                           Eigen::OuterStride<>(p.copy_rows)) = y.cast<float>();
       continue;
     }
     // The half copy: the same in single (it is rounded to half after, and a background refresh has
@@ -163,7 +166,7 @@ void SupernodalSolve::make_copy(Copy kind) {
     const int shift = largest > 0 ? 15 - exponent : 0;
     half_unscale_[q] = std::ldexp(1.0f, -shift);
     for (int j = 0; j < nc; ++j)
-      to_half(y.col(j).data(), size_t(nr), std::ldexp(1.0f, shift), values_half_.data() + p.at + int64_t(j) * p.ld);
+      to_half(y.col(j).data(), size_t(nr), std::ldexp(1.0f, shift), values_half_.data() + p.copy_at + int64_t(j) * p.copy_rows);
   }
 }
 
@@ -183,13 +186,13 @@ void forward_panel(const CopyView& c, size_t q, float* w, float* y) {
   const SupernodePanel& p = c.panels[q];
   float* x = w + p.column;
   if (c.half) {
-    half_product(c.half + p.at, p.ld, p.rows, p.width, x, c.unscale[q], y);
+    half_product(c.half + p.copy_at, p.copy_rows, p.copy_rows, p.width, x, c.unscale[q], y);  // y's padding: 0
   } else {
-    const float* B = c.single + p.at;
+    const float* B = c.single + p.copy_at;
     for (int i = 0; i < p.rows; ++i) y[i] = 0;
     for (int j = 0; j < p.width; ++j) {  // column j of the top block is zero above row j
       const float a = x[j];  // (x is written only after the product)
-      const float* col = B + size_t(j) * size_t(p.ld);
+      const float* col = B + size_t(j) * size_t(p.copy_rows);
       for (int i = j; i < p.rows; ++i) y[i] += col[i] * a;
     }
   }
@@ -210,12 +213,13 @@ void backward_pass(const CopyView& c, float* w, float* y) {
     for (int i = 0; i < p.width; ++i) y[i] = x[i];
     for (int i = p.width; i < p.rows; ++i) y[i] = -w[rows[i]];
     if (c.half) {
-      half_transposed_product(c.half + p.at, p.ld, p.rows, p.width, y, c.unscale[q], x);
+      for (int i = p.rows; i < p.copy_rows; ++i) y[i] = 0;  // the padding's zeros times finite values
+      half_transposed_product(c.half + p.copy_at, p.copy_rows, p.copy_rows, p.width, y, c.unscale[q], x);
       continue;
     }
-    const float* B = c.single + p.at;
+    const float* B = c.single + p.copy_at;
     for (int j = 0; j < p.width; ++j) {
-      const float* col = B + size_t(j) * size_t(p.ld);
+      const float* col = B + size_t(j) * size_t(p.copy_rows);
       x[j] = Eigen::Map<const Eigen::VectorXf>(col + j, p.rows - j).dot(Eigen::Map<const Eigen::VectorXf>(y + j, p.rows - j));
     }
   }

@@ -25,6 +25,10 @@ struct SupernodePanel {
   int32_t column, width, rows, ld;  // its first (permuted) column, columns, rows, leading dimension
   int64_t at;                        // its first value, in L->x's layout
   int32_t row_at;                    // its first row's index in L->s
+  // In the copies each panel is a block of its own, its rows padded with zeros to a multiple of 8
+  // (the leading dimension): the half kernels then run on whole vectors of 8, with no scalar rows.
+  int64_t copy_at;
+  int32_t copy_rows;
 };
 struct CopyView;
 
@@ -128,6 +132,7 @@ class SupernodalSolve {
   const int *super_ = nullptr, *pi_ = nullptr, *px_ = nullptr, *s_ = nullptr;
   const double* values_ = nullptr;
   std::vector<SupernodePanel> panels_;
+  int64_t copy_size_ = 0;  // the copies' entries (the panels', padded)
   std::vector<float> values_single_;
   // The half copy (empty: the single copy alone), in place of the single one once kept: a
   // panel's value = stored half * its unscale.

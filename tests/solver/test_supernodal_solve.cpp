@@ -122,35 +122,38 @@ static void test_half_refused_where_its_residual_is_large(void**) {
 // The half products against the same products in double from the same halves.
 static void test_half_products(void**) {
   if (!half_products_supported()) skip();
-  const int ld = 41, rows = 37, nc = 7;  // rows not a multiple of 8 or 16: the tails run too
-  std::vector<float> B(size_t(ld) * nc), x(nc), y(rows), out(nc), back(size_t(ld) * nc);
-  for (size_t q = 0; q < B.size(); ++q) B[q] = float(std::sin(0.37 * double(q)));
-  for (int j = 0; j < nc; ++j) x[size_t(j)] = float(std::cos(1.1 * j));
-  for (int i = 0; i < rows; ++i) y[size_t(i)] = float(std::sin(0.9 * i + 0.2));
-  std::vector<uint16_t> H(B.size());
-  to_half(B.data(), B.size(), 64.0f, H.data());
-  const float s = 1.0f / 64;
-  // The halves themselves: within half's rounding of the scaled values (2^-11 relative).
-  std::vector<float> ones(1, 1.0f), unit(1);
-  for (size_t q = 0; q < B.size(); ++q) {
-    half_product(H.data() + q, 1, 1, 1, ones.data(), s, unit.data());
-    back[q] = unit[0];
-    assert_true(std::fabs(back[q] - B[q]) <= std::ldexp(std::fabs(B[q]), -11) + 1e-12);
-  }
-  half_product(H.data(), ld, rows, nc, x.data(), s, y.data());
-  half_transposed_product(H.data(), ld, rows, nc, y.data(), s, out.data());
-  // Each result against the same sum in double of the stored halves, to float's rounding.
-  auto check = [](float got, int count, auto term) {
-    double expected = 0, size = 0;
-    for (int k = 0; k < count; ++k) {
-      expected += term(k);
-      size += std::fabs(term(k));
+  // Rows not a multiple of 8 or 16: 32 + 5 and 32 + 8 + 5 (the block of 8 and the scalar tail run too).
+  for (const int rows : {37, 45}) {
+    const int ld = 49, nc = 7;
+    std::vector<float> B(size_t(ld) * nc), x(nc), y(rows), out(nc), back(size_t(ld) * nc);
+    for (size_t q = 0; q < B.size(); ++q) B[q] = float(std::sin(0.37 * double(q)));
+    for (int j = 0; j < nc; ++j) x[size_t(j)] = float(std::cos(1.1 * j));
+    for (int i = 0; i < rows; ++i) y[size_t(i)] = float(std::sin(0.9 * i + 0.2));
+    std::vector<uint16_t> H(B.size());
+    to_half(B.data(), B.size(), 64.0f, H.data());
+    const float s = 1.0f / 64;
+    // The halves themselves: within half's rounding of the scaled values (2^-11 relative).
+    std::vector<float> ones(1, 1.0f), unit(1);
+    for (size_t q = 0; q < B.size(); ++q) {
+      half_product(H.data() + q, 1, 1, 1, ones.data(), s, unit.data());
+      back[q] = unit[0];
+      assert_true(std::fabs(back[q] - B[q]) <= std::ldexp(std::fabs(B[q]), -11) + 1e-12);
     }
-    assert_true(std::fabs(got - expected) <= 1e-6 * size);
-  };
-  auto entry = [&](int i, int j) { return double(back[size_t(j) * ld + size_t(i)]); };
-  for (int i = 0; i < rows; ++i) check(y[size_t(i)], nc, [&](int j) { return entry(i, j) * x[size_t(j)]; });
-  for (int j = 0; j < nc; ++j) check(out[size_t(j)], rows, [&](int i) { return entry(i, j) * y[size_t(i)]; });
+    half_product(H.data(), ld, rows, nc, x.data(), s, y.data());
+    half_transposed_product(H.data(), ld, rows, nc, y.data(), s, out.data());
+    // Each result against the same sum in double of the stored halves, to float's rounding.
+    auto check = [](float got, int count, auto term) {
+      double expected = 0, size = 0;
+      for (int k = 0; k < count; ++k) {
+        expected += term(k);
+        size += std::fabs(term(k));
+      }
+      assert_true(std::fabs(got - expected) <= 1e-6 * size);
+    };
+    auto entry = [&](int i, int j) { return double(back[size_t(j) * ld + size_t(i)]); };
+    for (int i = 0; i < rows; ++i) check(y[size_t(i)], nc, [&](int j) { return entry(i, j) * x[size_t(j)]; });
+    for (int j = 0; j < nc; ++j) check(out[size_t(j)], rows, [&](int i) { return entry(i, j) * y[size_t(i)]; });
+  }
 }
 
 // Half columns H = L^-1 P E of two nodes: H_a^T H_b against the block of A^-1 that cholmod_solve2
