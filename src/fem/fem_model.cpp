@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "fem/fem_model.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <numeric>
 
@@ -82,7 +83,10 @@ FemModel build_fem_model(const TetMesh& mesh, const std::vector<Material>& mater
 
 void compute_rotations(const FemModel& m, const Vec3List& x, std::vector<Mat3>& R, ThreadPool* pool) {
   parallel_for(pool, int64_t(m.elements.size()), 64, [&](int32_t first, int32_t last) {
-    for (int32_t e = first; e < last; ++e) R[e] = proper_rotation(deformation_gradient(m.elements[e], x));
+    int32_t e = first;
+    for (; e + 1 < last; e += 2)  // in pairs: proper_rotations takes two in about the time of one
+      proper_rotations(deformation_gradient(m.elements[e], x), deformation_gradient(m.elements[e + 1], x), R[e], R[e + 1]);
+    if (e < last) R[e] = proper_rotation(deformation_gradient(m.elements[e], x));
   });
 }
 
@@ -91,7 +95,14 @@ void compute_node_rotations(const FemModel& m, const std::vector<Mat3>& element_
   node_rotation.assign(size_t(m.node_count()), Mat3::Zero());
   for (size_t e = 0; e < m.elements.size(); ++e)
     for (int32_t a : m.elements[e].nodes) node_rotation[size_t(a)] += element_rotation[e];
-  for (Mat3& R : node_rotation) R = R.isZero(0) ? Mat3::Identity() : proper_rotation(R);
+  const size_t n = node_rotation.size();
+  for (size_t i = 0; i < n; i += 2) {
+    const size_t pair[2] = {i, std::min(i + 1, n - 1)};  // in pairs, for proper_rotations
+    const Mat3 sum[2] = {node_rotation[pair[0]], node_rotation[pair[1]]};
+    proper_rotations(sum[0], sum[1], node_rotation[pair[0]], node_rotation[pair[1]]);
+    for (int j = 0; j < 2; ++j)
+      if (sum[j].isZero(0)) node_rotation[pair[j]].setIdentity();
+  }
 }
 
 void assemble_elastic(const FemModel& m, const Vec3List& x, const std::vector<Mat3>* R, double k_scale,

@@ -1,21 +1,42 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "fem/linearisation.hpp"
 
+#include <algorithm>
+
 #include "fem/rotation.hpp"
 
 namespace mica {
 
+namespace {
+
+// For each element e in order, body(e, F1) with F1 its deformation gradient at x_end, after
+// R_end[e] = proper_rotation(F1) when `rotate`. The rotations are taken in pairs (proper_rotations,
+// about twice as fast), an odd count's last element paired with itself.
+template <class Body>
+void for_each_end_gradient(const FemModel& m, const Vec3List& x_end, bool rotate, std::vector<Mat3>& R_end,
+                           Body&& body) {
+  const size_t n = m.elements.size();
+  for (size_t first = 0; first < n; first += 2) {
+    const size_t second = std::min(first + 1, n - 1);
+    const Mat3 F1[2] = {deformation_gradient(m.elements[first], x_end), deformation_gradient(m.elements[second], x_end)};
+    if (rotate) proper_rotations(F1[0], F1[1], R_end[first], R_end[second]);
+    body(first, F1[0]);
+    if (second != first) body(second, F1[1]);
+  }
+}
+
+}  // namespace
+
 ScreenEnergies screen_energies(const FemModel& m, const Vec3List& x, const Vec3List& x_end, const std::vector<Mat3>& R,
                                std::vector<Mat3>& R_end, bool with_start) {
   ScreenEnergies out;
-  for (size_t e = 0; e < m.elements.size(); ++e) {
+  for_each_end_gradient(m, x_end, true, R_end, [&](size_t e, const Mat3& F1) {
     const TetElement& el = m.elements[e];
-    const Mat3 F1 = deformation_gradient(el, x_end);
-    R_end[e] = proper_rotation(F1);
-    out.u_end += elastic_energy(el, m.lame[e], R_end[e], F1);
-    out.u_lin_end += elastic_energy(el, m.lame[e], R[e], F1);
+    const std::array<double, 2> u = elastic_energies(el, m.lame[e], R_end[e], R[e], F1);
+    out.u_end += u[0];
+    out.u_lin_end += u[1];
     if (with_start) out.u_lin_start += elastic_energy(el, m.lame[e], R[e], deformation_gradient(el, x));
-  }
+  });
   return out;
 }
 
@@ -28,13 +49,12 @@ LinearisationEnergies linearisation_energies(const FemModel& m, const Vec3List& 
   const Mat3 I = Mat3::Identity();
   const bool corot = R_lin != nullptr;
   const bool twist = !modes.empty();
-  for (size_t e = 0; e < m.elements.size(); ++e) {
+  for_each_end_gradient(m, x_end, corot, R_end, [&](size_t e, const Mat3& F1) {
     const TetElement& el = m.elements[e];
     const Mat3& R = corot ? (*R_lin)[e] : I;
-    const Mat3 F1 = deformation_gradient(el, x_end);
-    if (corot) R_end[e] = proper_rotation(F1);
-    out.u_end += elastic_energy(el, m.lame[e], corot ? R_end[e] : I, F1);
-    out.u_lin_end += elastic_energy(el, m.lame[e], R, F1);
+    const std::array<double, 2> u = elastic_energies(el, m.lame[e], corot ? R_end[e] : I, R, F1);
+    out.u_end += u[0];
+    out.u_lin_end += u[1];
     out.u_lin_start += elastic_energy(el, m.lame[e], R, deformation_gradient(el, x));
     // v^T (R Ke R^T) v is twice the strain energy of the displacement v in the frame R.
     const Mat3 Fv = deformation_gradient(el, v);
@@ -43,7 +63,7 @@ LinearisationEnergies linearisation_energies(const FemModel& m, const Vec3List& 
       const Mat3& Rs = corot ? (*R_start)[e] : I;
       out.vKv_start += 2 * elastic_energy(el, m.lame[e], Rs, Fv + Rs);
     }
-    if (!twist) continue;
+    if (!twist) return;
     const TwistModes& t = modes[e];
     for (int32_t q = 0; q < t.count; ++q) {
       double cv = 0, cl = 0;
@@ -55,7 +75,7 @@ LinearisationEnergies linearisation_energies(const FemModel& m, const Vec3List& 
       out.gdd += t.weight[q] * (cv - cl) * (cv - cl);
       out.gll += t.weight[q] * cl * cl;
     }
-  }
+  });
   return out;
 }
 

@@ -9,5 +9,9 @@ namespace mica {
 // element) the smallest singular value's sign is flipped (Irving, Teran, Fedkiw 2004), so R
 // is always a proper rotation (det R = +1), also for collapsed elements.
 Mat3 proper_rotation(const Mat3& F);
+// proper_rotation of two matrices at once, in about the time of one (R0 = proper_rotation(F0),
+// R1 = proper_rotation(F1), the same bits): loops over many elements or nodes should take them in
+// pairs. R0 and R1 must not be F0 or F1 (they may be one another when F0 and F1 are too).
+void proper_rotations(const Mat3& F0, const Mat3& F1, Mat3& R0, Mat3& R1);
 
 }  // namespace mica

@@ -91,4 +91,21 @@ double elastic_energy(const TetElement& e, const Lame& m, const Mat3& R, const M
   return e.volume * (m.mu * eps.squaredNorm() + 0.5 * m.lambda * tr * tr);
 }
 
+std::array<double, 2> elastic_energies(const TetElement& e, const Lame& m, const Mat3& Ra, const Mat3& Rb,
+                                       const Mat3& F) {
+  using Lanes = Eigen::Array2d;  // lane 0: the frame Ra, lane 1: Rb
+  Lanes G[3][3];                 // R^T F
+  for (int i = 0; i < 3; ++i) {
+    const Lanes r0(Ra(0, i), Rb(0, i)), r1(Ra(1, i), Rb(1, i)), r2(Ra(2, i), Rb(2, i));
+    for (int j = 0; j < 3; ++j) G[i][j] = r0 * F(0, j) + r1 * F(1, j) + r2 * F(2, j);
+  }
+  // eps = sym(G) - I: its diagonal d and its entries above the diagonal s.
+  const Lanes d0 = G[0][0] - 1, d1 = G[1][1] - 1, d2 = G[2][2] - 1;
+  const Lanes s01 = 0.5 * (G[0][1] + G[1][0]), s02 = 0.5 * (G[0][2] + G[2][0]), s12 = 0.5 * (G[1][2] + G[2][1]);
+  const Lanes tr = d0 + d1 + d2;
+  const Lanes eps2 = d0 * d0 + d1 * d1 + d2 * d2 + 2 * (s01 * s01 + s02 * s02 + s12 * s12);
+  const Lanes u = e.volume * (m.mu * eps2 + 0.5 * m.lambda * tr * tr);
+  return {u(0), u(1)};
+}
+
 }  // namespace mica

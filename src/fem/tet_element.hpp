@@ -46,5 +46,9 @@ void add_element(const TetElement& e, const Lame& m, const Mat3& R, const Vec3Li
 
 // Strain energy 1/2 (R^T x - X)^T Ke (R^T x - X), J.
 double elastic_energy(const TetElement& e, const Lame& m, const Mat3& R, const Mat3& F);
+// The strain energy of one F in two frames, {elastic_energy(Ra, F), elastic_energy(Rb, F)} (to
+// round-off), side by side in SIMD lanes.
+std::array<double, 2> elastic_energies(const TetElement& e, const Lame& m, const Mat3& Ra, const Mat3& Rb,
+                                       const Mat3& F);
 
 }  // namespace mica

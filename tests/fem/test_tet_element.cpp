@@ -117,6 +117,55 @@ static void test_rotation_matches_the_svd_polar_factor(void**) {
   }
 }
 
+// proper_rotations takes two at a time, each lane exactly as proper_rotation alone: paired with a
+// partner that converges sooner or later, inverted (the SVD lane) or collapsed, and with itself.
+static void test_paired_rotations_match_single(void**) {
+  std::mt19937 rng(3);
+  std::normal_distribution<double> normal;
+  std::vector<Mat3> F;
+  for (double stretch : {0.0, 1e-3, 0.05, 0.3}) {
+    for (int trial = 0; trial < 10; ++trial) {
+      const Mat3 Q = rotation_about(Vec3(normal(rng), normal(rng), normal(rng)), 3 * normal(rng));
+      Mat3 noise;
+      for (int k = 0; k < 9; ++k) noise(k / 3, k % 3) = normal(rng);
+      F.push_back(Q * (Mat3::Identity() + stretch * noise));
+    }
+  }
+  F.push_back(Vec3(1, 1, -0.5).asDiagonal());                                     // inverted
+  F.push_back(Mat3::Zero());                                                       // collapsed
+  F.push_back(20 * rotation_about(Vec3(1, 2, 3), 0.4));                            // a node's sum
+  F.push_back(rotation_about(Vec3(0, 1, 0), 1.0) * Vec3(1.3, 1.2, 1.1).asDiagonal());  // det 1.7: cbrt
+  for (size_t i = 0; i < F.size(); ++i)
+    for (size_t j = 0; j < F.size(); ++j) {
+      Mat3 Ri, Rj;
+      proper_rotations(F[i], F[j], Ri, Rj);
+      assert_true(Ri == proper_rotation(F[i]));
+      assert_true(Rj == proper_rotation(F[j]));
+    }
+  Mat3 R;
+  proper_rotations(F[3], F[3], R, R);
+  assert_true(R == proper_rotation(F[3]));
+}
+
+// elastic_energies, two frames side by side, against elastic_energy in each.
+static void test_paired_energies_match_single(void**) {
+  const FemModel m = cube_model();
+  std::mt19937 rng(7);
+  std::normal_distribution<double> normal;
+  for (int trial = 0; trial < 20; ++trial) {
+    const TetElement& el = m.elements[size_t(trial) * 11 % m.elements.size()];
+    const Mat3 Qa = rotation_about(Vec3(normal(rng), normal(rng), normal(rng)), 3 * normal(rng));
+    const Mat3 Qb = rotation_about(Vec3(normal(rng), normal(rng), normal(rng)), 0.1 * normal(rng)) * Qa;
+    Mat3 noise;
+    for (int k = 0; k < 9; ++k) noise(k / 3, k % 3) = normal(rng);
+    const Mat3 F = Qa * (Mat3::Identity() + 0.02 * noise);
+    const std::array<double, 2> u = elastic_energies(el, m.lame[0], Qa, Qb, F);
+    const double ua = elastic_energy(el, m.lame[0], Qa, F), ub = elastic_energy(el, m.lame[0], Qb, F);
+    assert_near(u[0], ua, 1e-12 * ua);
+    assert_near(u[1], ub, 1e-12 * ub);
+  }
+}
+
 // -d f / d x against the assembled K, by central differences along random directions.
 static void check_stiffness(const FemModel& m, const Vec3List& x, bool corotational, double rel_tol) {
   std::vector<Mat3> R(m.elements.size(), Mat3::Identity());
@@ -214,6 +263,8 @@ int main(void) {
       cmocka_unit_test(test_rigid_rotation_gives_no_force),
       cmocka_unit_test(test_rotation_is_proper_for_inverted_elements),
       cmocka_unit_test(test_rotation_matches_the_svd_polar_factor),
+      cmocka_unit_test(test_paired_rotations_match_single),
+      cmocka_unit_test(test_paired_energies_match_single),
       cmocka_unit_test(test_stiffness_matches_finite_difference),
       cmocka_unit_test(test_fused_element_matches_reference),
       cmocka_unit_test(test_total_mass),
