@@ -85,6 +85,82 @@ void add_element(const TetElement& e, const Lame& m, const Mat3& R, const Vec3Li
     }
 }
 
+void add_elements(const TetElement* const e[2], const Lame* const m[2], const Mat3* const R[2], const Vec3List& x,
+                  double scale, const std::array<int32_t, 16>* const slots[2], Mat3* K, Vec3List& f) {
+  // add_element's steps, each quantity a pair: lane l belongs to element e[l].
+  using Lanes = Eigen::Array2d;
+  auto lanes = [](const auto& v0, const auto& v1, int i, int j) { return Lanes(v0(i, j), v1(i, j)); };
+  Lanes Rl[3][3], dm[3][3], ds[3][3];
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      Rl[i][j] = lanes(*R[0], *R[1], i, j);
+      dm[i][j] = lanes(e[0]->dm_inv, e[1]->dm_inv, i, j);
+    }
+  for (int k = 0; k < 3; ++k) {
+    const Vec3 d0 = x[e[0]->nodes[k + 1]] - x[e[0]->nodes[0]], d1 = x[e[1]->nodes[k + 1]] - x[e[1]->nodes[0]];
+    for (int i = 0; i < 3; ++i) ds[i][k] = Lanes(d0[i], d1[i]);
+  }
+  Lanes g[4][3];  // the rest gradients
+  for (int a = 0; a < 4; ++a)
+    for (int i = 0; i < 3; ++i) g[a][i] = Lanes(e[0]->grad[a][i], e[1]->grad[a][i]);
+  const Lanes volume(e[0]->volume, e[1]->volume), lambda(m[0]->lambda, m[1]->lambda), mu(m[0]->mu, m[1]->mu);
+
+  // Forces: F = Ds Dm^-1, G = R^T F, eps = sym(G) - I, sigma = 2 mu eps + lambda tr(eps) I,
+  // P = -V R sigma, f_a = P g_a.
+  Lanes F[3][3], G[3][3], sigma[3][3], P[3][3];
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) F[i][j] = ds[i][0] * dm[0][j] + ds[i][1] * dm[1][j] + ds[i][2] * dm[2][j];
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) G[i][j] = Rl[0][i] * F[0][j] + Rl[1][i] * F[1][j] + Rl[2][i] * F[2][j];
+  const Lanes tr = (G[0][0] - 1) + (G[1][1] - 1) + (G[2][2] - 1);
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      const Lanes eps = i == j ? Lanes(G[i][i] - 1) : Lanes(0.5 * (G[i][j] + G[j][i]));
+      sigma[i][j] = 2 * mu * eps;
+      if (i == j) sigma[i][j] += lambda * tr;
+    }
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      P[i][j] = -volume * (Rl[i][0] * sigma[0][j] + Rl[i][1] * sigma[1][j] + Rl[i][2] * sigma[2][j]);
+  for (int a = 0; a < 4; ++a) {
+    Lanes fa[3];
+    for (int i = 0; i < 3; ++i) fa[i] = P[i][0] * g[a][0] + P[i][1] * g[a][1] + P[i][2] * g[a][2];
+    for (int l = 0; l < 2; ++l) f[e[l]->nodes[a]] += Vec3(fa[0](l), fa[1](l), fa[2](l));
+  }
+  if (!K) return;
+
+  // Stiffness: block (a, b) = u h_b^T + w h_a^T + d I with h = R g, u = V lambda h_a, w = V mu h_b,
+  // d = V mu g_a . g_b; block (b, a) is its transpose, the same pairs read across.
+  Lanes h[4][3];
+  for (int a = 0; a < 4; ++a)
+    for (int i = 0; i < 3; ++i) h[a][i] = Rl[i][0] * g[a][0] + Rl[i][1] * g[a][1] + Rl[i][2] * g[a][2];
+  const Lanes vl = scale * volume * lambda, vm = scale * volume * mu;
+  // block += k (or k^T), k's entries (r, c) at 3c + r as Mat3 stores them: lane l into block[l].
+  auto add = [](Mat3* const block[2], const Lanes (&k)[3][3], bool transposed) {
+    auto at = [&](int i) -> const Lanes& { return transposed ? k[i / 3][i % 3] : k[i % 3][i / 3]; };
+    for (int l = 0; l < 2; ++l) {
+      double* out = block[l]->data();
+      for (int i = 0; i < 8; i += 2) Eigen::Map<Lanes>(out + i) += Lanes(at(i)(l), at(i + 1)(l));
+      out[8] += at(8)(l);
+    }
+  };
+  for (int a = 0; a < 4; ++a)
+    for (int b = a; b < 4; ++b) {
+      const Lanes d = vm * (g[a][0] * g[b][0] + g[a][1] * g[b][1] + g[a][2] * g[b][2]);
+      Lanes k[3][3];
+      for (int r = 0; r < 3; ++r) {
+        const Lanes u = vl * h[a][r], w = vm * h[b][r];
+        for (int c = 0; c < 3; ++c) k[r][c] = u * h[b][c] + w * h[a][c];
+        k[r][r] += d;
+      }
+      Mat3* const ab[2] = {&K[(*slots[0])[4 * a + b]], &K[(*slots[1])[4 * a + b]]};
+      add(ab, k, false);
+      if (b == a) continue;
+      Mat3* const ba[2] = {&K[(*slots[0])[4 * b + a]], &K[(*slots[1])[4 * b + a]]};
+      add(ba, k, true);
+    }
+}
+
 double elastic_energy(const TetElement& e, const Lame& m, const Mat3& R, const Mat3& F) {
   const Mat3 eps = rotated_strain(R, F);
   const double tr = eps.trace();

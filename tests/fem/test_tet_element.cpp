@@ -244,6 +244,40 @@ static void test_fused_element_matches_reference(void**) {
   }
 }
 
+// add_elements, two elements side by side, against add_element on each: pairs that share nodes
+// (so blocks and forces), with their own rotations, into the model's real slots; and forces only.
+static void test_paired_elements_match_single(void**) {
+  const FemModel m = cube_model();
+  std::mt19937 rng(9);
+  std::normal_distribution<double> normal;
+  Vec3List x(m.rest.size());
+  const Mat3 Q = rotation_about(Vec3(1, -2, 0.5), 1.1);
+  for (size_t i = 0; i < x.size(); ++i) x[i] = Q * m.rest[i] + 0.01 * Vec3(normal(rng), normal(rng), normal(rng));
+  std::vector<Mat3> R(m.elements.size());
+  compute_rotations(m, x, R);
+  for (size_t e0 = 0; e0 + 1 < m.elements.size(); e0 += 7) {
+    for (size_t e1 : {e0 + 1, (e0 * 13 + 5) % m.elements.size()}) {
+      if (e1 == e0) continue;
+      for (bool with_K : {true, false}) {
+        BlockValues K(m.pattern.block_count(), Mat3::Identity()), K_ref = K;
+        Vec3List f(x.size(), Vec3::Ones()), f_ref = f;
+        const TetElement* el[2] = {&m.elements[e0], &m.elements[e1]};
+        const Lame* lame[2] = {&m.lame[e0], &m.lame[e1]};
+        const Mat3* rot[2] = {&R[e0], &R[e1]};
+        const std::array<int32_t, 16>* slots[2] = {&m.slots[e0], &m.slots[e1]};
+        add_elements(el, lame, rot, x, 1e-4, slots, with_K ? K.data() : nullptr, f);
+        for (size_t e : {e0, e1})
+          add_element(m.elements[e], m.lame[e], R[e], x, 1e-4, m.slots[e], with_K ? K_ref.data() : nullptr, f_ref);
+        double k_scale = 0, f_scale = 0;
+        for (const Mat3& k : K_ref) k_scale = std::max(k_scale, (k - Mat3::Identity()).norm());
+        for (const Vec3& v : f_ref) f_scale = std::max(f_scale, (v - Vec3::Ones()).norm());
+        for (size_t q = 0; q < K.size(); ++q) assert_le((K[q] - K_ref[q]).norm(), 1e-12 * k_scale);
+        for (size_t i = 0; i < f.size(); ++i) assert_le((f[i] - f_ref[i]).norm(), 1e-12 * f_scale);
+      }
+    }
+  }
+}
+
 static void test_total_mass(void**) {
   for (MassKind kind : {MassKind::Consistent, MassKind::Lumped})
     for (int32_t tpc : {5, 6}) {
@@ -267,6 +301,7 @@ int main(void) {
       cmocka_unit_test(test_paired_energies_match_single),
       cmocka_unit_test(test_stiffness_matches_finite_difference),
       cmocka_unit_test(test_fused_element_matches_reference),
+      cmocka_unit_test(test_paired_elements_match_single),
       cmocka_unit_test(test_total_mass),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
