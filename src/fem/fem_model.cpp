@@ -98,10 +98,16 @@ void compute_node_rotations(const FemModel& m, const std::vector<Mat3>& element_
   const size_t n = node_rotation.size();
   for (size_t i = 0; i < n; i += 2) {
     const size_t pair[2] = {i, std::min(i + 1, n - 1)};  // in pairs, for proper_rotations
-    const Mat3 sum[2] = {node_rotation[pair[0]], node_rotation[pair[1]]};
-    proper_rotations(sum[0], sum[1], node_rotation[pair[0]], node_rotation[pair[1]]);
+    // Each sum S scaled to |S|_F^2 = 3, as a rotation's (its polar factor is the same): det S is
+    // then near 1, where Newton's scaling needs no cube root.
+    Mat3 S[2];
+    for (int j = 0; j < 2; ++j) {
+      const double n2 = node_rotation[pair[j]].squaredNorm();
+      S[j] = n2 > 0 ? Mat3(node_rotation[pair[j]] * std::sqrt(3 / n2)) : node_rotation[pair[j]];
+    }
+    proper_rotations(S[0], S[1], node_rotation[pair[0]], node_rotation[pair[1]]);
     for (int j = 0; j < 2; ++j)
-      if (sum[j].isZero(0)) node_rotation[pair[j]].setIdentity();
+      if (S[j].isZero(0)) node_rotation[pair[j]].setIdentity();  // a node in no element
   }
 }
 
