@@ -132,6 +132,7 @@ class SupernodalSolve {
   const int *super_ = nullptr, *pi_ = nullptr, *px_ = nullptr, *s_ = nullptr;
   const double* values_ = nullptr;
   std::vector<SupernodePanel> panels_;
+  std::vector<int32_t> first_panel_;  // per supernode its first panel, and one past the last
   int64_t copy_size_ = 0;  // the copies' entries (the panels', padded)
   std::vector<float> values_single_;
   // The half copy (empty: the single copy alone), in place of the single one once kept: a
@@ -142,7 +143,8 @@ class SupernodalSolve {
   // The permuted vector, and a supernode's rows below its columns (grown, never shrunk).
   mutable Eigen::VectorXd w_, t_;
   mutable Eigen::VectorXf w_single_;
-  mutable Eigen::VectorXf y_single_;  // a panel's rows (the single halves')
+  mutable Eigen::VectorXf y_single_;      // a panel's rows (the single halves')
+  mutable Eigen::VectorXf below_single_;  // a supernode's rows below its columns (the forward half's)
   mutable Eigen::Matrix<double, Eigen::Dynamic, 3> w3_, t3_;  // half_columns' (w3_ zero between calls)
   mutable Eigen::Matrix<float, Eigen::Dynamic, 3> w3_single_;  // the copy's half columns' (zero between calls)
   mutable bool halves_single_ = false;                       // forward() left w in w_single_
