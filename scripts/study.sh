@@ -58,7 +58,7 @@ stages=(
   "sweep|250|$bin/study_sweep $out ${quick[*]:-}"
   "anchors|90|$bin/study_anchors $out ${quick[*]:-}"
   "filter|35|$bin/study_filter $out"
-  "nidus|45|$nidus_bin $root/data/nidus/nidus.msh 1e-6 ${nidus_steps[0]} ${nidus_steps[1]} 1e4 0.01 0 4"
+  "nidus|45|$nidus_bin $root/data/nidus/nidus.msh 1e-6 ${nidus_steps[0]} ${nidus_steps[1]} 1e4 0.01 0 6"
   "scaling|215|$pin $nidus_bin --scaling $out/scaling.csv $scaling_max factored"
   "contact|90|$pin $contact_bin $contact_set --csv $out/contact.csv"
   "plots|6|/usr/bin/python3 $root/scripts/study_plots.py $out"

@@ -204,11 +204,13 @@ typedef struct mica_world_def {
    *  refresh and kept until the world is destroyed) while the steps go on, and used from
    *  that many solves later (in lockstep: the step waits for a late factorization, so results do
    *  not depend on timing). Meant for bodies that keep turning far from the factor's shape; on the
-   *  nidus benchmark (a tool moving in a soft blob), every 4 steps: 6.9 conjugate-gradient
-   *  iterations per step instead of 10.9 and a median step 0.89-0.91x as long, its p95 no
-   *  shorter (three sets of six runs, docs/performance.md).
+   *  nidus benchmark (a tool moving in a soft blob), every 6 steps: 8.0 conjugate-gradient
+   *  iterations per step instead of 10.7 and a median step 0.88-0.91x as long (5.0 ms), its p95
+   *  about the same; every 4, a factorization (about 22 ms on the second core) outlasts four
+   *  steps and the adopting steps wait for it (docs/performance.md).
    *  Default 0: factor when the time step, damping or constraint set changes, and when a solve
-   *  drags on. Costs a second core while it runs, and a second factor's memory. (With or
+   *  drags on. Costs a second core while it runs, and a second copy of the factor's memory (the
+   *  factorization's double-precision values only while it runs). (With or
    *  without a refresh, so that a failed step can be undone, a factor replaced within a step
    *  is kept until the step ends and then reused as the next one's storage: one factor's
    *  memory more.) */
