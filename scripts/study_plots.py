@@ -57,11 +57,31 @@ def fin(v):
 COLOURS = {"MICA": "tab:blue", "MICA-F": "tab:green", "PCG": "tab:orange", "exact": "k"}
 
 
+def label_points(ax, labels, fontsize=6):
+    """Annotates (x, y, text, colour) points of `ax`, each label moved down (then up) by a line
+    until it overlaps no label placed before it: points close together stay readable. Call it
+    after the axes' scales and data are final (it reads their limits)."""
+    ax.figure.canvas.draw()  # the final limits, so data maps to display coordinates
+    pt = ax.figure.dpi / 72  # display pixels per point
+    line, placed = fontsize + 1.5, []
+    for x, y, text, colour in sorted(labels, key=lambda l: (l[0], -l[1])):
+        px, py = ax.transData.transform((x, y)) / pt  # in points
+        width = 0.55 * fontsize * len(text)
+        for shift in [0] + [s * k * line for k in range(1, 8) for s in (-1, 1)]:
+            box = (px + 3, py + 2 + shift, width, line)
+            if not any(abs(box[0] - b[0]) < max(box[2], b[2]) and abs(box[1] - b[1]) < line for b in placed):
+                break
+        placed.append(box)
+        ax.annotate(text, (x, y), fontsize=fontsize, color=colour, xytext=(3, 2 + shift), textcoords="offset points",
+                    arrowprops=dict(arrowstyle="-", lw=0.3, color="0.6") if shift else None)
+
+
 def error_vs_time(rows, out):
-    fig, axes = plt.subplots(1, 2, figsize=(13, 5), dpi=110)
+    fig, axes = plt.subplots(1, 2, figsize=(13, 6), dpi=110)
     floor = {"disp_rms_err_m": 1e-15, "force_err_N": 1e-13}
     for ax, key, label in ((axes[0], "disp_rms_err_m", "position error, RMS over nodes, worst step (m)"),
                            (axes[1], "force_err_N", "tool force error, worst step (N)")):
+        labels = []
         for solver in ("MICA", "MICA-F", "PCG"):
             for group, ls, marker, mode in (("tolerance", "-", "o", "fixed tolerance"),
                                             ("iterations", "--", "s", "fixed iterations")):
@@ -75,15 +95,15 @@ def error_vs_time(rows, out):
                           color=COLOURS[solver], label=f"{solver}, {mode}")
                 for x, y, r in pts:
                     tag = f"{num(r['tol']):.0e}" if group == "tolerance" else r["cap"]
-                    ax.annotate(tag, (x, y), fontsize=6, color=COLOURS[solver], xytext=(3, 2),
-                                textcoords="offset points")
+                    labels.append((x, y, tag, COLOURS[solver]))
         exact = [num(r["ms_median"]) for r in rows if r["group"] == "tolerance" and r["solver"] == "exact"]
         if exact:
             ax.axvline(exact[0], color="k", ls=":", lw=1.2, label=f"exact (DIRECT): {exact[0]:.1f} ms")
         ax.set_xlabel("median ms per step (in-process, after warm-up)")
         ax.set_ylabel(label)
         ax.grid(alpha=0.3, which="both")
-        ax.legend(fontsize=7)
+        ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=3)  # below: no point hidden
+        label_points(ax, labels)
     axes[0].set_title("Position error against cost (labels: tolerance or iteration cap)")
     axes[1].set_title("Tool force error against cost")
     fig.suptitle("Error against the exact solver on the same scene: 3072-tet cube, sphere press + grasp drag, "
@@ -115,7 +135,7 @@ def iterations_vs_tolerance(rows, out):
         ax.set_xlabel("tolerance (relative change of v and lambda)")
         ax.grid(alpha=0.3, which="both")
         ax.legend(fontsize=7)
-    ax_i.set_ylabel("iterations per step (PCG: summed over its solves, one per contact row + 1)")
+    ax_i.set_ylabel("iterations per step\n(PCG: summed over its solves, one per contact row + 1)")
     ax_t.set_ylabel("ms per step")
     ax_i.set_title("Iterations against tolerance")
     ax_t.set_title("Time against tolerance")
@@ -267,7 +287,7 @@ def figure1(samples, filt, out):
 def knobs(rows, out):
     panels = [("dt", "time step", lambda r: f"{1e3 * num(r['dt_s']):g} ms"),
               ("mesh", "mesh (cells per side)", lambda r: f"{r['cells']}^3"),
-              ("model", "model", lambda r: r["model"][:6]),
+              ("model", "model", lambda r: r["model"]),
               ("mass", "mass", lambda r: r["mass"]),
               ("pgs", "PGS sweeps (tol 1e-6)", lambda r: f"{r['pgs_sweeps']} sweeps"),
               ("warmstart", "warm start", lambda r: f"{'on' if r['warm_start'] == '1' else 'off'} {num(r['tol']):.0e}"),
@@ -281,6 +301,7 @@ def knobs(rows, out):
             ax.set_title(f"{title}: not in this run")
             ax.axis("off")
             continue
+        labels = []
         for r in rs:
             x = num(r["ms_median"])
             y = num(r["model_disp_rms_err_m"]) if group in ("dt", "model", "mass") else num(r["disp_rms_err_m"])
@@ -291,7 +312,7 @@ def knobs(rows, out):
             y = max(y, 1e-12)
             ax.loglog(x, y, "o" if r["solver"] == "MICA" else "s" if r["solver"] == "PCG" else "D",
                       color=COLOURS[r["solver"]], ms=6)
-            ax.annotate(f"{r['solver']} {tag(r)}", (x, y), fontsize=6, xytext=(3, 3), textcoords="offset points")
+            labels.append((x, y, f"{r['solver']} {tag(r)}", "k"))
         if group in ("pgs", "norm", "warmstart") and base:
             pts = sorted((num(r["ms_median"]), num(r["disp_rms_err_m"])) for r in base)
             ax.loglog([p[0] for p in pts], [max(p[1], 1e-12) for p in pts], "-", color="0.7", lw=1,
@@ -304,6 +325,7 @@ def knobs(rows, out):
         ax.set_xlabel("median ms per step", fontsize=8)
         ax.set_title(title)
         ax.grid(alpha=0.3, which="both")
+        label_points(ax, labels)
     drift = [r for r in rows if r["group"] == "drift"]
     ax = axes[7]
     if drift:
@@ -314,9 +336,11 @@ def knobs(rows, out):
         ax.set_xticklabels(labels, rotation=45, fontsize=7, ha="right")
         ax.set_ylabel("energy after 1 s / energy after the push")
         ax.set_title("Energy drift: undamped free vibration")
-        lo = min(v for v in vals if fin(v))
-        ax.set_ylim(min(lo * 0.98, 0.9), max(vals) * 1.02)
-        ax.grid(alpha=0.3, axis="y")
+        # Log scale: the ratios span decades (backward Euler damps the vibration), and a linear axis
+        # cut just below the smallest made bars of similar height look empty.
+        ax.set_yscale("log")
+        ax.set_ylim(min(v for v in vals if fin(v) and v > 0) / 10, max(vals) * 2)
+        ax.grid(alpha=0.3, axis="y", which="both")
     fig.suptitle("The other knobs (MICA tol 1e-6 unless marked): error against cost")
     fig.tight_layout()
     fig.savefig(os.path.join(out, "knobs.png"))
@@ -327,6 +351,7 @@ def anchors(rows, curve, out):
     if not rows:
         return
     fig, (ax_c, ax_f) = plt.subplots(1, 2, figsize=(13, 5), dpi=110)
+    labels = []
     for test, model, colour, marker in (("hertz", "linear", "tab:red", "o"),
                                         ("cantilever", "linear", "tab:blue", "s"),
                                         ("cantilever", "corotational", "tab:cyan", "^")):
@@ -339,13 +364,13 @@ def anchors(rows, curve, out):
                  else f"cantilever tip ({model}), h = H / n")
         ax_c.loglog([p[0] for p in pts], [p[1] for p in pts], marker=marker, color=colour, label=label)
         for h, e, s in pts:
-            ax_c.annotate(f"{s:+.1%}", (h, e), fontsize=6, xytext=(3, 3), textcoords="offset points")
+            labels.append((h, e, f"{s:+.1%}", colour))
         if len(pts) >= 2:
             (h1, e1, _), (h2, e2, _) = pts[0], pts[1]
             if e1 > 0 and e2 > 0 and h2 != h1:
                 rate = math.log(e2 / e1) / math.log(h2 / h1)
-                ax_c.annotate(f"slope {rate:.2f} (finest two)", (h1, e1), fontsize=7, color=colour,
-                              xytext=(-10, -14), textcoords="offset points")
+                labels.append((h1, e1, f"slope {rate:.2f} (finest two)", colour))
+    label_points(ax_c, labels)
     ax_c.set_xlabel("element size h (m)")
     ax_c.set_ylabel("|FEM - theory| / theory")
     ax_c.set_title("Mesh convergence toward Hertz and Euler-Bernoulli (exact solver, static)")
