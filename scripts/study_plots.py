@@ -145,7 +145,7 @@ def iterations_vs_tolerance(rows, out):
 
 
 def figure2(rows, steps, out):
-    fig, (ax_s, ax_e, ax_t) = plt.subplots(1, 3, figsize=(16, 4.5), dpi=110)
+    fig, (ax_s, ax_e, ax_t) = plt.subplots(1, 3, figsize=(16, 5.2), dpi=110)
     runs = OrderedDict()
     for r in steps:
         if r["solver"] == "MICA":
@@ -162,7 +162,7 @@ def figure2(rows, steps, out):
     ax_s.set_ylabel("MICA iterations to tolerance 1e-8")
     ax_s.set_title("Figure 2: iterations per step (nu = 0.3)")
     ax_s.grid(alpha=0.3, which="both")
-    ax_s.legend(fontsize=7)
+    ax_s.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.15), ncol=3)  # below: no curve hidden
     for solver in ("MICA", "MICA-F", "PCG", "exact"):
         pts = sorted((num(r["E_Pa"]), num(r["iters_mean"]), num(r["ms_median"])) for r in rows
                      if r["group"] == "stiffness" and r["solver"] == solver)
@@ -420,6 +420,9 @@ def scaling(rows, out):
     for a in (ax_t, ax_i):
         a.grid(alpha=0.3, which="both")
     ax_t.legend(fontsize=7)
+    # One legend for both of the right panel's axes (each curve is on its own y axis).
+    lines = ax_i.get_lines() + ax_i2.get_lines()
+    ax_i.legend(lines, [l.get_label() for l in lines], fontsize=7, loc="upper left")
     fig.tight_layout()
     fig.savefig(os.path.join(out, "scaling.png"))
     plt.close(fig)
