@@ -58,6 +58,21 @@ void block_multiply_sse2(const BlockPattern& p, const BlockValues& A, const Vec3
   }
 }
 
+void block_multiply_bound_sse2(const BlockPattern& p, const BlockValues& A, const Vec3List& x, Vec3List& y,
+                               std::vector<double>& bound) {
+  for (int32_t i = 0; i < p.rows; ++i) {
+    Vec3 sum = Vec3::Zero();
+    double a2 = 0, x2 = 0;
+    for (int32_t k = p.row_start[i]; k < p.row_start[i + 1]; ++k) {
+      sum += A[k] * x[p.col[k]];
+      a2 += A[k].squaredNorm();
+      x2 += x[p.col[k]].squaredNorm();
+    }
+    y[i] = sum;
+    bound[size_t(i)] = a2 * x2;
+  }
+}
+
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
 #define MICA_BLOCK_AVX2 1
 // A block's three columns as three vectors of 4 (the 4th lane reads the next column's first
@@ -83,6 +98,38 @@ __attribute__((target("avx2,fma"))) void block_multiply_avx2(const BlockPattern&
   }
 }
 
+// block_multiply_avx2 that also sums the squares of the blocks' entries (lanes 0-2 of each load).
+__attribute__((target("avx2,fma"))) void block_multiply_bound_avx2(const BlockPattern& p, const BlockValues& A,
+                                                                       const Vec3List& x, Vec3List& y,
+                                                                       std::vector<double>& bound) {
+  const int32_t blocks = p.row_start[p.rows];
+  for (int32_t i = 0; i < p.rows; ++i) {
+    __m256d s0 = _mm256_setzero_pd(), s1 = _mm256_setzero_pd(), q = _mm256_setzero_pd();
+    double x2 = 0;
+    const int32_t end = std::min(p.row_start[i + 1], blocks - 1);
+    for (int32_t k = p.row_start[i]; k < end; ++k) {
+      const double *a = A[k].data(), *v = x[p.col[k]].data();
+      const __m256d c0 = _mm256_loadu_pd(a), c1 = _mm256_loadu_pd(a + 3), c2 = _mm256_loadu_pd(a + 6);
+      s0 = _mm256_fmadd_pd(c0, _mm256_set1_pd(v[0]), s0);
+      s1 = _mm256_fmadd_pd(c1, _mm256_set1_pd(v[1]), s1);
+      s0 = _mm256_fmadd_pd(c2, _mm256_set1_pd(v[2]), s0);
+      q = _mm256_fmadd_pd(c0, c0, _mm256_fmadd_pd(c1, c1, _mm256_fmadd_pd(c2, c2, q)));
+      x2 += v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+    }
+    alignas(32) double sum[4], a2[4];
+    _mm256_store_pd(sum, _mm256_add_pd(s0, s1));
+    _mm256_store_pd(a2, q);
+    y[i] = Vec3(sum[0], sum[1], sum[2]);
+    double a2_sum = a2[0] + a2[1] + a2[2];
+    if (end < p.row_start[i + 1]) {
+      y[i] += A[end] * x[p.col[end]];
+      a2_sum += A[end].squaredNorm();
+      x2 += x[p.col[end]].squaredNorm();
+    }
+    bound[size_t(i)] = a2_sum * x2;
+  }
+}
+
 bool avx2_supported() {
   static const bool supported = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
   return supported;
@@ -96,6 +143,14 @@ void block_multiply(const BlockPattern& p, const BlockValues& A, const Vec3List&
   if (avx2_supported()) return block_multiply_avx2(p, A, x, y);
 #endif
   block_multiply_sse2(p, A, x, y);
+}
+
+void block_multiply_bound(const BlockPattern& p, const BlockValues& A, const Vec3List& x, Vec3List& y,
+                          std::vector<double>& bound) {
+#ifdef MICA_BLOCK_AVX2
+  if (avx2_supported()) return block_multiply_bound_avx2(p, A, x, y, bound);
+#endif
+  block_multiply_bound_sse2(p, A, x, y, bound);
 }
 
 }  // namespace mica

@@ -29,5 +29,9 @@ std::vector<std::array<int32_t, 16>> element_block_slots(const BlockPattern& p, 
 
 // y = A x
 void block_multiply(const BlockPattern& p, const BlockValues& A, const Vec3List& x, Vec3List& y);
+// y = A x and, per row, bound_i = (sum_j |A_ij|_F^2)(sum_j |x_j|^2), which bounds (sum_j |A_ij| |x_j|)^2
+// by Cauchy-Schwarz: what the round-off in y_i is relative to (momentum_residual). One pass.
+void block_multiply_bound(const BlockPattern& p, const BlockValues& A, const Vec3List& x, Vec3List& y,
+                          std::vector<double>& bound);
 
 }  // namespace mica

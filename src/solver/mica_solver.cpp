@@ -65,30 +65,24 @@ void MicaSolver::update_tangents(const ContactRows& rows, size_t r, std::vector<
 }
 
 double momentum_residual(const std::vector<SolverBody>& bodies) {
+  thread_local Vec3List av;  // kept: grown to the largest body, then no allocation
+  thread_local std::vector<double> bound;
   double worst = 0;
   for (const SolverBody& body : bodies) {  // per body: a small body's imbalance may not hide in a large one's
     const BlockPattern& p = body.pattern();
-    const BlockValues& A = *body.A;
-    const Vec3List& v = *body.v;
+    if (av.size() < size_t(p.rows)) av.resize(size_t(p.rows)), bound.resize(size_t(p.rows));
+    // A v, and what its round-off is relative to: sum_j |A_ij| |v_j|, bounded (block_multiply_bound).
+    block_multiply_bound(p, *body.A, *body.v, av, bound);
     const bool projected = body.projection->active();
     double r2 = 0, scale2 = 0, terms2 = 0;
     for (int32_t i = 0; i < p.rows; ++i) {
-      Vec3 av = Vec3::Zero();
-      // What round-off in A v is relative to, sum_j |A_ij| |v_j|, bounded by Cauchy-Schwarz:
-      // its square is at most (sum_j |A_ij|^2)(sum_j |v_j|^2), with no square root per block.
-      double a2 = 0, v2 = 0;
-      for (int32_t k = p.row_start[i]; k < p.row_start[i + 1]; ++k) {
-        av += A[k] * v[p.col[k]];
-        a2 += A[k].squaredNorm();
-        v2 += v[p.col[k]].squaredNorm();
-      }
       const Vec3& b = (*body.b)[i];
       const Vec3& g = (*body.contact_impulse)[i];
-      const Vec3 r = b + g - av;
+      const Vec3 r = b + g - av[i];
       r2 += (projected && body.projection->is_constrained[i] ? body.projection->S[i] * r : r).squaredNorm();
       const double floor = 1e-6 * body.fem->node_mass[i];
-      scale2 += std::max({b.squaredNorm(), g.squaredNorm(), av.squaredNorm(), floor * floor});
-      terms2 += a2 * v2;
+      scale2 += std::max({b.squaredNorm(), g.squaredNorm(), av[i].squaredNorm(), floor * floor});
+      terms2 += bound[size_t(i)];
     }
     // A v is a sum of large terms that cancel where the body is driven through its constraints:
     // its rounding (a few hundred ulps of those terms) is no error of the solve.
