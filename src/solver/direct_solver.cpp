@@ -48,13 +48,23 @@ void DirectSolver::solve_raw_cholmod(const Eigen::Ref<const Eigen::MatrixXd>& B,
   X = Eigen::Map<const Eigen::MatrixXd>(static_cast<const double*>(x_->x), B.rows(), B.cols());
 }
 
-void DirectSolver::analyze(const BlockPattern& pattern) {
+namespace {
+// Node i is held still: no velocity component of it is free.
+bool held_still(const Projection& p, size_t i) { return p.is_constrained[i] && p.S[i].isZero(0); }
+}  // namespace
+
+void DirectSolver::analyze(const BlockPattern& pattern, const Projection* projection) {
+  by_hand_.unbind();  // it points into the factor a new analysis replaces
   const int32_t n = 3 * pattern.rows;
+  held_.assign(size_t(pattern.rows), 0);
+  if (projection && projection->active())
+    for (int32_t i : projection->nodes) held_[size_t(i)] = held_still(*projection, size_t(i));
   std::vector<Eigen::Triplet<double>> entries;
   entries.reserve(9 * pattern.block_count() / 2 + 3 * size_t(pattern.rows));
   for (int32_t i = 0; i < pattern.rows; ++i)
     for (int32_t k = pattern.row_start[i]; k < pattern.row_start[i + 1]; ++k) {
       const int32_t j = pattern.col[k];
+      if (j != i && (held_[size_t(i)] || held_[size_t(j)])) continue;
       for (int r = 0; r < 3; ++r)
         for (int c = 0; c < 3; ++c)
           if (3 * i + r >= 3 * j + c) entries.emplace_back(3 * i + r, 3 * j + c, 1.0);
@@ -96,6 +106,10 @@ int DirectSolver::ordering() const { return analyzed_ && llt_.factor() ? llt_.fa
 
 void DirectSolver::factorize(const ProjectedSystem& sys) {
   const BlockPattern& p = sys.pattern;
+  bool same_held = analyzed_ && held_.size() == size_t(p.rows);
+  for (size_t i = 0; same_held && i < held_.size(); ++i)
+    same_held = held_[i] == (sys.projection.active() && held_still(sys.projection, i));
+  if (!same_held) analyze(p, &sys.projection);
   for (int32_t i = 0; i < p.rows; ++i)
     for (int32_t k = p.row_start[i]; k < p.row_start[i + 1]; ++k) projected_[k] = sys.block(i, k);
   const double* source = projected_[0].data();

@@ -18,8 +18,11 @@ class DirectSolver : public LinearSolver {
   ~DirectSolver() override;
   DirectSolver(const DirectSolver&) = delete;  // owns CHOLMOD workspaces
   DirectSolver& operator=(const DirectSolver&) = delete;
-  // Builds the scalar lower-triangular pattern from the block pattern and analyses it.
-  void analyze(const BlockPattern& pattern);
+  // Builds the scalar lower-triangular pattern from the block pattern and analyses it. The nodes
+  // `projection` holds still (S_i = 0: their rows of S A S + I - S are the identity's) keep only
+  // their diagonal blocks, so the factor neither stores nor solves through their couplings, which
+  // are zero. factorize() analyses again when its system holds other nodes still.
+  void analyze(const BlockPattern& pattern, const Projection* projection = nullptr);
   bool analyzed() const { return analyzed_; }
   // Numeric factorization of S A S + I - S. Throws Error(Numerical) if not positive definite.
   void factorize(const ProjectedSystem& sys);
@@ -59,6 +62,7 @@ class DirectSolver : public LinearSolver {
  private:
   Eigen::SparseMatrix<double> lower_;          // scalar matrix, lower triangle, fixed pattern
   std::vector<int32_t> value_source_;          // per stored value: 9 * block + position in block
+  std::vector<uint8_t> held_;                  // per node: held still in the analysed pattern
   BlockValues projected_;                      // S A S + I - S per block
   // Supernodal LL^T: dense BLAS on the supernodes, about twice as fast as the simplicial LDL^T
   // with OpenBLAS on bodies of a few thousand nodes (docs/architecture.md).

@@ -17,7 +17,7 @@ LinearSolver& ExactContactSolver::linear_solver(const SolveContext& ctx, const S
     return cache.pcg;
   }
   // CHOLMOD: analysed once; factored when A or the constraint set changed.
-  if (!cache.direct.analyzed()) cache.direct.analyze(body.pattern());
+  if (!cache.direct.analyzed()) cache.direct.analyze(body.pattern(), body.projection);
   if (!cache.factored || cache.matrix_version != body.matrix_version ||
       cache.constraint_version != body.constraint_version) {
     cache.factored = false;

@@ -29,7 +29,7 @@ void LaggedFactor::require_halves(const Slot& slot) {
 
 void LaggedFactor::factor(Slot& slot, const BlockPattern& pattern, const BlockValues& A, const Projection& projection,
                           const std::vector<Mat3>* node_rotation, const std::vector<TriangleStiffness>* extra) {
-  if (!slot.direct.analyzed()) slot.direct.analyze(pattern);
+  if (!slot.direct.analyzed()) slot.direct.analyze(pattern, &projection);
   copy_system(slot, pattern, A, extra);  // what it is made from, kept for a saved state
   slot.direct.factorize(ProjectedSystem{pattern, slot.A, projection});
   require_halves(slot);
@@ -155,7 +155,7 @@ void LaggedFactor::update(const FemModel& fem, const Key& key, const BlockValues
     // The copies the worker factors: *pending_ is free, or holds the factor replaced just now
     // (in a step that may be undone, that one moves aside: writable).
     Slot& slot = writable(pending_);
-    if (!slot.direct.analyzed()) slot.direct.analyze(fem.pattern);
+    if (!slot.direct.analyzed()) slot.direct.analyze(fem.pattern, &projection);
     copy_system(slot, fem.pattern, A, extra);
     slot.projection = projection;
     if (open_) {
@@ -267,7 +267,7 @@ void LaggedFactor::load_slot(Slot& slot, ByteReader& in, const BlockPattern& pat
               (slot.rotation.empty() || slot.rotation.size() == n);
   for (int32_t node : slot.projection.nodes) fits = fits && node >= 0 && size_t(node) < n;
   if (!fits) fail(Errc::Parse, "a saved factor does not fit its body's matrix pattern: corrupt state");
-  slot.direct.analyze(pattern);
+  slot.direct.analyze(pattern, &slot.projection);
   slot.direct.factorize(ProjectedSystem{pattern, slot.A, slot.projection});
   require_halves(slot);
 }

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // The linear solvers of one body's projected system (S A S + I - S) y = S (b - A z), v = y + z:
-// CHOLMOD (DirectSolver) against a dense Cholesky of the same matrix, and projected PCG
+// CHOLMOD (DirectSolver) against a dense Cholesky of the same matrix (also as the nodes held still
+// change, which the factor leaves out), and projected PCG
 // (PcgSolver) against CHOLMOD, for solve and solve_homogeneous; PCG stops at its deadline.
 #include "solver/direct_solver.hpp"  // before cmocka (test_util.hpp)
 #include "solver/pcg.hpp"
@@ -48,6 +49,43 @@ static void test_direct_matches_dense(void**) {
   assert_int_equal(direct.factorizations(), 1);
 }
 
+// One DirectSolver factoring systems that hold different nodes still, in turn: each solve against
+// the dense Cholesky, and the held nodes' couplings left out of the factor (fewer nonzeros in L
+// than with the same nodes sliding, whose couplings stay).
+static void test_direct_follows_the_held_nodes(void**) {
+  SolverProblem p(0, 3, false);
+  const Projection bottom_held = p.projection;
+  const int32_t n = p.fem.node_count();
+  struct Case {
+    const char* name;
+    int held;  // 0: none, 1: the bottom nodes, 2: the bottom nodes slide on y = 0
+  } cases[] = {{"bottom held", 1}, {"none held", 0}, {"bottom sliding", 2}, {"bottom held again", 1}};
+  DirectSolver direct;
+  direct.analyze(p.fem.pattern);
+  double nonzeros[3] = {0, 0, 0};
+  for (const Case& c : cases) {
+    p.projection.reset(n);
+    for (int32_t i : bottom_held.nodes) {
+      if (c.held == 1) p.projection.constrain(i, Mat3::Identity(), Vec3(0, 0.01, 0));
+      if (c.held == 2) p.projection.constrain(i, line_projector(Vec3::UnitY()), Vec3::Zero());
+    }
+    const ProjectedSystem sys{p.fem.pattern, p.A, p.projection};
+    direct.factorize(sys);
+    Vec3List v(p.v.size(), Vec3::Zero()), rhs(p.v.size()), tmp(p.v.size());
+    direct.solve(sys, p.b, v);
+    sys.right_hand_side(p.b, rhs, tmp);
+    Vec3List expected(v.size());
+    flat(expected) = dense_projected(p).llt().solve(flat(rhs));
+    for (int32_t i : p.projection.nodes) expected[i] += p.projection.z[i];
+    const double d = relative_difference(v, expected);
+    nonzeros[c.held] = direct.factor_nonzeros();
+    print_message("%-18s: %.0f nonzeros in L, against dense Cholesky %.3g\n", c.name, direct.factor_nonzeros(), d);
+    assert_le(d, 1e-12);
+  }
+  assert_true(nonzeros[1] < nonzeros[2]);
+  assert_true(nonzeros[2] == nonzeros[0]);  // a sliding node keeps its couplings
+}
+
 static void test_pcg_matches_direct(void**) {
   SolverProblem p(0, 3, false);
   const ProjectedSystem sys{p.fem.pattern, p.A, p.projection};
@@ -83,6 +121,7 @@ static void test_pcg_stops_at_its_deadline(void**) {
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_direct_matches_dense),
+      cmocka_unit_test(test_direct_follows_the_held_nodes),
       cmocka_unit_test(test_pcg_matches_direct),
       cmocka_unit_test(test_pcg_stops_at_its_deadline),
   };
