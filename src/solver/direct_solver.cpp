@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "solver/direct_solver.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/assert.hpp"
@@ -53,18 +54,14 @@ namespace {
 bool held_still(const Projection& p, size_t i) { return p.is_constrained[i] && p.S[i].isZero(0); }
 }  // namespace
 
-void DirectSolver::analyze(const BlockPattern& pattern, const Projection* projection) {
-  by_hand_.unbind();  // it points into the factor a new analysis replaces
+void DirectSolver::build_lower(const BlockPattern& pattern, bool leave_out_held) {
   const int32_t n = 3 * pattern.rows;
-  held_.assign(size_t(pattern.rows), 0);
-  if (projection && projection->active())
-    for (int32_t i : projection->nodes) held_[size_t(i)] = held_still(*projection, size_t(i));
   std::vector<Eigen::Triplet<double>> entries;
   entries.reserve(9 * pattern.block_count() / 2 + 3 * size_t(pattern.rows));
   for (int32_t i = 0; i < pattern.rows; ++i)
     for (int32_t k = pattern.row_start[i]; k < pattern.row_start[i + 1]; ++k) {
       const int32_t j = pattern.col[k];
-      if (j != i && (held_[size_t(i)] || held_[size_t(j)])) continue;
+      if (leave_out_held && j != i && (held_[size_t(i)] || held_[size_t(j)])) continue;
       for (int r = 0; r < 3; ++r)
         for (int c = 0; c < 3; ++c)
           if (3 * i + r >= 3 * j + c) entries.emplace_back(3 * i + r, 3 * j + c, 1.0);
@@ -80,18 +77,58 @@ void DirectSolver::analyze(const BlockPattern& pattern, const Projection* projec
       const int32_t k = pattern.find(row / 3, col / 3);
       value_source_[size_t(&it.valueRef() - lower_.valuePtr())] = 9 * k + 3 * (col % 3) + row % 3;
     }
+}
+
+void DirectSolver::Factor::analyze_given(const Eigen::SparseMatrix<double>& lower, std::vector<int>& perm) {
+  cholmod_common& common = cholmod();
+  if (m_cholmodFactor) cholmod_free_factor(&m_cholmodFactor, &common);
+  cholmod_sparse A = Eigen::viewAsCholmod(lower.selfadjointView<Eigen::Lower>());
+  const int nmethods = common.nmethods, ordering = common.method[0].ordering;
+  common.nmethods = 1;
+  common.method[0].ordering = CHOLMOD_GIVEN;
+  m_cholmodFactor = cholmod_analyze_p(&A, perm.data(), nullptr, 0, &common);
+  common.nmethods = nmethods;
+  common.method[0].ordering = ordering;
+  if (!m_cholmodFactor) fail(Errc::Internal, "CHOLMOD could not analyse the system with its own ordering");
+  this->m_isInitialized = true;
+  this->m_info = Eigen::Success;
+  m_analysisIsOk = true;
+  m_factorizationIsOk = false;
+}
+
+void DirectSolver::analyze(const BlockPattern& pattern, const Projection* projection) {
+  by_hand_.unbind();  // it points into the factor a new analysis replaces
+  held_.assign(size_t(pattern.rows), 0);
+  if (projection && projection->active())
+    for (int32_t i : projection->nodes) held_[size_t(i)] = held_still(*projection, size_t(i));
   projected_.resize(pattern.block_count());
-  // The fill-reducing ordering: AMD or nested dissection (CHOLMOD's NESDIS over METIS), whichever
-  // fills less. CHOLMOD's default tries METIS only after AMD filled a lot, and kept AMD on the
-  // nidus, where NESDIS has 10.5 % fewer nonzeros in L and 27 % fewer flops (bench_factor); on
-  // a 35k-tet cube the memory after the first step fell 5073 -> 4775 B per tet (bench_nidus
-  // --scaling). Both are deterministic, so a restored state factors the same bits.
   cholmod_common& common = llt_.cholmod();
-  common.nmethods = 2;
-  common.method[0].ordering = CHOLMOD_AMD;
-  common.method[1].ordering = CHOLMOD_NESDIS;
   common.postorder = 1;
-  llt_.analyzePattern(lower_);
+  // The fill-reducing ordering, once per pattern and of the whole pattern (no node held): AMD or
+  // nested dissection (CHOLMOD's NESDIS over METIS), whichever fills less. CHOLMOD's default tries
+  // METIS only after AMD filled a lot, and kept AMD on the nidus, where NESDIS has 10.5 % fewer
+  // nonzeros in L and 27 % fewer flops (bench_factor); on a 35k-tet cube the memory after the
+  // first step fell 5073 -> 4775 B per tet (bench_nidus --scaling). NESDIS takes ~20 ms on the
+  // nidus, so a new held set (a grasp) is analysed with this ordering given (~1 ms). All of it
+  // is deterministic, so a restored state factors the same bits.
+  const bool any_held = std::find(held_.begin(), held_.end(), 1) != held_.end();
+  bool whole_analysed = false;
+  if (ordering_.size() != size_t(3 * pattern.rows)) {
+    whole_analysed = true;
+    build_lower(pattern, false);
+    common.nmethods = 2;
+    common.method[0].ordering = CHOLMOD_AMD;
+    common.method[1].ordering = CHOLMOD_NESDIS;
+    llt_.analyzePattern(lower_);
+    const cholmod_factor* L = llt_.factor();
+    if (!L) fail(Errc::Internal, "CHOLMOD could not analyse the system");
+    ordering_.assign(static_cast<const int*>(L->Perm), static_cast<const int*>(L->Perm) + L->n);
+    ordering_method_ = L->ordering;
+  }
+  if (any_held || !whole_analysed) {
+    build_lower(pattern, true);
+    llt_.analyze_given(lower_, ordering_);
+  }
   nonzeros_ = common.lnz;
   flops_ = common.fl;
   analyzed_ = true;
@@ -102,7 +139,7 @@ int64_t DirectSolver::factor_entries() const {
   return L ? int64_t(L->is_super ? L->xsize : L->nzmax) : 0;
 }
 
-int DirectSolver::ordering() const { return analyzed_ && llt_.factor() ? llt_.factor()->ordering : 0; }
+int DirectSolver::ordering() const { return analyzed_ ? ordering_method_ : 0; }
 
 void DirectSolver::factorize(const ProjectedSystem& sys) {
   const BlockPattern& p = sys.pattern;

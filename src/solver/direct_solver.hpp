@@ -60,15 +60,21 @@ class DirectSolver : public LinearSolver {
   const SupernodalSolve* by_hand() const { return by_hand_.bound() ? &by_hand_ : nullptr; }
 
  private:
+  // lower_ over the block pattern, without the couplings of held_ nodes when `leave_out_held`.
+  void build_lower(const BlockPattern& pattern, bool leave_out_held);
   Eigen::SparseMatrix<double> lower_;          // scalar matrix, lower triangle, fixed pattern
   std::vector<int32_t> value_source_;          // per stored value: 9 * block + position in block
   std::vector<uint8_t> held_;                  // per node: held still in the analysed pattern
+  std::vector<int> ordering_;                  // the whole pattern's fill-reducing permutation
+  int ordering_method_ = 0;                    // CHOLMOD_AMD or CHOLMOD_NESDIS: how it was found
   BlockValues projected_;                      // S A S + I - S per block
   // Supernodal LL^T: dense BLAS on the supernodes, about twice as fast as the simplicial LDL^T
   // with OpenBLAS on bodies of a few thousand nodes (docs/architecture.md).
   // Eigen's wrapper, opened to cholmod_solve2 (its factor is a protected member).
   struct Factor : Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> {
     cholmod_factor* factor() const { return m_cholmodFactor; }
+    // analyzePattern with this fill-reducing permutation (CHOLMOD_GIVEN; postordered after).
+    void analyze_given(const Eigen::SparseMatrix<double>& lower, std::vector<int>& perm);
   };
   Factor llt_;
   SupernodalSolve by_hand_;  // bound to llt_'s factor after each factorization
