@@ -119,15 +119,24 @@ void assemble_elastic(const FemModel& m, const Vec3List& x, const std::vector<Ma
   });
   const Mat3 I = Mat3::Identity();
   Mat3* blocks = K ? K->data() : nullptr;
-  // Elements first to last, in pairs (add_elements: two in about the time of one).
+  // Elements first to last, four at a time (add_elements4), then a pair (add_elements), then one.
   auto elements = [&](int32_t first, int32_t last) {
     int32_t e = first;
-    for (; e + 1 < last; e += 2) {
+    for (; e + 3 < last; e += 4) {
+      const TetElement* el[4] = {&m.elements[e], &m.elements[e + 1], &m.elements[e + 2], &m.elements[e + 3]};
+      const Lame* lame[4] = {&m.lame[e], &m.lame[e + 1], &m.lame[e + 2], &m.lame[e + 3]};
+      const Mat3* rot[4];
+      for (int l = 0; l < 4; ++l) rot[l] = R ? &(*R)[e + l] : &I;
+      const std::array<int32_t, 16>* slots[4] = {&m.slots[e], &m.slots[e + 1], &m.slots[e + 2], &m.slots[e + 3]};
+      add_elements4(el, lame, rot, x, k_scale, slots, blocks, f_int);
+    }
+    if (e + 1 < last) {
       const TetElement* el[2] = {&m.elements[e], &m.elements[e + 1]};
       const Lame* lame[2] = {&m.lame[e], &m.lame[e + 1]};
       const Mat3* rot[2] = {R ? &(*R)[e] : &I, R ? &(*R)[e + 1] : &I};
       const std::array<int32_t, 16>* slots[2] = {&m.slots[e], &m.slots[e + 1]};
       add_elements(el, lame, rot, x, k_scale, slots, blocks, f_int);
+      e += 2;
     }
     if (e < last) add_element(m.elements[e], m.lame[e], R ? (*R)[e] : I, x, k_scale, m.slots[e], blocks, f_int);
   };

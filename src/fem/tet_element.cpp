@@ -5,6 +5,10 @@
 
 #include <Eigen/LU>
 
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#include <immintrin.h>
+#endif
+
 namespace mica {
 
 TetElement make_tet_element(const Vec3List& rest, const Tet& nodes) {
@@ -159,6 +163,200 @@ void add_elements(const TetElement* const e[2], const Lame* const m[2], const Ma
       Mat3* const ba[2] = {&K[(*slots[0])[4 * b + a]], &K[(*slots[1])[4 * b + a]]};
       add(ba, k, true);
     }
+}
+
+namespace {
+
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#define MICA_ELEMENTS_AVX2 1
+#define MICA_AVX2 __attribute__((target("avx2,fma")))
+
+bool avx2_supported() {
+  static const bool supported = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+  return supported;
+}
+
+// The 4x4 transpose of rows v[0..3]: afterwards v[i] holds the old rows' entries i.
+MICA_AVX2 inline void transpose4(__m256d v[4]) {
+  const __m256d t0 = _mm256_unpacklo_pd(v[0], v[1]), t1 = _mm256_unpackhi_pd(v[0], v[1]);
+  const __m256d t2 = _mm256_unpacklo_pd(v[2], v[3]), t3 = _mm256_unpackhi_pd(v[2], v[3]);
+  v[0] = _mm256_permute2f128_pd(t0, t2, 0x20);
+  v[1] = _mm256_permute2f128_pd(t1, t3, 0x20);
+  v[2] = _mm256_permute2f128_pd(t0, t2, 0x31);
+  v[3] = _mm256_permute2f128_pd(t1, t3, 0x31);
+}
+
+// out[i] = (p[0][i], p[1][i], p[2][i], p[3][i]) for i < 4.
+MICA_AVX2 inline void load_lanes4(const double* const p[4], __m256d out[4]) {
+  for (int l = 0; l < 4; ++l) out[l] = _mm256_loadu_pd(p[l]);
+  transpose4(out);
+}
+
+// Four 3x3 matrices as lanes: out[3j + i] holds their entries (i, j) (Mat3 is column-major).
+MICA_AVX2 inline void load_matrices(const Mat3* const M[4], __m256d out[9]) {
+  const double* p[4] = {M[0]->data(), M[1]->data(), M[2]->data(), M[3]->data()};
+  load_lanes4(p, out);
+  for (int l = 0; l < 4; ++l) p[l] += 4;
+  load_lanes4(p, out + 4);
+  out[8] = _mm256_setr_pd((*M[0])(8), (*M[1])(8), (*M[2])(8), (*M[3])(8));
+}
+
+// Four 3-vectors, (x, y) in xy[l] and z in z[l], as lanes: out[i] holds their entries i.
+MICA_AVX2 inline void vectors_to_lanes(const __m128d xy[4], const double z[4], __m256d out[3]) {
+  const __m256d v02 = _mm256_insertf128_pd(_mm256_castpd128_pd256(xy[0]), xy[2], 1);
+  const __m256d v13 = _mm256_insertf128_pd(_mm256_castpd128_pd256(xy[1]), xy[3], 1);
+  out[0] = _mm256_unpacklo_pd(v02, v13);
+  out[1] = _mm256_unpackhi_pd(v02, v13);
+  out[2] = _mm256_setr_pd(z[0], z[1], z[2], z[3]);
+}
+
+// *v[l] += lane l of the 3-vector in lanes s, one after the other (two may be the same vector).
+MICA_AVX2 inline void add_vectors(Vec3* const v[4], const __m256d s[3]) {
+  const __m256d lo = _mm256_unpacklo_pd(s[0], s[1]), hi = _mm256_unpackhi_pd(s[0], s[1]);
+  const __m128d xy[4] = {_mm256_castpd256_pd128(lo), _mm256_castpd256_pd128(hi), _mm256_extractf128_pd(lo, 1),
+                         _mm256_extractf128_pd(hi, 1)};
+  alignas(32) double z[4];
+  _mm256_store_pd(z, s[2]);
+  for (int l = 0; l < 4; ++l) {
+    double* out = v[l]->data();
+    _mm_storeu_pd(out, _mm_add_pd(_mm_loadu_pd(out), xy[l]));
+    out[2] += z[l];
+  }
+}
+
+// *block[l] += lane l of the column-major entries k[0..8], one block after the other (two may be the
+// same block: no lane's sum is read before the previous lane's is stored).
+MICA_AVX2 inline void add_blocks(Mat3* const block[4], const __m256d (&k)[9]) {
+  __m256d lo[4] = {k[0], k[1], k[2], k[3]}, hi[4] = {k[4], k[5], k[6], k[7]};
+  transpose4(lo);  // lo[l]: element l's entries 0-3
+  transpose4(hi);
+  alignas(32) double last[4];
+  _mm256_store_pd(last, k[8]);
+  for (int l = 0; l < 4; ++l) {
+    double* out = block[l]->data();
+    _mm256_storeu_pd(out, _mm256_add_pd(_mm256_loadu_pd(out), lo[l]));
+    _mm256_storeu_pd(out + 4, _mm256_add_pd(_mm256_loadu_pd(out + 4), hi[l]));
+    out[8] += last[l];
+  }
+}
+
+// Entry (i, j) of A B, and of A^T B, for 3x3 matrices in lanes (column-major).
+MICA_AVX2 inline __m256d product(const __m256d* A, const __m256d* B, int i, int j) {
+  const __m256d s = _mm256_fmadd_pd(A[3 + i], B[3 * j + 1], _mm256_mul_pd(A[i], B[3 * j]));
+  return _mm256_fmadd_pd(A[6 + i], B[3 * j + 2], s);
+}
+MICA_AVX2 inline __m256d transposed_product(const __m256d* A, const __m256d* B, int i, int j) {
+  const __m256d s = _mm256_fmadd_pd(A[3 * i + 1], B[3 * j + 1], _mm256_mul_pd(A[3 * i], B[3 * j]));
+  return _mm256_fmadd_pd(A[3 * i + 2], B[3 * j + 2], s);
+}
+// A v for a 3x3 matrix and a 3-vector in lanes.
+MICA_AVX2 inline void apply(const __m256d* A, const __m256d* v, __m256d* out) {
+  for (int i = 0; i < 3; ++i)
+    out[i] = _mm256_fmadd_pd(A[6 + i], v[2], _mm256_fmadd_pd(A[3 + i], v[1], _mm256_mul_pd(A[i], v[0])));
+}
+
+// add_elements' steps four lanes wide; written by hand for the reason half_products.hpp gives (the
+// library is built for any x86-64). Matrices are lane vectors in column-major order: M[3j + i] is
+// entry (i, j).
+MICA_AVX2 void add_elements4_avx2(const TetElement* const e[4], const Lame* const m[4], const Mat3* const R[4],
+                                   const Vec3List& x, double scale, const std::array<int32_t, 16>* const slots[4],
+                                   Mat3* K, Vec3List& f) {
+  __m256d Rl[9], dm[9], g[4][3];
+  load_matrices(R, Rl);
+  {
+    __m256d rows[12];  // grad's 12 entries (std::array<Vec3, 4>, contiguous) in three rows of 4
+    for (int q = 0; q < 3; ++q) {
+      const double* p[4];
+      for (int l = 0; l < 4; ++l) p[l] = e[l]->grad[0].data() + 4 * q;
+      load_lanes4(p, rows + 4 * q);
+    }
+    for (int a = 0; a < 4; ++a)
+      for (int i = 0; i < 3; ++i) g[a][i] = rows[3 * a + i];
+  }
+  for (int k = 0; k < 3; ++k)  // Dm^-1's rows are g_1, g_2, g_3 (make_tet_element): no loads of their own
+    for (int j = 0; j < 3; ++j) dm[3 * j + k] = g[k + 1][j];
+  __m256d ds[9];  // Ds = [x1 - x0, x2 - x0, x3 - x0]
+  for (int k = 0; k < 3; ++k) {
+    __m128d xy[4];  // element l's column k
+    double z[4];
+    for (int l = 0; l < 4; ++l) {
+      const double *xk = x[e[l]->nodes[k + 1]].data(), *x0 = x[e[l]->nodes[0]].data();
+      xy[l] = _mm_sub_pd(_mm_loadu_pd(xk), _mm_loadu_pd(x0));
+      z[l] = xk[2] - x0[2];
+    }
+    vectors_to_lanes(xy, z, ds + 3 * k);
+  }
+  const __m256d volume = _mm256_setr_pd(e[0]->volume, e[1]->volume, e[2]->volume, e[3]->volume);
+  const __m256d lambda = _mm256_setr_pd(m[0]->lambda, m[1]->lambda, m[2]->lambda, m[3]->lambda);
+  const __m256d mu = _mm256_setr_pd(m[0]->mu, m[1]->mu, m[2]->mu, m[3]->mu);
+  const __m256d one = _mm256_set1_pd(1.0), half = _mm256_set1_pd(0.5), two = _mm256_set1_pd(2.0);
+
+  // Forces: F = Ds Dm^-1, G = R^T F, eps = sym(G) - I, sigma = 2 mu eps + lambda tr(eps) I,
+  // P = -V R sigma, f_a = P g_a.
+  __m256d F[9], G[9], sigma[9], P[9];
+  for (int j = 0; j < 3; ++j)
+    for (int i = 0; i < 3; ++i) F[3 * j + i] = product(ds, dm, i, j);
+  for (int j = 0; j < 3; ++j)
+    for (int i = 0; i < 3; ++i) G[3 * j + i] = transposed_product(Rl, F, i, j);
+  const __m256d tr = _mm256_add_pd(_mm256_add_pd(_mm256_sub_pd(G[0], one), _mm256_sub_pd(G[4], one)),
+                                   _mm256_sub_pd(G[8], one));
+  const __m256d minus_volume = _mm256_sub_pd(_mm256_setzero_pd(), volume);
+  // -V sigma, so that P = R (-V sigma) takes no multiplication of its own.
+  const __m256d two_mu = _mm256_mul_pd(_mm256_mul_pd(two, mu), minus_volume);
+  const __m256d lambda_tr = _mm256_mul_pd(_mm256_mul_pd(lambda, tr), minus_volume);
+  for (int j = 0; j < 3; ++j)
+    for (int i = 0; i < 3; ++i) {
+      const __m256d eps = i == j ? _mm256_sub_pd(G[4 * i], one)
+                                 : _mm256_mul_pd(half, _mm256_add_pd(G[3 * j + i], G[3 * i + j]));
+      sigma[3 * j + i] = i == j ? _mm256_fmadd_pd(two_mu, eps, lambda_tr) : _mm256_mul_pd(two_mu, eps);
+    }
+  for (int j = 0; j < 3; ++j)
+    for (int i = 0; i < 3; ++i) P[3 * j + i] = product(Rl, sigma, i, j);
+  for (int a = 0; a < 4; ++a) {
+    __m256d fa[3];
+    apply(P, g[a], fa);
+    Vec3* node[4] = {&f[e[0]->nodes[a]], &f[e[1]->nodes[a]], &f[e[2]->nodes[a]], &f[e[3]->nodes[a]]};
+    add_vectors(node, fa);
+  }
+  if (!K) return;
+
+  // Stiffness: block (a, b) = u h_b^T + w h_a^T + d I with h = R g, u = V lambda h_a, w = V mu h_b,
+  // d = V mu g_a . g_b; block (b, a) is its transpose.
+  const __m256d s = _mm256_set1_pd(scale);
+  const __m256d vl = _mm256_mul_pd(_mm256_mul_pd(s, volume), lambda), vm = _mm256_mul_pd(_mm256_mul_pd(s, volume), mu);
+  __m256d h[4][3];
+  for (int a = 0; a < 4; ++a) apply(Rl, g[a], h[a]);
+  for (int a = 0; a < 4; ++a)
+    for (int b = a; b < 4; ++b) {
+      const __m256d gg = _mm256_fmadd_pd(g[a][2], g[b][2],
+                                         _mm256_fmadd_pd(g[a][1], g[b][1], _mm256_mul_pd(g[a][0], g[b][0])));
+      const __m256d d = _mm256_mul_pd(vm, gg);
+      __m256d k[3][3];
+      for (int r = 0; r < 3; ++r) {
+        const __m256d u = _mm256_mul_pd(vl, h[a][r]), w = _mm256_mul_pd(vm, h[b][r]);
+        for (int c = 0; c < 3; ++c) k[r][c] = _mm256_fmadd_pd(u, h[b][c], _mm256_mul_pd(w, h[a][c]));
+        k[r][r] = _mm256_add_pd(k[r][r], d);
+      }
+      Mat3* ab[4];
+      for (int l = 0; l < 4; ++l) ab[l] = &K[(*slots[l])[4 * a + b]];
+      add_blocks(ab, {k[0][0], k[1][0], k[2][0], k[0][1], k[1][1], k[2][1], k[0][2], k[1][2], k[2][2]});
+      if (b == a) continue;
+      Mat3* ba[4];
+      for (int l = 0; l < 4; ++l) ba[l] = &K[(*slots[l])[4 * b + a]];
+      add_blocks(ba, {k[0][0], k[0][1], k[0][2], k[1][0], k[1][1], k[1][2], k[2][0], k[2][1], k[2][2]});
+    }
+}
+#endif
+
+}  // namespace
+
+void add_elements4(const TetElement* const e[4], const Lame* const m[4], const Mat3* const R[4], const Vec3List& x,
+                   double scale, const std::array<int32_t, 16>* const slots[4], Mat3* K, Vec3List& f) {
+#ifdef MICA_ELEMENTS_AVX2
+  if (avx2_supported()) return add_elements4_avx2(e, m, R, x, scale, slots, K, f);
+#endif
+  add_elements(e, m, R, x, scale, slots, K, f);
+  add_elements(e + 2, m + 2, R + 2, x, scale, slots + 2, K, f);
 }
 
 double elastic_energy(const TetElement& e, const Lame& m, const Mat3& R, const Mat3& F) {

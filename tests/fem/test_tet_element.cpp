@@ -278,6 +278,69 @@ static void test_paired_elements_match_single(void**) {
   }
 }
 
+// add_elements4 (its AVX2 kernel where the CPU has AVX2 and FMA), four elements side by side,
+// against add_element on each, table-driven over the groups: neighbours (which share nodes, so
+// blocks and forces), one element twice and four times (every node and block shared), and
+// strangers; with K and forces only, into the model's real slots, each element with its own
+// rotation.
+static void test_four_elements_match_single(void**) {
+  const FemModel m = cube_model();
+  const size_t n = m.elements.size();
+  std::mt19937 rng(13);
+  std::normal_distribution<double> normal;
+  Vec3List x(m.rest.size());
+  const Mat3 Q = rotation_about(Vec3(-0.5, 1, 2), 2.3);
+  for (size_t i = 0; i < x.size(); ++i) x[i] = Q * m.rest[i] + 0.01 * Vec3(normal(rng), normal(rng), normal(rng));
+  std::vector<Mat3> R(n);
+  compute_rotations(m, x, R);
+  struct Case {
+    const char* name;
+    size_t step[4];  // the group's elements: e0 + step[l] (mod n), for e0 along the model
+  } cases[] = {
+      {"neighbours", {0, 1, 2, 3}},
+      {"one element twice", {0, 1, 0, 5}},
+      {"one element four times", {0, 0, 0, 0}},
+      {"strangers", {0, n / 4, n / 2, 3 * n / 4}},
+  };
+  for (const Case& c : cases) {
+    double worst = 0;
+    for (size_t e0 = 0; e0 < n; e0 += 5) {
+      size_t g[4];
+      for (int l = 0; l < 4; ++l) g[l] = (e0 + c.step[l]) % n;
+      for (bool with_K : {true, false}) {
+        BlockValues K(m.pattern.block_count(), Mat3::Identity()), K_ref = K;
+        Vec3List f(x.size(), Vec3::Ones()), f_ref = f;
+        const TetElement* el[4];
+        const Lame* lame[4];
+        const Mat3* rot[4];
+        const std::array<int32_t, 16>* slots[4];
+        for (int l = 0; l < 4; ++l) {
+          el[l] = &m.elements[g[l]];
+          lame[l] = &m.lame[g[l]];
+          rot[l] = &R[g[l]];
+          slots[l] = &m.slots[g[l]];
+        }
+        add_elements4(el, lame, rot, x, 1e-4, slots, with_K ? K.data() : nullptr, f);
+        for (size_t e : g)
+          add_element(m.elements[e], m.lame[e], R[e], x, 1e-4, m.slots[e], with_K ? K_ref.data() : nullptr, f_ref);
+        double k_scale = 0, f_scale = 0;
+        for (const Mat3& k : K_ref) k_scale = std::max(k_scale, (k - Mat3::Identity()).norm());
+        for (const Vec3& v : f_ref) f_scale = std::max(f_scale, (v - Vec3::Ones()).norm());
+        assert_true(f_scale > 0);
+        for (size_t q = 0; q < K.size(); ++q) {  // without K: k_scale is 0, K must be untouched
+          assert_le((K[q] - K_ref[q]).norm(), 1e-12 * k_scale);
+          if (with_K) worst = std::max(worst, (K[q] - K_ref[q]).norm() / k_scale);
+        }
+        for (size_t i = 0; i < f.size(); ++i) {
+          assert_le((f[i] - f_ref[i]).norm(), 1e-12 * f_scale);
+          worst = std::max(worst, (f[i] - f_ref[i]).norm() / f_scale);
+        }
+      }
+    }
+    std::printf("  %-22s worst relative difference from add_element %.1e\n", c.name, worst);
+  }
+}
+
 static void test_total_mass(void**) {
   for (MassKind kind : {MassKind::Consistent, MassKind::Lumped})
     for (int32_t tpc : {5, 6}) {
@@ -302,6 +365,7 @@ int main(void) {
       cmocka_unit_test(test_stiffness_matches_finite_difference),
       cmocka_unit_test(test_fused_element_matches_reference),
       cmocka_unit_test(test_paired_elements_match_single),
+      cmocka_unit_test(test_four_elements_match_single),
       cmocka_unit_test(test_total_mass),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
