@@ -83,10 +83,15 @@ FemModel build_fem_model(const TetMesh& mesh, const std::vector<Material>& mater
 
 void compute_rotations(const FemModel& m, const Vec3List& x, std::vector<Mat3>& R, ThreadPool* pool) {
   parallel_for(pool, int64_t(m.elements.size()), 64, [&](int32_t first, int32_t last) {
+    const auto F = [&](int32_t e) { return deformation_gradient(m.elements[e], x); };
     int32_t e = first;
-    for (; e + 1 < last; e += 2)  // in pairs: proper_rotations takes two in about the time of one
-      proper_rotations(deformation_gradient(m.elements[e], x), deformation_gradient(m.elements[e + 1], x), R[e], R[e + 1]);
-    if (e < last) R[e] = proper_rotation(deformation_gradient(m.elements[e], x));
+    for (; e + 4 <= last; e += 4) {  // four at a time, for proper_rotations4
+      const Mat3 F4[4] = {F(e), F(e + 1), F(e + 2), F(e + 3)};  // made in place (a copy would stall)
+      proper_rotations4(F4, &R[e]);
+    }
+    Mat3 tail[3];
+    for (int32_t j = 0; e + j < last; ++j) tail[j] = F(e + j);
+    proper_rotations(tail, R.data() + e, last - e);
   });
 }
 
@@ -96,18 +101,18 @@ void compute_node_rotations(const FemModel& m, const std::vector<Mat3>& element_
   for (size_t e = 0; e < m.elements.size(); ++e)
     for (int32_t a : m.elements[e].nodes) node_rotation[size_t(a)] += element_rotation[e];
   const size_t n = node_rotation.size();
-  for (size_t i = 0; i < n; i += 2) {
-    const size_t pair[2] = {i, std::min(i + 1, n - 1)};  // in pairs, for proper_rotations
+  for (size_t i = 0; i < n; i += 4) {  // four at a time, for proper_rotations4
+    const int count = int(std::min<size_t>(4, n - i));
     // Each sum S scaled to |S|_F^2 = 3, as a rotation's (its polar factor is the same): det S is
     // then near 1, where Newton's scaling needs no cube root.
-    Mat3 S[2];
-    for (int j = 0; j < 2; ++j) {
-      const double n2 = node_rotation[pair[j]].squaredNorm();
-      S[j] = n2 > 0 ? Mat3(node_rotation[pair[j]] * std::sqrt(3 / n2)) : node_rotation[pair[j]];
+    Mat3 S[4];
+    for (int j = 0; j < count; ++j) {
+      const double n2 = node_rotation[i + j].squaredNorm();
+      S[j] = n2 > 0 ? Mat3(node_rotation[i + j] * std::sqrt(3 / n2)) : node_rotation[i + j];
     }
-    proper_rotations(S[0], S[1], node_rotation[pair[0]], node_rotation[pair[1]]);
-    for (int j = 0; j < 2; ++j)
-      if (S[j].isZero(0)) node_rotation[pair[j]].setIdentity();  // a node in no element
+    proper_rotations(S, &node_rotation[i], count);
+    for (int j = 0; j < count; ++j)
+      if (S[j].isZero(0)) node_rotation[i + j].setIdentity();  // a node in no element
   }
 }
 

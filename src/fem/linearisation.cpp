@@ -10,19 +10,23 @@ namespace mica {
 namespace {
 
 // For each element e in order, body(e, F1) with F1 its deformation gradient at x_end, after
-// R_end[e] = proper_rotation(F1) when `rotate`. The rotations are taken in pairs (proper_rotations,
-// about twice as fast), an odd count's last element paired with itself.
+// R_end[e] = proper_rotation(F1) when `rotate`. The elements are taken four at a time, for
+// proper_rotations4 (a pair and a single at the end).
 template <class Body>
 void for_each_end_gradient(const FemModel& m, const Vec3List& x_end, bool rotate, std::vector<Mat3>& R_end,
                            Body&& body) {
   const size_t n = m.elements.size();
-  for (size_t first = 0; first < n; first += 2) {
-    const size_t second = std::min(first + 1, n - 1);
-    const Mat3 F1[2] = {deformation_gradient(m.elements[first], x_end), deformation_gradient(m.elements[second], x_end)};
-    if (rotate) proper_rotations(F1[0], F1[1], R_end[first], R_end[second]);
-    body(first, F1[0]);
-    if (second != first) body(second, F1[1]);
+  const auto F = [&](size_t e) { return deformation_gradient(m.elements[e], x_end); };
+  size_t first = 0;
+  for (; first + 4 <= n; first += 4) {
+    const Mat3 F1[4] = {F(first), F(first + 1), F(first + 2), F(first + 3)};  // made in place (a copy would stall)
+    if (rotate) proper_rotations4(F1, &R_end[first]);
+    for (size_t j = 0; j < 4; ++j) body(first + j, F1[j]);
   }
+  Mat3 tail[3];
+  for (size_t j = 0; first + j < n; ++j) tail[j] = F(first + j);
+  if (rotate) proper_rotations(tail, R_end.data() + first, int(n - first));
+  for (size_t j = 0; first + j < n; ++j) body(first + j, tail[j]);
 }
 
 }  // namespace

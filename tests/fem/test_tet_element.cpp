@@ -3,6 +3,8 @@
 // difference of the forces, and mass totals.
 #include <Eigen/SVD>
 #include <cstdio>
+#include <cstring>
+#include <functional>
 #include <random>
 
 #include "fem/fem_model.hpp"
@@ -145,6 +147,70 @@ static void test_paired_rotations_match_single(void**) {
   Mat3 R;
   proper_rotations(F[3], F[3], R, R);
   assert_true(R == proper_rotation(F[3]));
+}
+
+// proper_rotations4 (AVX2 where the CPU has it) against proper_rotation lane by lane, bit for bit
+// (memcmp: -0 is not +0), table-driven: each kind alone in all four lanes, then mixed so that lanes
+// converge at different steps or take the SVD beside Newton lanes, in place (R = F), and the tail
+// helper proper_rotations(F, R, count) for counts 1 to 4.
+static void test_four_rotations_match_single(void**) {
+  std::mt19937 rng(5);
+  std::normal_distribution<double> normal;
+  auto rotation = [&] { return rotation_about(Vec3(normal(rng), normal(rng), normal(rng)), 3 * normal(rng)); };
+  auto noise = [&] {
+    Mat3 N;
+    for (int k = 0; k < 9; ++k) N(k) = normal(rng);
+    return N;
+  };
+  struct Case {
+    const char* name;
+    std::function<Mat3()> make;
+  } cases[] = {
+      {"random", [&] { return noise(); }},  // det < 0 about half the time
+      {"rotation", [&] { return rotation(); }},
+      {"near-rotation", [&] { return Mat3(rotation() * (Mat3::Identity() + 1e-3 * noise())); }},
+      {"strain 5 %", [&] { return Mat3(rotation() * (Mat3::Identity() + 0.05 * noise())); }},
+      {"strain 30 %", [&] { return Mat3(rotation() * (Mat3::Identity() + 0.3 * noise())); }},
+      {"node sum", [&] { return Mat3(20 * rotation() * (Mat3::Identity() + 1e-3 * noise())); }},
+      {"tiny scale", [&] { return Mat3(1e-3 * rotation()); }},  // cbrt scaling
+      {"det 1.1", [&] { return Mat3(rotation() * Vec3(1.1, 1.0, 1.0).asDiagonal()); }},  // the cubic
+      {"inverted", [&] { return Mat3(rotation() * Vec3(1, 1 + 0.1 * normal(rng), -0.5).asDiagonal()); }},
+      {"rank 2", [&] { return Mat3(rotation() * Vec3(1, 0.8, 0).asDiagonal() * rotation()); }},
+      {"rank 1", [&] { return Mat3(Vec3(normal(rng), normal(rng), normal(rng)) * Vec3(normal(rng), normal(rng), normal(rng)).transpose()); }},
+      {"nearly collapsed", [&] { return Mat3(rotation() * Vec3(1, 1, 1e-4).asDiagonal()); }},
+      {"flat but Newton", [&] { return Mat3(rotation() * Vec3(1, 1, 0.02).asDiagonal()); }},  // det just above the SVD's bound
+      {"zero", [&] { return Mat3(Mat3::Zero()); }},
+  };
+  const auto same_bits = [](const Mat3& a, const Mat3& b) { return std::memcmp(a.data(), b.data(), sizeof(Mat3)) == 0; };
+  const auto check = [&](const Mat3 F[4], const char* name) {
+    Mat3 R[4];
+    proper_rotations4(F, R);
+    Mat3 in_place[4] = {F[0], F[1], F[2], F[3]};
+    proper_rotations4(in_place, in_place);
+    for (int l = 0; l < 4; ++l) {
+      const Mat3 single = proper_rotation(F[l]);
+      if (!same_bits(R[l], single) || !same_bits(in_place[l], single)) std::printf("  %s: lane %d differs\n", name, l);
+      assert_true(same_bits(R[l], single));
+      assert_true(same_bits(in_place[l], single));
+    }
+    for (int count = 0; count <= 4; ++count) {
+      Mat3 Rc[4];
+      proper_rotations(F, Rc, count);
+      for (int l = 0; l < count; ++l) assert_true(same_bits(Rc[l], proper_rotation(F[l])));
+    }
+  };
+  std::vector<Mat3> pool;
+  for (const Case& c : cases) {
+    for (int trial = 0; trial < 12; ++trial) pool.push_back(c.make());
+    for (size_t i = pool.size() - 12; i < pool.size(); i += 4) check(&pool[i], c.name);  // one kind in all lanes
+  }
+  for (size_t i = 0; i < pool.size(); ++i) {  // mixed kinds, each matrix in each lane
+    const Mat3 F[4] = {pool[i], pool[(i + 13) % pool.size()], pool[(i + 50) % pool.size()], pool[(i + 97) % pool.size()]};
+    check(F, "mixed");
+  }
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+  std::printf("  %zu matrices, AVX2 %s\n", pool.size(), __builtin_cpu_supports("avx2") ? "used" : "absent (pairs)");
+#endif
 }
 
 // elastic_energies, two frames side by side, against elastic_energy in each.
@@ -361,6 +427,7 @@ int main(void) {
       cmocka_unit_test(test_rotation_is_proper_for_inverted_elements),
       cmocka_unit_test(test_rotation_matches_the_svd_polar_factor),
       cmocka_unit_test(test_paired_rotations_match_single),
+      cmocka_unit_test(test_four_rotations_match_single),
       cmocka_unit_test(test_paired_energies_match_single),
       cmocka_unit_test(test_stiffness_matches_finite_difference),
       cmocka_unit_test(test_fused_element_matches_reference),
