@@ -56,6 +56,14 @@ FemModel build_fem_model(const TetMesh& mesh, const std::vector<Material>& mater
                               " m^3) is too small or too large to model in double precision");
   }
   m.pattern = build_block_pattern(m.node_count(), mesh.tets);
+  m.node_element_start.assign(size_t(m.node_count()) + 1, 0);
+  for (const Tet& t : mesh.tets)
+    for (int32_t a : t) ++m.node_element_start[size_t(a) + 1];
+  for (size_t i = 0; i + 1 < m.node_element_start.size(); ++i) m.node_element_start[i + 1] += m.node_element_start[i];
+  m.node_elements.resize(size_t(m.node_element_start.back()));
+  std::vector<int32_t> next(m.node_element_start.begin(), m.node_element_start.end() - 1);
+  for (size_t e = 0; e < mesh.tets.size(); ++e)
+    for (int32_t a : mesh.tets[e]) m.node_elements[size_t(next[size_t(a)]++)] = int32_t(e);
   m.slots = element_block_slots(m.pattern, mesh.tets);
 
   // Consistent: M_ab = rho V / 20 (1 + delta_ab); lumped: rho V / 4 on the diagonal.
@@ -97,18 +105,20 @@ void compute_rotations(const FemModel& m, const Vec3List& x, std::vector<Mat3>& 
 
 void compute_node_rotations(const FemModel& m, const std::vector<Mat3>& element_rotation,
                             std::vector<Mat3>& node_rotation) {
-  node_rotation.assign(size_t(m.node_count()), Mat3::Zero());
-  for (size_t e = 0; e < m.elements.size(); ++e)
-    for (int32_t a : m.elements[e].nodes) node_rotation[size_t(a)] += element_rotation[e];
-  const size_t n = node_rotation.size();
+  const size_t n = size_t(m.node_count());
+  node_rotation.resize(n);
   for (size_t i = 0; i < n; i += 4) {  // four at a time, for proper_rotations4
     const int count = int(std::min<size_t>(4, n - i));
-    // Each sum S scaled to |S|_F^2 = 3, as a rotation's (its polar factor is the same): det S is
-    // then near 1, where Newton's scaling needs no cube root.
+    // Each sum S of the node's element rotations (gathered, in element order) scaled to
+    // |S|_F^2 = 3, as a rotation's (its polar factor is the same): det S is then near 1, where
+    // Newton's scaling needs no cube root.
     Mat3 S[4];
     for (int j = 0; j < count; ++j) {
-      const double n2 = node_rotation[i + j].squaredNorm();
-      S[j] = n2 > 0 ? Mat3(node_rotation[i + j] * std::sqrt(3 / n2)) : node_rotation[i + j];
+      Mat3 sum = Mat3::Zero();
+      for (int32_t k = m.node_element_start[i + j]; k < m.node_element_start[i + j + 1]; ++k)
+        sum += element_rotation[size_t(m.node_elements[size_t(k)])];
+      const double n2 = sum.squaredNorm();
+      S[j] = n2 > 0 ? Mat3(sum * std::sqrt(3 / n2)) : sum;
     }
     proper_rotations(S, &node_rotation[i], count);
     for (int j = 0; j < count; ++j)

@@ -27,6 +27,9 @@ struct FemModel {
   std::vector<std::array<int32_t, 16>> slots;  // per element, block index of (a, b)
   std::vector<double> mass;                    // scalar mass per block (M_ij = mass * I)
   std::vector<double> node_mass;               // row sums of M: the node's share, kg
+  // Per node, the elements that hold it in ascending order: node i's are node_elements[
+  // node_element_start[i] .. node_element_start[i + 1]).
+  std::vector<int32_t> node_element_start, node_elements;
   QualityReport quality;                       // rest-shape quality: slivers are kept but reported
 
   int32_t node_count() const { return int32_t(rest.size()); }
