@@ -104,13 +104,13 @@ void DirectSolver::analyze(const BlockPattern& pattern, const Projection* projec
   projected_.resize(pattern.block_count());
   cholmod_common& common = llt_.cholmod();
   common.postorder = 1;
-  // The fill-reducing ordering, once per pattern and of the whole pattern (no node held): AMD or
-  // nested dissection (CHOLMOD's NESDIS over METIS), whichever fills less. CHOLMOD's default tries
-  // METIS only after AMD filled a lot, and kept AMD on the nidus, where NESDIS has 10.5 % fewer
-  // nonzeros in L and 27 % fewer flops (bench_factor); on a 35k-tet cube the memory after the
-  // first step fell 5073 -> 4775 B per tet (bench_nidus --scaling). NESDIS takes ~20 ms on the
-  // nidus, so a new held set (a grasp) is analysed with this ordering given (~1 ms). All of it
-  // is deterministic, so a restored state factors the same bits.
+  // The fill-reducing ordering, once (a solver serves one body's pattern), of the whole pattern
+  // with no node held: AMD or nested dissection (CHOLMOD's NESDIS over METIS), whichever fills
+  // less. CHOLMOD's default tries METIS only after AMD filled a lot, and kept AMD on the nidus,
+  // where NESDIS has 10.5 % fewer nonzeros in L and 27 % fewer flops (bench_factor); on a
+  // 35k-tet cube the memory after the first step fell 5073 -> 4775 B per tet (bench_nidus
+  // --scaling). NESDIS takes ~20 ms on the nidus, so a new held set (a grasp) is analysed with
+  // this ordering given (~5 ms). All of it is deterministic: a restored state factors the same bits.
   const bool any_held = std::find(held_.begin(), held_.end(), 1) != held_.end();
   bool whole_analysed = false;
   if (ordering_.size() != size_t(3 * pattern.rows)) {
