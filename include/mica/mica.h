@@ -204,10 +204,11 @@ typedef struct mica_world_def {
    *  refresh and kept until the world is destroyed) while the steps go on, and used from
    *  that many solves later (in lockstep: the step waits for a late factorization, so results do
    *  not depend on timing). Meant for bodies that keep turning far from the factor's shape; on the
-   *  nidus benchmark (a tool moving in a soft blob), every 6 steps: 8.0 conjugate-gradient
-   *  iterations per step instead of 10.7 and a median step 0.88-0.91x as long (5.0 ms), its p95
-   *  about the same; every 4, a factorization (about 22 ms on the second core) outlasts four
-   *  steps and the adopting steps wait for it (docs/performance.md).
+   *  nidus benchmark (a tool moving in a soft blob), every 6 steps: 7.6 conjugate-gradient
+   *  iterations per step instead of 10.1, but on a 2-core machine the median step is about the
+   *  same (4.5-5.3 ms against 4.5-4.7) and its p95 less steady, as the second core's
+   *  factorization slows the step; every 4, a factorization outlasts four steps and the adopting
+   *  steps wait for it (docs/performance.md).
    *  Default 0: factor when the time step, damping or constraint set changes, and when a solve
    *  drags on. Costs a second core while it runs, and a second copy of the factor's memory (the
    *  factorization's double-precision values only while it runs). (With or
