@@ -50,26 +50,18 @@ std::vector<std::array<int32_t, 16>> element_block_slots(const BlockPattern& p, 
 
 namespace {
 
-void block_multiply_sse2(const BlockPattern& p, const BlockValues& A, const Vec3List& x, Vec3List& y) {
-  for (int32_t i = 0; i < p.rows; ++i) {
-    Vec3 sum = Vec3::Zero();
-    for (int32_t k = p.row_start[i]; k < p.row_start[i + 1]; ++k) sum += A[k] * x[p.col[k]];
-    y[i] = sum;
-  }
-}
-
-void block_multiply_bound_sse2(const BlockPattern& p, const BlockValues& A, const Vec3List& x, Vec3List& y,
-                               std::vector<double>& bound) {
+// y = A x; with kBound also bound[i] = (sum_k |A_k|^2)(sum_k |x_col(k)|^2) over row i's blocks.
+template <bool kBound>
+void block_multiply_sse2(const BlockPattern& p, const BlockValues& A, const Vec3List& x, Vec3List& y, double* bound) {
   for (int32_t i = 0; i < p.rows; ++i) {
     Vec3 sum = Vec3::Zero();
     double a2 = 0, x2 = 0;
     for (int32_t k = p.row_start[i]; k < p.row_start[i + 1]; ++k) {
       sum += A[k] * x[p.col[k]];
-      a2 += A[k].squaredNorm();
-      x2 += x[p.col[k]].squaredNorm();
+      if (kBound) a2 += A[k].squaredNorm(), x2 += x[p.col[k]].squaredNorm();
     }
     y[i] = sum;
-    bound[size_t(i)] = a2 * x2;
+    if (kBound) bound[i] = a2 * x2;
   }
 }
 
@@ -77,31 +69,12 @@ void block_multiply_bound_sse2(const BlockPattern& p, const BlockValues& A, cons
 #define MICA_BLOCK_AVX2 1
 // A block's three columns as three vectors of 4 (the 4th lane reads the next column's first
 // entry, or the next block's: the array's last block goes the SSE2 way), 3 FMAs a block where
-// SSE2 takes 9 scalar ones: 0.054 -> 0.042 ms on the nidus's 30 k blocks. Written by hand for the
-// reason half_products.hpp gives: the library is built for any x86-64.
+// SSE2 takes 9 scalar ones: 0.054 -> 0.042 ms on the nidus's 30 k blocks. With kBound, the squares
+// of the entries summed too (lanes 0-2 of each load). Written by hand for the reason
+// half_products.hpp gives: the library is built for any x86-64.
+template <bool kBound>
 __attribute__((target("avx2,fma"))) void block_multiply_avx2(const BlockPattern& p, const BlockValues& A,
-                                                                 const Vec3List& x, Vec3List& y) {
-  const int32_t blocks = p.row_start[p.rows];
-  for (int32_t i = 0; i < p.rows; ++i) {
-    __m256d s0 = _mm256_setzero_pd(), s1 = _mm256_setzero_pd();
-    const int32_t end = std::min(p.row_start[i + 1], blocks - 1);
-    for (int32_t k = p.row_start[i]; k < end; ++k) {
-      const double *a = A[k].data(), *v = x[p.col[k]].data();
-      s0 = _mm256_fmadd_pd(_mm256_loadu_pd(a), _mm256_set1_pd(v[0]), s0);
-      s1 = _mm256_fmadd_pd(_mm256_loadu_pd(a + 3), _mm256_set1_pd(v[1]), s1);
-      s0 = _mm256_fmadd_pd(_mm256_loadu_pd(a + 6), _mm256_set1_pd(v[2]), s0);
-    }
-    alignas(32) double sum[4];
-    _mm256_store_pd(sum, _mm256_add_pd(s0, s1));
-    y[i] = Vec3(sum[0], sum[1], sum[2]);
-    if (end < p.row_start[i + 1]) y[i] += A[end] * x[p.col[end]];
-  }
-}
-
-// block_multiply_avx2 that also sums the squares of the blocks' entries (lanes 0-2 of each load).
-__attribute__((target("avx2,fma"))) void block_multiply_bound_avx2(const BlockPattern& p, const BlockValues& A,
-                                                                       const Vec3List& x, Vec3List& y,
-                                                                       std::vector<double>& bound) {
+                                                                 const Vec3List& x, Vec3List& y, double* bound) {
   const int32_t blocks = p.row_start[p.rows];
   for (int32_t i = 0; i < p.rows; ++i) {
     __m256d s0 = _mm256_setzero_pd(), s1 = _mm256_setzero_pd(), q = _mm256_setzero_pd();
@@ -113,20 +86,20 @@ __attribute__((target("avx2,fma"))) void block_multiply_bound_avx2(const BlockPa
       s0 = _mm256_fmadd_pd(c0, _mm256_set1_pd(v[0]), s0);
       s1 = _mm256_fmadd_pd(c1, _mm256_set1_pd(v[1]), s1);
       s0 = _mm256_fmadd_pd(c2, _mm256_set1_pd(v[2]), s0);
-      q = _mm256_fmadd_pd(c0, c0, _mm256_fmadd_pd(c1, c1, _mm256_fmadd_pd(c2, c2, q)));
-      x2 += v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+      if (kBound) {
+        q = _mm256_fmadd_pd(c0, c0, _mm256_fmadd_pd(c1, c1, _mm256_fmadd_pd(c2, c2, q)));
+        x2 += v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+      }
     }
     alignas(32) double sum[4], a2[4];
     _mm256_store_pd(sum, _mm256_add_pd(s0, s1));
-    _mm256_store_pd(a2, q);
     y[i] = Vec3(sum[0], sum[1], sum[2]);
+    if (end < p.row_start[i + 1]) y[i] += A[end] * x[p.col[end]];
+    if (!kBound) continue;
+    _mm256_store_pd(a2, q);
     double a2_sum = a2[0] + a2[1] + a2[2];
-    if (end < p.row_start[i + 1]) {
-      y[i] += A[end] * x[p.col[end]];
-      a2_sum += A[end].squaredNorm();
-      x2 += x[p.col[end]].squaredNorm();
-    }
-    bound[size_t(i)] = a2_sum * x2;
+    if (end < p.row_start[i + 1]) a2_sum += A[end].squaredNorm(), x2 += x[p.col[end]].squaredNorm();
+    bound[i] = a2_sum * x2;
   }
 }
 
@@ -140,17 +113,17 @@ bool avx2_supported() {
 
 void block_multiply(const BlockPattern& p, const BlockValues& A, const Vec3List& x, Vec3List& y) {
 #ifdef MICA_BLOCK_AVX2
-  if (avx2_supported()) return block_multiply_avx2(p, A, x, y);
+  if (avx2_supported()) return block_multiply_avx2<false>(p, A, x, y, nullptr);
 #endif
-  block_multiply_sse2(p, A, x, y);
+  block_multiply_sse2<false>(p, A, x, y, nullptr);
 }
 
 void block_multiply_bound(const BlockPattern& p, const BlockValues& A, const Vec3List& x, Vec3List& y,
                           std::vector<double>& bound) {
 #ifdef MICA_BLOCK_AVX2
-  if (avx2_supported()) return block_multiply_bound_avx2(p, A, x, y, bound);
+  if (avx2_supported()) return block_multiply_avx2<true>(p, A, x, y, bound.data());
 #endif
-  block_multiply_bound_sse2(p, A, x, y, bound);
+  block_multiply_sse2<true>(p, A, x, y, bound.data());
 }
 
 }  // namespace mica

@@ -9,17 +9,33 @@
 
 using namespace mica;
 
-static void test_product_matches_dense(void**) {
-  for (const int cells : {1, 3}) {
-    const TetMesh mesh = make_box_grid(Vec3(0, 0, 0), Vec3(1, 1, 1), {cells, cells + 1, 2}, 6);
-    const BlockPattern p = build_block_pattern(int32_t(mesh.nodes.size()), mesh.tets);
-    std::mt19937 rng(3);
+namespace {
+// A box mesh's block pattern with random blocks A and a random vector x, entries in [-1, 1].
+struct RandomProduct {
+  BlockPattern p;
+  BlockValues A;
+  Vec3List x;
+  RandomProduct(std::array<int, 3> cells, unsigned seed) {
+    const TetMesh mesh = make_box_grid(Vec3(0, 0, 0), Vec3(1, 1, 1), cells, 6);
+    p = build_block_pattern(int32_t(mesh.nodes.size()), mesh.tets);
+    std::mt19937 rng(seed);
     std::uniform_real_distribution<double> u(-1, 1);
-    BlockValues A(p.block_count());
+    A.resize(p.block_count());
     for (Mat3& block : A)
       for (int k = 0; k < 9; ++k) block(k / 3, k % 3) = u(rng);
-    Vec3List x(size_t(p.rows)), y(size_t(p.rows));
+    x.resize(size_t(p.rows));
     for (Vec3& v : x) v = Vec3(u(rng), u(rng), u(rng));
+  }
+};
+}  // namespace
+
+static void test_product_matches_dense(void**) {
+  for (const int cells : {1, 3}) {
+    const RandomProduct r({cells, cells + 1, 2}, 3);
+    const BlockPattern& p = r.p;
+    const BlockValues& A = r.A;
+    const Vec3List& x = r.x;
+    Vec3List y(size_t(p.rows));
     Eigen::MatrixXd dense = Eigen::MatrixXd::Zero(3 * p.rows, 3 * p.rows);
     Eigen::VectorXd flat_x(3 * p.rows);
     for (int32_t i = 0; i < p.rows; ++i) {
@@ -37,15 +53,11 @@ static void test_product_matches_dense(void**) {
 }
 
 static void test_bound_matches_its_definition(void**) {
-  const TetMesh mesh = make_box_grid(Vec3(0, 0, 0), Vec3(1, 1, 1), {3, 4, 2}, 6);
-  const BlockPattern p = build_block_pattern(int32_t(mesh.nodes.size()), mesh.tets);
-  std::mt19937 rng(5);
-  std::uniform_real_distribution<double> u(-1, 1);
-  BlockValues A(p.block_count());
-  for (Mat3& block : A)
-    for (int k = 0; k < 9; ++k) block(k / 3, k % 3) = u(rng);
-  Vec3List x(size_t(p.rows)), y(size_t(p.rows)), y_plain(size_t(p.rows));
-  for (Vec3& v : x) v = Vec3(u(rng), u(rng), u(rng));
+  const RandomProduct r({3, 4, 2}, 5);
+  const BlockPattern& p = r.p;
+  const BlockValues& A = r.A;
+  const Vec3List& x = r.x;
+  Vec3List y(size_t(p.rows)), y_plain(size_t(p.rows));
   std::vector<double> bound(size_t(p.rows));
   block_multiply_bound(p, A, x, y, bound);
   block_multiply(p, A, x, y_plain);
