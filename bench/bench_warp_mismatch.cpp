@@ -87,7 +87,7 @@ int main(int argc, char** argv) {
     double trav = tt < tin ? speed * tt : depth + wob * std::sin(2 * M_PI * (tt - tin));
     w.set_tool_pose(tool, Vec3(c.x(), y0 - trav, c.z()), Eigen::Quaterniond::Identity());
     w.step(dt);
-    compute_node_rotations(b.fem, b.R, Rn);
+    compute_node_rotations(b.fem, b.rotations(), Rn);
     if (k == K1 - 1 || k == K1 - 5 || k == 0) saved[K1 - k] = {b.A, Rn};
   }
   const BlockPattern& p = b.fem.pattern;

@@ -51,10 +51,15 @@ struct ToolState {
 };
 
 // What a step derives from the state: the velocities the step's pose change implies (its
-// contacts move with them).
+// contacts move with them), and the step's results, ToolState's once the step commits.
 struct ToolScratch {
   Vec3 velocity = Vec3::Zero();          // m/s
   Vec3 angular_velocity = Vec3::Zero();  // rad/s
+  struct {
+    Vec3 force = Vec3::Zero(), torque = Vec3::Zero();
+    int32_t contact_count = 0;
+    Mat3 stiffness = Mat3::Zero();
+  } next;
 };
 
 struct Tool : ToolModel, ToolState, ToolScratch {

@@ -21,16 +21,16 @@ BodyState::BodyState(const BodyModel& model) {
   v.assign(n, Vec3::Zero());
   v_previous.assign(n, Vec3::Zero());
   node_forces.assign(n, Vec3::Zero());
-  contact_impulse.assign(n, Vec3::Zero());
+  end.R.assign(model.fem.elements.size(), Mat3::Identity());  // sized once: the step swaps it with next_end.R
   bvh.build(x, model.surface);
 }
 
 BodyScratch::BodyScratch(const BodyModel& model) {
   const size_t n = model.fem.rest.size();
-  R.assign(model.fem.elements.size(), Mat3::Identity());
-  R_end.assign(model.fem.elements.size(), Mat3::Identity());
+  own_R.assign(model.fem.elements.size(), Mat3::Identity());
+  next_end.R.assign(model.fem.elements.size(), Mat3::Identity());
   A.assign(model.fem.pattern.block_count(), Mat3::Zero());
-  for (Vec3List* w : {&f_int, &f_ext, &b, &v_next, &x_next}) w->assign(n, Vec3::Zero());
+  for (Vec3List* w : {&f_int, &f_ext, &b, &v_next, &x_next, &contact_impulse}) w->assign(n, Vec3::Zero());
   projection.reset(int32_t(n));
   constrained_sum.assign(n, Mat3::Zero());
 }

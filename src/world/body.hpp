@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: Apache-2.0
 // A deformable (or static) body in three parts: the model it was made with (never changed after
-// creation), the state a step starts from and leaves, and the per-step work arrays, sized once at
-// creation so that stepping does not allocate. Body is the three together; a function that needs
-// one part takes that part.
+// creation), the state a step starts from and leaves, and the step's work arrays, sized once at
+// creation so that stepping does not allocate. A step writes only into the work arrays until it
+// commits (World::commit swaps what it made into the state), so a step that fails leaves the state
+// as it was. Body is the three together.
 #pragma once
 #include <string>
 #include <vector>
@@ -57,27 +58,36 @@ struct BodyState {
   Vec3List node_forces;        // persistent user loads, N
   bool has_node_forces = false;
   uint64_t lpc_version = 0;    // bumped when a constraint on this body is added or removed
-  Vec3List contact_impulse;    // G^T lambda of the last step, N s
-  TriangleBvh bvh;                         // over the surface triangles at x, refit every step
+  TriangleBvh bvh;             // over the surface triangles at x, refit every step
+  // Co-rotational bodies: what the last step found at its end positions, the next step's start
+  // rotations (World::start_rotations reuses them while x is still end.x).
+  struct EndRotations {
+    Vec3List x;                 // the positions (empty: none)
+    std::vector<Mat3> R;        // each element's rotation at x
+    double u = 0;               // J, the elastic energy at x
+  } end;
 };
 
-// The step's work arrays (and what one step hands the next: R_end at x_end, A of a linear body).
+// The step's work arrays (and the cache of a linear body's A, kept while its system stays).
 struct BodyScratch {
   explicit BodyScratch(const BodyModel& model);
 
-  std::vector<Mat3> R;         // element rotations the step is linearised with
-  std::vector<Mat3> R_end;     // rotations of x_end (computed after the solve: the next step's R)
-  Vec3List x_end;              // the positions R_end belongs to (empty: none)
+  // The element rotations the step is (the last step was) linearised with, Body::rotations(): the
+  // state's end.R when the step starts where the last one ended (read in place, not copied; after
+  // the commit's swap they are next_end.R), else own_R.
+  enum class RotationsIn : uint8_t { Own, End, NextEnd } rotations_in = RotationsIn::Own;
+  std::vector<Mat3> own_R;
+  BodyState::EndRotations next_end;  // this step's end rotations: end once the step commits
   struct Relinearisation {     // world/relinearise.cpp; sized on first use
     std::vector<Mat3> R_start;        // the step's start rotations
     std::vector<TwistModes> modes;    // the linearisation's twist stiffness (empty: none)
     Vec3List v_iter, v_lin, v_best, v_trial, scratch;
     double u_start = 0, k_start = 0;  // J, elastic and kinetic energy at the step's start
-    double u_end = 0;                 // J, elastic energy at x_end
-    bool u_start_known = false;       // u_start is U(x) (x == the last step's x_end)
+    bool u_start_known = false;       // u_start is U(x) (x == the last step's end.x)
   } relin;
   BlockValues A;               // M + h C + h^2 K
   Vec3List f_int, f_ext, b, v_next, x_next;
+  Vec3List contact_impulse;    // G^T lambda of the step, N s
   std::vector<Mat3> constrained_sum;  // per node, sum of I - S over its constraint groups (reactions)
   Projection projection;
   // The contact-curvature terms this step put into A (World::add_contact_stiffness): their
@@ -95,13 +105,16 @@ struct BodyScratch {
   SystemKey matrix_key{0, -1, -1};
   bool matrix_current = false;   // A holds M + hC + h^2 K for matrix_key
   bool matrix_rebuilt = false;   // this step assembled A anew
+  int32_t step_index = -1;       // among the step's dynamic bodies (Contact::a.body); -1: static
   uint64_t matrix_version = 0;   // bumped whenever the values of A change (the solvers' factors follow it)
 };
 
 struct Body : BodyModel, BodyState, BodyScratch {
   Body(const TetMesh& mesh, const BodySettings& settings, const std::string& name, uint64_t key);
   const BodyModel& model() const { return *this; }
-  const BodyState& state() const { return *this; }
+  const std::vector<Mat3>& rotations() const {
+    return rotations_in == RotationsIn::End ? end.R : rotations_in == RotationsIn::NextEnd ? next_end.R : own_R;
+  }
 };
 
 }  // namespace mica

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // The host sets a body's node positions or velocities (checking a simulation, starting from a
 // computed state). What the world derived from the old positions goes with them:
-//  - the end-of-step rotations kept for the next step (x_end, R_end: recomputed from x);
+//  - the end-of-step rotations kept for the next step (end: recomputed from x);
 //  - the surface tree (refitted here: a static body's is not refitted by the step);
 //  - the warm-start impulses of the body's contacts (their features may no longer touch, and a
 //    remembered force would stiffen the next step's contact rows, add_contact_stiffness);
@@ -35,19 +35,18 @@ void World::set_positions(Id id, const Vec3List& x) {
   // The keys of the rows of the last step's contacts on this body (by its index then).
   std::vector<uint64_t> stale;
   int32_t index = -1;
-  for (size_t k = 0; k < step_bodies_.size(); ++k)
-    if (step_bodies_[k] == id) index = int32_t(k);
-  for (size_t r = 0; r < rows_.size(); ++r) {
-    const Contact& c = contacts_[size_t(rows_.contact[r])];
+  for (size_t k = 0; k < last_.bodies.size(); ++k)
+    if (last_.bodies[k] == id) index = int32_t(k);
+  for (size_t r = 0; r < last_.rows.size(); ++r) {
+    const Contact& c = last_.contacts[size_t(last_.rows.contact[r])];
     const bool ours = (index >= 0 && (c.a.body == index || (c.b.count > 0 && c.b.body == index))) || c.other == id;
-    if (ours) stale.push_back(rows_.key[r]);
+    if (ours) stale.push_back(last_.rows.key[r]);
   }
   b.x = x;  // the same size: no allocation, nothing thrown from here on
-  b.x_end.clear();
-  b.relin.u_start_known = false;
+  b.end.x.clear();
   b.bvh.refit(b.x);
   for (uint64_t key : stale) warm_start_.erase(key);
-  debt_ = decltype(debt_){};
+  last_.debt = 0;
   if (recorder_) recorder_->write(RecordKind::SetPositions, id, x);
 }
 

@@ -15,7 +15,7 @@
 //   growth = [U(x+) - U_lin(x+)] - [U(x) - U_lin(x)] - dissipation,
 // U_lin the quadratic energy the step was linearised with (U_R for the first solve),
 // dissipation = |v+ - v|_M^2 / 2 + h^2 v+^T K v+ / 2 + h v+^T C v+ >= 0. Accepted while the
-// growth, summed over the steps since the energy last went down (`World::debt_`), stays below
+// growth, summed over the steps since the energy last went down (StepResults::debt), stays below
 // WorldSettings::relinearise_tolerance times the bodies' energy. The first screen costs one
 // rotation and two element energies per element: the rotations at x+ are the next step's start
 // rotations (start_rotations reuses them when the positions did not change in between), so the
@@ -59,37 +59,38 @@ struct Eval {
   double phi = 0;     // J, the incremental potential (all dynamic bodies)
 };
 
-// x_end = x + h v and, for a co-rotational body, R_end = R(x_end).
+// The step's end positions x + h v (next_end.x; its rotations are the caller's to compute).
 void end_state(Body& b, const Vec3List& v, double h) {
-  b.x_end.resize(b.x.size());
-  for (size_t i = 0; i < b.x.size(); ++i) b.x_end[i] = b.x[i] + h * v[i];
+  Vec3List& x_end = b.next_end.x;
+  x_end.resize(b.x.size());
+  for (size_t i = 0; i < b.x.size(); ++i) x_end[i] = b.x[i] + h * v[i];
 }
 
-// The first screen of the step's solution b.v_next, linearised with b.R (the step's start
-// rotations): computes R_end and returns [U(x+) - U_R(x+)] (an upper bound of the growth) and
+// The first screen of the step's solution b.v_next, linearised with b.rotations() (the step's
+// start rotations): computes next_end.R and returns [U(x+) - U_R(x+)] (an upper bound of the growth) and
 // the scale; caches U(x+) for the next step.
 Eval screen(Body& b, double h) {
   const FemModel& m = b.fem;
   end_state(b, b.v_next, h);
   const bool start_known = b.relin.u_start_known;
-  const ScreenEnergies u = screen_energies(m, b.x, b.x_end, b.R, b.R_end, !start_known);
+  const ScreenEnergies u = screen_energies(m, b.x, b.next_end.x, b.rotations(), b.next_end.R, !start_known);
   if (!start_known) b.relin.u_start = u.u_lin_start;
   b.relin.k_start = 0.5 * mass_dot(m, b.v, b.v);
-  b.relin.u_end = u.u_end;
+  b.next_end.u = u.u_end;
   Eval out;
   out.growth = u.u_end - u.u_lin_end;
   out.scale = std::max(b.relin.k_start + b.relin.u_start, 0.5 * mass_dot(m, b.v_next, b.v_next) + u.u_end);
   return out;
 }
 
-// The full evaluation of velocities v of body b for a step linearised with b.R (and, when
+// The full evaluation of velocities v of body b for a step linearised with b.rotations() (and, when
 // b.relin.modes is not empty, the twist stiffness at x + h v_lin); R_start the step's start
-// rotations (they define the damping in phi). Sets x_end, R_end; caches U(x_end).
+// rotations (they define the damping in phi). Sets next_end: x, R and U(x).
 Eval evaluate(Body& b, const Vec3List& v, double h, const BodyTerms& d, const std::vector<Mat3>& R_start) {
   const FemModel& m = b.fem;
   end_state(b, v, h);
   const LinearisationEnergies u =
-      linearisation_energies(m, b.x, b.x_end, v, b.settings.corotational ? &b.R : nullptr, b.R_end, &R_start,
+      linearisation_energies(m, b.x, b.next_end.x, v, b.settings.corotational ? &b.rotations() : nullptr, b.next_end.R, &R_start,
                              d.beta != 0, b.relin.modes, b.relin.v_lin);
   // The linearisation is backward Euler on U_L(y) = U_R(y) + (y - x_lin)^T G (y - x_lin) / 2.
   const double U1 = u.u_end, UL1 = u.u_lin_end + 0.5 * h * h * u.gdd, UL0 = u.u_lin_start + 0.5 * h * h * u.gll;
@@ -108,29 +109,28 @@ Eval evaluate(Body& b, const Vec3List& v, double h, const BodyTerms& d, const st
   if (d.loads)
     for (size_t i = 0; i < v.size(); ++i) fv += b.f_ext[i].dot(v[i]);
   out.phi = 0.5 * dvMdv + U1 - h * fv + 0.5 * h * (d.alpha * vMv + d.beta * u.vKv_start);
-  b.relin.u_end = U1;
+  b.next_end.u = U1;
   return out;
 }
 
-// The linearisation at x_end = x + h v_iter (whose rotations b.R are) gains the positive twist
+// The linearisation at next_end.x = x + h v_iter (whose rotations b.rotations() are) gains the positive twist
 // stiffness G (fem/linearisation.hpp).
 void add_twist_stiffness(Body& b, double h) {
   b.relin.v_lin = b.relin.v_iter;
-  mica::add_twist_stiffness(b.fem, b.x_end, b.relin.v_lin, h, b.relin.modes, b.A, b.f_int);
+  mica::add_twist_stiffness(b.fem, b.next_end.x, b.relin.v_lin, h, b.relin.modes, b.A, b.f_int);
 }
 
 }  // namespace
 
 void World::start_rotations(const StepContext& ctx, Body& b) const {
   // The rotations computed after the last step's solve, if the positions are still those.
-  b.relin.u_start_known = !b.x_end.empty() && b.x_end == b.x;
-  if (b.relin.u_start_known) {
-    std::swap(b.R, b.R_end);
-    b.relin.u_start = b.relin.u_end;
-  } else {
-    compute_rotations(b.fem, b.x, b.R, ctx.pool);
-  }
-  b.x_end.clear();
+  b.relin.u_start_known = !b.end.x.empty() && b.end.x == b.x;
+  b.rotations_in = b.relin.u_start_known ? Body::RotationsIn::End : Body::RotationsIn::Own;
+  if (b.relin.u_start_known)
+    b.relin.u_start = b.end.u;
+  else
+    compute_rotations(b.fem, b.x, b.own_R, ctx.pool);
+  b.next_end.x.clear();
 }
 
 void World::relinearise(const StepContext& ctx, StageRunner& stage) {
@@ -139,19 +139,14 @@ void World::relinearise(const StepContext& ctx, StageRunner& stage) {
   const double tol = settings_.relinearise_tolerance;
   const int32_t max_solves = settings_.relinearise_max;
   if (max_solves < 2) return;
-  // The growth the last step added to the debt counts once that step went through.
-  if (debt_.pending_step == stats_.step_count) debt_.committed = debt_.pending;
-  debt_.pending_step = -1;
-  const double debt = debt_.committed;
-  auto settle = [&](double growth) {
-    debt_.pending = std::max(0.0, debt + growth);
-    debt_.pending_step = stats_.step_count + 1;
-  };
+  // The debt the last good step left; this step's goes to its results (kept if the step is).
+  const double debt = last_.debt;
+  auto settle = [&](double growth) { next_.debt = std::max(0.0, debt + growth); };
   auto time_rotations = [&](auto&& f) {  // the rotations and energies of the check
     const auto start = std::chrono::steady_clock::now();
     f();
     const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-    StageStats& s = stats_.stages[size_t(Stage::Rotations)];
+    StageStats& s = next_.stats.stages[size_t(Stage::Rotations)];
     s.ms_last_step += ms;
     s.ms_total += ms;
   };
@@ -192,7 +187,7 @@ void World::relinearise(const StepContext& ctx, StageRunner& stage) {
     return sum;
   };
   for (Body* b : dynamic) {
-    b->relin.R_start = b->R;
+    b->relin.R_start = b->rotations();
     b->relin.modes.clear();
   }
   time_rotations([&] { cur = evaluate_all(false); });
@@ -202,12 +197,13 @@ void World::relinearise(const StepContext& ctx, StageRunner& stage) {
     return;
   }
 
-  // Newton iterations. Linearise at x + h v_iter (x_end, R_end hold its positions and rotations:
+  // Newton iterations. Linearise at x + h v_iter (next_end holds its positions and rotations:
   // the last evaluation was of the iterate) or at the step's start, and solve.
   auto linearise_and_solve = [&](bool at_start) {
     for (Body* b : dynamic) {
       if (!b->settings.corotational) continue;
-      b->R = at_start ? b->relin.R_start : b->R_end;
+      b->own_R = at_start ? b->relin.R_start : b->next_end.R;
+      b->rotations_in = Body::RotationsIn::Own;
       b->relin.modes.clear();
     }
     stage.run(Stage::Elements, true, [&] {
@@ -223,8 +219,8 @@ void World::relinearise(const StepContext& ctx, StageRunner& stage) {
                   if (b->settings.corotational && needs_damping(*b)) add_damping(ctx, *b);
               });
     // The statistics report the solve whose solution the step keeps; iterations add up.
-    stats_.solver_residual = 0;
-    stats_.converged = true;
+    next_.stats.solver_residual = 0;
+    next_.stats.converged = true;
     stage.run(Stage::Solve, true, [&] { solve(ctx); });
   };
   for (Body* b : dynamic) b->relin.v_iter = b->v_next;
@@ -279,14 +275,14 @@ void World::relinearise(const StepContext& ctx, StageRunner& stage) {
         b->relin.v_iter = b->relin.v_best;
         end_state(*b, b->relin.v_iter, h);
         if (b->settings.corotational) {
-          compute_rotations(b->fem, b->x_end, b->R_end, ctx.pool);
+          compute_rotations(b->fem, b->next_end.x, b->next_end.R, ctx.pool);
         }
       }
     }
     linearise_and_solve(best_solve == 1);
     solution_evaluated = false;
   }
-  // Whatever is kept, x_end and R_end must be of its end positions (the next step's start).
+  // Whatever is kept, next_end must be of its end positions (the next step's start).
   if (!solution_evaluated) time_rotations([&] { cur = evaluate_all(false); });
   settle(cur.growth);
 }

@@ -9,10 +9,10 @@
 //   world    step statistics (the step counter), the re-linearisation's energy debt, the warm-start
 //            impulses by row key, the last step's contacts, rows and impulses (the contacts readout),
 //            pairs of bodies created overlapping
-//   bodies   positions, velocities (now and at the last step's start), node forces, contact
-//            impulses, the rotations a step hands the next, and what the solver keeps for the body
-//            (its lagged factor: VelocitySolver::save_body)
-//   tools    poses (now and at the last step), velocities, force, torque, contact count, stiffness
+//   bodies   positions, velocities (now and at the last step's start), node forces, the rotations
+//            and energy a step hands the next (BodyState::end), and what the solver keeps for the
+//            body (its lagged factor: VelocitySolver::save_body)
+//   tools    poses (now and at the last step), force, torque, contact count, stiffness
 //   lpcs     prescribed velocity, reaction, handle (targets or grab offsets, pose, tool)
 //   devices  the force filter (moving average) and the last force sent
 // A restore reads and checks all of it before it changes anything; the solver's part (factoring the
@@ -31,7 +31,9 @@ namespace mica {
 namespace {
 
 constexpr char kMagic[8] = {'M', 'I', 'C', 'A', 'S', 'T', 'A', 'T'};
-constexpr uint32_t kFormatVersion = 4;  // 2: the contacts' curvature impulses; 3: v_previous; 4: solves, factorizations
+// 2: the contacts' curvature impulses; 3: v_previous; 4: solves, factorizations; 5: the step's
+// work (contact impulses, start rotations, tool velocities) left out, the energy debt one number
+constexpr uint32_t kFormatVersion = 5;
 // Byte order and the size of a double: a state is read back only where it was written.
 constexpr uint32_t kLayout = 0x01020304u ^ uint32_t(sizeof(double) << 24);
 
@@ -120,16 +122,14 @@ std::string shape_difference(const Shape& saved, const Shape& here) {
 
 // What a restore reads for a body before it changes anything.
 struct BodyData {
-  Vec3List x, v, v_previous, node_forces, contact_impulse, x_end;
+  Vec3List x, v, v_previous, node_forces;
   uint8_t has_node_forces = 0;
-  std::vector<Mat3> R, R_end;
-  double u_start = 0, k_start = 0, u_end = 0;
-  uint8_t u_start_known = 0;
+  BodyState::EndRotations end;
   std::vector<uint8_t> solver;
 };
 
 struct ToolData {
-  Vec3 position, previous_position, velocity, angular_velocity, force, torque;
+  Vec3 position, previous_position, force, torque;
   Eigen::Quaterniond orientation, previous_orientation;
   Mat3 stiffness;
   int32_t contact_count;
@@ -139,7 +139,7 @@ struct ToolData {
 // A state copies these structs as bytes: a padding byte would be uninitialised, and two saves of
 // one state could differ in it. Each size is the sum of its fields'.
 static_assert(sizeof(StateShape::BodyShape) == 2 * 4 + 4 * 1, "BodyShape has padding");
-static_assert(sizeof(ToolData) == 6 * sizeof(Vec3) + 2 * sizeof(Eigen::Quaterniond) + sizeof(Mat3) + 2 * 4,
+static_assert(sizeof(ToolData) == 4 * sizeof(Vec3) + 2 * sizeof(Eigen::Quaterniond) + sizeof(Mat3) + 2 * 4,
               "ToolData has padding");
 static_assert(sizeof(BodyPoint) == 6 * 4 + 3 * 8, "BodyPoint has padding");
 static_assert(sizeof(Contact) == 8 + 2 * sizeof(BodyPoint) + 3 * sizeof(Vec3) + 2 * 8 + 4 * 4 + 8, "Contact has padding");
@@ -190,24 +190,25 @@ std::vector<uint8_t> World::save_state() const {
   shape.write(out);
 
   // The world.
-  out.put(stats_);
-  out.put(debt_);
+  out.put(last_.stats);
+  out.put(last_.debt);
   std::vector<std::pair<uint64_t, double>> warm(warm_start_.begin(), warm_start_.end());
   std::sort(warm.begin(), warm.end());
   out.put_vector(warm);
-  out.put_vector(contacts_);
-  out.put_vector(rows_.start);
-  out.put_vector(rows_.terms);
-  out.put_vector(rows_.direction);
-  out.put_vector(rows_.bias);
-  out.put_vector(rows_.normal_of);
-  out.put_vector(rows_.mu);
-  out.put_vector(rows_.contact);
-  out.put_vector(rows_.key);
-  out.put_vector(lambda_);
-  out.put_vector(curvature_impulse_);
-  out.put_vector(step_bodies_);
-  out.put_vector(step_tools_);
+  const ContactRows& rows = last_.rows;
+  out.put_vector(last_.contacts);
+  out.put_vector(rows.start);
+  out.put_vector(rows.terms);
+  out.put_vector(rows.direction);
+  out.put_vector(rows.bias);
+  out.put_vector(rows.normal_of);
+  out.put_vector(rows.mu);
+  out.put_vector(rows.contact);
+  out.put_vector(rows.key);
+  out.put_vector(last_.lambda);
+  out.put_vector(last_.curvature_impulse);
+  out.put_vector(last_.bodies);
+  out.put_vector(last_.tools);
   out.put_vector(overlapping_);
 
   bodies_.for_each([&](Id, const Body& b) {
@@ -216,20 +217,15 @@ std::vector<uint8_t> World::save_state() const {
     out.put_vector(b.v_previous);
     out.put_vector(b.node_forces);
     out.put(uint8_t(b.has_node_forces));
-    out.put_vector(b.contact_impulse);
-    out.put_vector(b.R);
-    out.put_vector(b.R_end);
-    out.put_vector(b.x_end);
-    out.put(b.relin.u_start);
-    out.put(b.relin.k_start);
-    out.put(b.relin.u_end);
-    out.put(uint8_t(b.relin.u_start_known));
+    out.put_vector(b.end.x);
+    out.put_vector(b.end.R);
+    out.put(b.end.u);
     ByteWriter solver;
     solver_->save_body(b.key, solver);
     out.put_vector(solver.bytes());
   });
   tools_.for_each([&](Id, const Tool& t) {
-    out.put(ToolData{t.position, t.previous_position, t.velocity, t.angular_velocity, t.force, t.torque,
+    out.put(ToolData{t.position, t.previous_position, t.force, t.torque,
                      t.orientation, t.previous_orientation, t.stiffness, t.contact_count});
   });
   lpcs_.for_each([&](Id, const Lpc& c) {
@@ -300,7 +296,7 @@ void World::restore_state(const uint8_t* data, size_t size) {
 
   // The world.
   const WorldStats stats = in.get<WorldStats>("the statistics");
-  const decltype(debt_) debt = in.get<decltype(debt_)>("the energy debt");
+  const double debt = in.get<double>("the energy debt");
   std::vector<std::pair<uint64_t, double>> warm;
   in.get_vector(warm, "the warm-start impulses");
   std::vector<Contact> contacts;
@@ -357,23 +353,18 @@ void World::restore_state(const uint8_t* data, size_t size) {
   for (size_t k = 0; k < bodies.size(); ++k) {
     const Body& b = *bodies[k];
     BodyData& d = body_data[k];
-    const size_t n = size_t(b.fem.node_count()), e = b.R.size();
+    const size_t n = size_t(b.fem.node_count()), e = b.fem.elements.size();
     in.get_vector(d.x, "a body's positions");
     in.get_vector(d.v, "a body's velocities");
     in.get_vector(d.v_previous, "a body's last velocities");
     in.get_vector(d.node_forces, "a body's node forces");
     d.has_node_forces = in.get<uint8_t>("a body's node forces");
-    in.get_vector(d.contact_impulse, "a body's contact impulses");
-    in.get_vector(d.R, "a body's rotations");
-    in.get_vector(d.R_end, "a body's rotations");
-    in.get_vector(d.x_end, "a body's end positions");
-    d.u_start = in.get<double>("a body's energies");
-    d.k_start = in.get<double>("a body's energies");
-    d.u_end = in.get<double>("a body's energies");
-    d.u_start_known = in.get<uint8_t>("a body's energies");
+    in.get_vector(d.end.x, "a body's end positions");
+    in.get_vector(d.end.R, "a body's rotations");
+    d.end.u = in.get<double>("a body's energies");
     in.get_vector(d.solver, "a body's solver state");
     require(d.x.size() == n && d.v.size() == n && d.v_previous.size() == n && d.node_forces.size() == n &&
-                d.contact_impulse.size() == n && d.R.size() == e && d.R_end.size() == e && (d.x_end.empty() || d.x_end.size() == n),
+                d.end.R.size() == e && (d.end.x.empty() || d.end.x.size() == n),
             "a body's arrays do not match its node or tet count");
     require(flat(d.x).allFinite() && flat(d.v).allFinite() && flat(d.v_previous).allFinite() &&
                 flat(d.node_forces).allFinite(),
@@ -424,16 +415,16 @@ void World::restore_state(const uint8_t* data, size_t size) {
   solver_->restore_bodies(solver_bodies);
 
   // Nothing throws from here on: values move in.
-  stats_ = stats;
-  debt_ = debt;
+  last_.stats = stats;
+  last_.debt = debt;
   warm_start_.clear();
   for (const auto& [key, impulse] : warm) warm_start_[key] = impulse;
-  contacts_.swap(contacts);
-  rows_ = std::move(rows);
-  lambda_.swap(lambda);
-  curvature_impulse_.swap(curvature_impulse);
-  step_bodies_.swap(step_bodies);
-  step_tools_.swap(step_tools);
+  last_.contacts.swap(contacts);
+  last_.rows = std::move(rows);
+  last_.lambda.swap(lambda);
+  last_.curvature_impulse.swap(curvature_impulse);
+  last_.bodies.swap(step_bodies);
+  last_.tools.swap(step_tools);
   overlapping_.swap(overlapping);
   size_t k = 0;
   bodies_.for_each([&](Id, Body& b) {
@@ -443,14 +434,7 @@ void World::restore_state(const uint8_t* data, size_t size) {
     b.v_previous = d.v_previous;
     b.node_forces.swap(d.node_forces);
     b.has_node_forces = d.has_node_forces != 0;
-    b.contact_impulse.swap(d.contact_impulse);
-    b.R.swap(d.R);
-    b.R_end.swap(d.R_end);
-    b.x_end.swap(d.x_end);
-    b.relin.u_start = d.u_start;
-    b.relin.k_start = d.k_start;
-    b.relin.u_end = d.u_end;
-    b.relin.u_start_known = d.u_start_known != 0;
+    std::swap(b.end, d.end);
     b.bvh.refit(b.x);
     // The solvers' factors of the current matrix are redone (the same matrix: the same bits).
     b.matrix_current = false;
@@ -463,8 +447,6 @@ void World::restore_state(const uint8_t* data, size_t size) {
     t.orientation = d.orientation;
     t.previous_position = d.previous_position;
     t.previous_orientation = d.previous_orientation;
-    t.velocity = d.velocity;
-    t.angular_velocity = d.angular_velocity;
     t.force = d.force;
     t.torque = d.torque;
     t.contact_count = d.contact_count;

@@ -63,7 +63,9 @@ void World::step(double h) {
     std::snprintf(text, sizeof text, "%.17g", h);
     fail(Errc::InvalidArgument, "the time step must be in [1e-9, 1] s, got " + std::string(text));
   }
-  save_undo();  // a failed step leaves the world as it was (undo.cpp)
+  // The step writes into its own buffers until commit: a failed one puts back only the poses it
+  // took from the devices, and the solver's schedules (undo.cpp).
+  save_undo();
   try {
     advance(h);
   } catch (...) {
@@ -71,7 +73,6 @@ void World::step(double h) {
     if (recorder_) recorder_->write(RecordKind::Step, h, adopted_, false, uint64_t(0));
     throw;
   }
-  solver_->commit_step();
   if (recorder_) recorder_->write(RecordKind::Step, h, adopted_, true, fingerprint());
 }
 
@@ -86,40 +87,48 @@ void World::step_replayed(double h, const std::vector<AdoptedPose>& poses) {
   replayed_ = nullptr;
 }
 
-StepContext World::begin_step(double h) {
-  StepContext ctx;
+void World::prepare_step(double h) {
+  StepContext& ctx = step_;  // its lists keep their capacity from step to step
   ctx.start = StepContext::Clock::now();
+  ctx.deadline.reset();
   if (settings_.time_budget_ms > 0)
     ctx.deadline = ctx.start + std::chrono::duration_cast<StepContext::Clock::duration>(
                                    std::chrono::duration<double, std::milli>(settings_.time_budget_ms));
   ctx.pool = pool_.get();
   ctx.h = h;
   ctx.plan = plan();
-  step_bodies_.clear();  // keeps its capacity
+  ctx.dynamic.clear();
+  ctx.tools.clear();
+  next_.bodies.clear();
+  next_.tools.clear();
+  next_.contacts.clear();
+  next_.rows.clear();
+  next_.lambda.clear();
   bodies_.for_each([&](Id id, Body& b) {
+    b.step_index = b.is_dynamic() ? int32_t(ctx.dynamic.size()) : -1;
     if (!b.is_dynamic()) return;
     ctx.dynamic.push_back(&b);
-    step_bodies_.push_back(id);
+    next_.bodies.push_back(id);
   });
-  return ctx;
+  next_.stats = last_.stats;
+  next_.stats.solver_iterations = 0;
+  next_.stats.solver_solves = 0;
+  next_.stats.solver_residual = 0;
+  next_.stats.converged = true;
+  next_.stats.out_of_time = false;
+  next_.debt = last_.debt;
 }
 
 void World::advance(double h) {
-  StepContext ctx = begin_step(h);
+  prepare_step(h);
+  StepContext& ctx = step_;
   const Plan& plan = ctx.plan;
-  stats_.solver_iterations = 0;
-  stats_.solver_solves = 0;
-  stats_.solver_residual = 0;
-  stats_.converged = true;
-  stats_.out_of_time = false;
+  WorldStats& stats = next_.stats;
 
   follow_devices();
-  StageRunner stage(stats_);
+  StageRunner stage(stats);
   stage.run(Stage::Collide, plan.collide, [&] { collide(ctx); });
-  if (!plan.collide) contacts_.clear();  // nothing to collide: drop last step's contacts
-  rows_.clear();
-  lambda_.clear();
-  curvature_impulse_.assign(contacts_.size(), Vec3::Zero());  // compute_forces fills the rounded tools'
+  next_.curvature_impulse.assign(next_.contacts.size(), Vec3::Zero());  // compute_forces fills the rounded tools'
   stage.run(Stage::Loads, plan.loads, [&] {
     for (Body* b : ctx.dynamic)
       if (needs_loads(*b)) apply_loads(*b);
@@ -141,19 +150,18 @@ void World::advance(double h) {
   const int64_t factored_before = factorizations(ctx);
   stage.run(Stage::Solve, plan.solve, [&] { solve(ctx); });
   if (plan.rotations && plan.solve) relinearise(ctx, stage);
-  stats_.factorizations = int32_t(factorizations(ctx) - factored_before);
+  stats.factorizations = int32_t(factorizations(ctx) - factored_before);
   stage.run(Stage::Integrate, plan.integrate, [&] {
     for (Body* b : ctx.dynamic)
       for (size_t i = 0; i < b->x.size(); ++i) b->x_next[i] = b->x[i] + h * b->v_next[i];
   });
-  check_finite(ctx);  // throws before anything observable has changed
+  check_finite(ctx);
   stage.run(Stage::Forces, plan.forces, [&] { compute_forces(ctx); });
   check_forces();
-  commit(ctx);
+  stats.step_count += 1;
+  stats.ms_last_step = std::chrono::duration<double, std::milli>(StepContext::Clock::now() - ctx.start).count();
+  commit(ctx);  // nothing throws from here on
   publish_force_models();
-  stats_.step_count += 1;
-  stats_.ms_last_step =
-      std::chrono::duration<double, std::milli>(StepContext::Clock::now() - ctx.start).count();
 }
 
 void World::follow_devices() {
@@ -222,7 +230,7 @@ void World::publish_force_models() {
     } else if (const Lpc* c = link.settings().lpc ? lpcs_.find(link.settings().lpc) : nullptr) {
       model = grasp_force_model(link, *c);
     }
-    model.step = stats_.step_count;
+    model.step = last_.stats.step_count;
     link.publish(model);
   });
 }
@@ -240,7 +248,7 @@ void World::assemble_elements(const StepContext& ctx, Body& b) const {
   const SystemKey key{h, alpha, beta};
   // A linear body keeps A while h and the damping stay: only its forces are recomputed.
   const bool rebuild = b.settings.corotational || !b.matrix_current || !(key == b.matrix_key);
-  const std::vector<Mat3>* R = b.settings.corotational ? &b.R : nullptr;
+  const std::vector<Mat3>* R = b.settings.corotational ? &b.rotations() : nullptr;
   if (rebuild) set_scaled_mass(b.fem, 1.0, b.A, ctx.pool);
   assemble_elastic(b.fem, b.x, R, h * h + h * beta, rebuild ? &b.A : nullptr, b.f_int, &b.element_colours, ctx.pool);
   if (rebuild) {
@@ -255,14 +263,14 @@ void World::assemble_elements(const StepContext& ctx, Body& b) const {
 void World::add_contact_stiffness(const StepContext& ctx, Body& b) const {
   // h^2 K_c with K_c = F (-H)+ per contact of a rounded tool on a triangle, F the contact's force
   // in the last step (this step's force is the unknown: the lag keeps the system linear).
-  const int32_t index = ctx.index_of(&b);
+  const int32_t index = b.step_index;
   MICA_ASSERT(index >= 0, "the elements stage assembles dynamic bodies only");
   thread_local ToolCore core;  // kept: a step allocates nothing here
   int32_t core_of = -1;
   b.curvature_terms.clear();
   b.curvature_stiffness.clear();
-  for (size_t k = 0; k < contacts_.size(); ++k) {
-    const Contact& c = contacts_[k];
+  for (size_t k = 0; k < next_.contacts.size(); ++k) {
+    const Contact& c = next_.contacts[k];
     if (c.tool < 0 || (c.core_corner < 0 && c.core_edge < 0) || c.a.body != index) continue;
     const auto last = warm_start_.find(ContactRows::normal_row_key(c.key));
     if (last == warm_start_.end() || !(last->second > 0)) continue;
@@ -325,9 +333,6 @@ void World::form_rhs(const StepContext& ctx, Body& b) const {
 
 void World::collide(StepContext& ctx) {
   const double h = ctx.h;
-  contacts_.clear();
-  ctx.tools.clear();
-  step_tools_.clear();
   // Tool velocities from the pose change the host made since the last step.
   tools_.for_each([&](Id, Tool& t) {
     t.velocity = (t.position - t.previous_position) / h;
@@ -337,7 +342,7 @@ void World::collide(StepContext& ctx) {
   // Every body's surface as collision sees it; dynamic bodies' trees follow their nodes.
   std::vector<SurfaceView> views;
   bodies_.for_each([&](Id id, Body& b) {
-    const int32_t index = ctx.index_of(&b);
+    const int32_t index = b.step_index;
     double speed = 0;
     if (index >= 0) {
       b.bvh.refit(b.x);
@@ -348,15 +353,15 @@ void World::collide(StepContext& ctx) {
   });
   tools_.for_each([&](Id tool_id, Tool& t) {
     ctx.tools.push_back(&t);
-    step_tools_.push_back(tool_id);
+    next_.tools.push_back(tool_id);
     for (const SurfaceView& v : views)
-      if (v.index >= 0) collide_tool(t, int32_t(ctx.tools.size() - 1), tool_id, v, h, contacts_);
+      if (v.index >= 0) collide_tool(t, int32_t(ctx.tools.size() - 1), tool_id, v, h, next_.contacts);
   });
   if (!settings_.body_contact) return;
   for (const SurfaceView& a : views)
     for (const SurfaceView& b : views)
       if (a.index >= 0 && &a != &b && (b.index < 0 || bounds_overlap(a, b)) && !contacts_skipped(a.key, b.key))
-        collide_bodies(a, b, settings_.body_margin, settings_.body_friction, contacts_);
+        collide_bodies(a, b, settings_.body_margin, settings_.body_friction, next_.contacts);
 }
 
 bool World::bounds_overlap(const SurfaceView& a, const SurfaceView& b) const {
@@ -382,53 +387,52 @@ void World::solve(const StepContext& ctx) {
     sb.v = &b.v_next;
     sb.contact_impulse = &b.contact_impulse;
     sb.colours = ctx.pool && !b.node_colours.empty() ? &b.node_colours : nullptr;
-    sb.rotation = b.settings.corotational ? &b.R : nullptr;
+    sb.rotation = b.settings.corotational ? &b.rotations() : nullptr;
     sb.extra_stiffness = &b.curvature_stiffness;
     sb.system = b.matrix_key;
     sb.matrix_version = b.matrix_version;
     sb.constraint_version = b.lpc_version;
   }
   // The impulses of contact rows that persist from the last step are the warm start.
-  rows_.build(contacts_, ctx.h, settings_.max_recovery_speed);
-  lambda_.assign(rows_.size(), 0.0);
-  for (size_t r = 0; settings_.warm_start && r < rows_.size(); ++r) {
-    const auto it = warm_start_.find(rows_.key[r]);
-    if (it != warm_start_.end()) lambda_[r] = it->second;
+  ContactRows& rows = next_.rows;
+  std::vector<double>& lambda = next_.lambda;
+  rows.build(next_.contacts, ctx.h, settings_.max_recovery_speed);
+  lambda.assign(rows.size(), 0.0);
+  for (size_t r = 0; settings_.warm_start && r < rows.size(); ++r) {
+    const auto it = warm_start_.find(rows.key[r]);
+    if (it != warm_start_.end()) lambda[r] = it->second;
   }
-  if (rows_.size() > kExactRowsWarning && settings_.solver != SolverKind::Mica && !warned_exact_rows_ && settings_.log) {
+  if (rows.size() > kExactRowsWarning && settings_.solver != SolverKind::Mica && !warned_exact_rows_ && settings_.log) {
     warned_exact_rows_ = true;  // once per world
     settings_.log(LogLevel::Warning,
-                  std::to_string(rows_.size()) + " contact rows in one step: the exact solvers (DIRECT, PCG) form a dense "
+                  std::to_string(rows.size()) + " contact rows in one step: the exact solvers (DIRECT, PCG) form a dense "
                   "Delassus matrix with one linear solve per row, which takes seconds above some hundred rows "
                   "(docs/solvers.md); MICA_SOLVER_MICA scales to such contact sets");
   }
-  record(solver_->solve(ctx, solver_bodies_, rows_, lambda_));
+  add_to_stats(solver_->solve(ctx, solver_bodies_, rows, lambda));
 }
 
 void World::compute_forces(const StepContext& ctx) {
   const double h = ctx.h;
   const std::vector<double>& row_diagonal = solver_->row_diagonal();
-  MICA_ASSERT(row_diagonal.size() == rows_.size(), "the solver reports the compliance of each row it solved");
+  const ContactRows& rows = next_.rows;
+  const std::vector<double>& lambda = next_.lambda;
+  MICA_ASSERT(row_diagonal.size() == rows.size(), "the solver reports the compliance of each row it solved");
   // Tools: the force the tissue puts on the tool is -sum n lambda / h.
-  for (Tool* t : ctx.tools) {
-    t->force.setZero();
-    t->torque.setZero();
-    t->contact_count = 0;
-    t->stiffness.setZero();
-  }
-  for (size_t r = 0; r < rows_.size(); ++r) {
-    const Contact& c = contacts_[rows_.contact[r]];
+  for (Tool* t : ctx.tools) t->next = {};
+  for (size_t r = 0; r < rows.size(); ++r) {
+    const Contact& c = next_.contacts[rows.contact[r]];
     if (c.tool < 0) continue;
-    Tool& t = *ctx.tools[c.tool];
-    const Vec3 f = -rows_.direction[r] * lambda_[r] / h;
+    auto& t = ctx.tools[c.tool]->next;
+    const Vec3 f = -rows.direction[r] * lambda[r] / h;
     t.force += f;
-    t.torque += (c.point - t.position).cross(f);
-    if (rows_.normal_of[r] < 0 && lambda_[r] > 0) {
+    t.torque += (c.point - ctx.tools[c.tool]->position).cross(f);
+    if (rows.normal_of[r] < 0 && lambda[r] > 0) {
       t.contact_count += 1;
       // Around the pose it used, pushing the tool in by dx along n raises this row's impulse by
       // n.dx / (h W_rr): the force changes by -n n^T dx / (h^2 W_rr).
       if (row_diagonal[r] > 0)
-        t.stiffness -= rows_.direction[r] * rows_.direction[r].transpose() / (h * h * row_diagonal[r]);
+        t.stiffness -= rows.direction[r] * rows.direction[r].transpose() / (h * h * row_diagonal[r]);
     }
   }
   // The curvature terms in A push the triangles' corners by -h^2 F K_c v+ (add_contact_stiffness):
@@ -441,12 +445,12 @@ void World::compute_forces(const StepContext& ctx) {
       for (int r = 0; r < 3; ++r)
         for (int s = 0; s < 3; ++s)
           impulse -= stiffness.K.block<3, 3>(3 * r, 3 * s) * b->v_next[size_t(stiffness.nodes[s])];
-      const Contact& c = contacts_[size_t(term.contact)];
-      curvature_impulse_[size_t(term.contact)] = impulse;
+      const Contact& c = next_.contacts[size_t(term.contact)];
+      next_.curvature_impulse[size_t(term.contact)] = impulse;
       Tool& t = *ctx.tools[size_t(c.tool)];
       const Vec3 f = -impulse / h;
-      t.force += f;
-      t.torque += (term.core_point - t.position).cross(f);
+      t.next.force += f;
+      t.next.torque += (term.core_point - t.position).cross(f);
     }
   // Constraints: the impulse r = (I - S)(A v - b - G^T lambda) holds the body; whoever holds
   // the constraint (the user's hand) feels the opposite force, -r / h. A node held by several
@@ -462,8 +466,8 @@ void World::compute_forces(const StepContext& ctx) {
   });
   lpcs_.for_each([&](Id, Lpc& c) {
     Body& b = bodies_.get(c.body, "body");
-    c.reaction.setZero();
-    if (ctx.index_of(&b) < 0) return;
+    c.next_reaction.setZero();
+    if (b.step_index < 0) return;
     for (int32_t i : c.nodes) {
       Vec3 Av = Vec3::Zero();
       for (int32_t k = b.fem.pattern.row_start[i]; k < b.fem.pattern.row_start[i + 1]; ++k)
@@ -471,7 +475,7 @@ void World::compute_forces(const StepContext& ctx) {
       const Vec3 r = Av - b.b[i] - b.contact_impulse[i];
       const Mat3& sum = b.constrained_sum[i];
       const Vec3 share = sum == c.constrained ? Vec3(c.constrained * r) : Vec3(c.constrained * pseudo_inverse(sum) * r);
-      c.reaction -= share / h;
+      c.next_reaction -= share / h;
     }
   });
 }
@@ -482,31 +486,32 @@ int64_t World::factorizations(const StepContext& ctx) const {
   return n;
 }
 
-void World::record(const SolveReport& report) {
-  stats_.solver_iterations += report.iterations;
-  stats_.solver_solves += std::max(1, report.solves);
+void World::add_to_stats(const SolveReport& report) {
+  WorldStats& stats = next_.stats;
+  stats.solver_iterations += report.iterations;
+  stats.solver_solves += std::max(1, report.solves);
   // A NaN residual must show, not vanish in a max.
-  if (!(report.residual <= stats_.solver_residual)) stats_.solver_residual = report.residual;
-  stats_.converged = stats_.converged && report.converged;
-  stats_.out_of_time = stats_.out_of_time || report.out_of_time;
+  if (!(report.residual <= stats.solver_residual)) stats.solver_residual = report.residual;
+  stats.converged = stats.converged && report.converged;
+  stats.out_of_time = stats.out_of_time || report.out_of_time;
 }
 
 void World::check_finite(const StepContext& ctx) const {
   for (const Body* b : ctx.dynamic)
     if (!(flat(b->v_next).allFinite() && flat(b->x_next).allFinite()))
       fail(Errc::Numerical, b->name + ": the step produced non-finite velocities or positions; the step was undone");
-  for (double l : lambda_)
+  for (double l : next_.lambda)
     if (!std::isfinite(l)) fail(Errc::Numerical, "a contact impulse is not finite; the step was undone");
 }
 
 void World::check_forces() const {
   tools_.for_each([&](Id, const Tool& t) {
-    if (!(t.force.allFinite() && t.torque.allFinite() && t.stiffness.allFinite()))
+    if (!(t.next.force.allFinite() && t.next.torque.allFinite() && t.next.stiffness.allFinite()))
       fail(Errc::Numerical, "a tool force is not finite (the time step is too small, or the contact too stiff, "
                             "for double precision); the step was undone");
   });
   lpcs_.for_each([&](Id, const Lpc& c) {
-    if (!c.reaction.allFinite())
+    if (!c.next_reaction.allFinite())
       fail(Errc::Numerical, "a constraint reaction is not finite (the time step is too small for double "
                             "precision); the step was undone");
   });
@@ -517,13 +522,26 @@ void World::commit(const StepContext& ctx) {
     std::swap(b->x, b->x_next);
     std::swap(b->v_previous, b->v);  // v_next keeps the old v_previous as scratch
     std::swap(b->v, b->v_next);
+    std::swap(b->end, b->next_end);
+    if (b->rotations_in == Body::RotationsIn::End) b->rotations_in = Body::RotationsIn::NextEnd;
   }
+  std::swap(last_, next_);
   warm_start_.clear();
-  for (size_t r = 0; r < rows_.size(); ++r) warm_start_[rows_.key[r]] = lambda_[r];
+  for (size_t r = 0; r < last_.rows.size(); ++r) warm_start_[last_.rows.key[r]] = last_.lambda[r];
   tools_.for_each([&](Id, Tool& t) {
     t.previous_position = t.position;
     t.previous_orientation = t.orientation;
   });
+  if (ctx.plan.forces) {  // else the last forces stand
+    for (Tool* t : ctx.tools) {
+      t->force = t->next.force;
+      t->torque = t->next.torque;
+      t->contact_count = t->next.contact_count;
+      t->stiffness = t->next.stiffness;
+    }
+    lpcs_.for_each([&](Id, Lpc& c) { c.reaction = c.next_reaction; });
+  }
+  solver_->commit_step();
   if (!overlapping_.empty()) forget_parted_overlaps();  // by the bounds this step's collide refitted
 }
 

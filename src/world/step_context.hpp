@@ -1,9 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
-// What one step works with, built once at its start (World::advance) and handed to its stages:
+// What one step works with, filled at its start (World::prepare_step) and handed to its stages:
 // the step size, the one deadline of the step's time budget, the thread pool (null: serial), the
 // plan, the dynamic bodies and the tools collision numbered. The solver sees the SolveContext part.
 #pragma once
-#include <algorithm>
 #include <vector>
 
 #include "collision/tool.hpp"
@@ -25,12 +24,6 @@ struct StepContext : SolveContext {
   Plan plan;
   std::vector<Body*> dynamic;    // the bodies that move; Contact::a.body / b.body index this list
   std::vector<Tool*> tools;      // every tool, in collision's order; Contact::tool indexes it
-
-  // The index of b among the dynamic bodies, -1 for a static body.
-  int32_t index_of(const Body* b) const {
-    const auto it = std::find(dynamic.begin(), dynamic.end(), b);
-    return it == dynamic.end() ? -1 : int32_t(it - dynamic.begin());
-  }
 };
 
 }  // namespace mica

@@ -1,32 +1,36 @@
 // SPDX-License-Identifier: Apache-2.0
-// Undoing a failed step: World::step saves what the step writes before it can fail and puts it
-// back when it fails (issue 16: a device-driven tool stayed at the device's new pose and the
-// factored sweep's refresh schedule shifted, so a failed step left traces in later ones).
+// A failed step: the stages write only into the step's own buffers (StepResults, the bodies' and
+// tools' scratch) until World::commit, so what a failed step must put back is what it took from
+// outside: the poses the devices gave their tools and grasp handles (follow_devices), and the
+// solver's refresh schedules (VelocitySolver::begin_step, rollback_step).
 #include "world/world.hpp"
 
 namespace mica {
 
 void World::save_undo() {
-  saved_stats_ = stats_;
-  saved_debt_ = debt_;
-  saved_tools_.clear();  // keeps its capacity: no allocation once the tool count is reached
-  tools_.for_each([&](Id, Tool& t) {
-    saved_tools_.push_back({&t, t.state(), t.scratch()});
+  saved_poses_.clear();  // keeps its capacity: no allocation once the device count is reached
+  devices_.for_each([&](Id, const DeviceLink& link) {
+    const Id target = link.settings().tool ? link.settings().tool : link.settings().lpc;
+    if (const Tool* t = id_kind(target) == IdKind::Tool ? tools_.find(target) : nullptr)
+      saved_poses_.push_back({target, t->position, t->orientation});
+    else if (const Lpc* c = id_kind(target) == IdKind::Lpc ? lpcs_.find(target) : nullptr; c && c->handle)
+      saved_poses_.push_back({target, c->handle->position, c->handle->orientation});
   });
-  saved_reactions_.clear();
-  lpcs_.for_each([&](Id, Lpc& c) { saved_reactions_.push_back(c.reaction); });
   solver_->begin_step();
 }
 
 void World::undo() {
-  stats_ = saved_stats_;
-  debt_ = saved_debt_;
-  for (const SavedTool& s : saved_tools_) {
-    static_cast<ToolState&>(*s.tool) = s.state;  // the pose (follow_devices moved it) and the results
-    static_cast<ToolScratch&>(*s.tool) = s.scratch;
+  for (const SavedPose& p : saved_poses_) {
+    if (id_kind(p.target) == IdKind::Tool) {
+      Tool& t = tool(p.target);
+      t.position = p.position;
+      t.orientation = p.orientation;
+    } else {
+      Handle& h = *lpcs_.get(p.target, "constraint").handle;
+      h.position = p.position;
+      h.orientation = p.orientation;
+    }
   }
-  size_t k = 0;
-  lpcs_.for_each([&](Id, Lpc& c) { c.reaction = saved_reactions_[k++]; });
   solver_->rollback_step();
 }
 

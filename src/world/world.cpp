@@ -144,7 +144,7 @@ void World::set_body_materials(Id id, const std::vector<Material>& materials) {
   b.fem = std::move(rebuilt);
   b.matrix_current = false;  // A and everything factored from it belong to the old materials
   ++b.matrix_version;
-  b.relin.u_start_known = false;
+  b.end.x.clear();  // the end energy cached for the next step is of the old materials
   b.relin.modes.clear();
   if (recorder_) recorder_->write(RecordKind::SetMaterials, id, materials);
 }

@@ -17,6 +17,7 @@
 #include "world/body.hpp"
 #include "world/slot_map.hpp"
 #include "world/stats.hpp"
+#include "world/step_results.hpp"
 #include "world/step_context.hpp"
 
 namespace mica {
@@ -93,6 +94,7 @@ struct Lpc {
   Vec3 velocity;     // prescribed when there is no handle
   std::unique_ptr<Handle> handle;  // targets: z_i = C (target_i - x_i) / h each step
   Vec3 reaction = Vec3::Zero();  // N: the force on whoever holds the constraint (the user), last step
+  Vec3 next_reaction = Vec3::Zero();  // the running step's (World::compute_forces), reaction once it commits
 };
 
 // A body created overlapping another deeper than contacts look (World::add_body): the two do
@@ -183,15 +185,15 @@ class World {
   DeviceReadGuard device_read_guard() const { return DeviceReadGuard(devices_); }
 
   // The last step's contacts, their rows of G and the impulses on them.
-  const std::vector<Contact>& contacts() const { return contacts_; }
-  const ContactRows& contact_rows() const { return rows_; }
-  const std::vector<double>& impulses() const { return lambda_; }  // per contact row, N s
+  const std::vector<Contact>& contacts() const { return last_.contacts; }
+  const ContactRows& contact_rows() const { return last_.rows; }
+  const std::vector<double>& impulses() const { return last_.lambda; }  // per contact row, N s
   // Per contact, the impulse on its body of the contact-curvature term (rounded tools; else 0), N s.
-  const Vec3List& curvature_impulses() const { return curvature_impulse_; }
+  const Vec3List& curvature_impulses() const { return last_.curvature_impulse; }
   // The ids behind the last step's indices: Contact::a.body / b.body index step_bodies(),
   // Contact::tool indexes step_tools().
-  const std::vector<Id>& step_bodies() const { return step_bodies_; }
-  const std::vector<Id>& step_tools() const { return step_tools_; }
+  const std::vector<Id>& step_bodies() const { return last_.bodies; }
+  const std::vector<Id>& step_tools() const { return last_.tools; }
 
   // The dynamic state (state_io.cpp): positions, velocities, warm starts, the solver's lagged
   // factors, tool poses and forces, constraint targets and handles, device filters, counters.
@@ -219,7 +221,7 @@ class World {
   uint64_t fingerprint() const;
 
   Plan plan() const;
-  const WorldStats& stats() const { return stats_; }
+  const WorldStats& stats() const { return last_.stats; }
   int32_t thread_count() const { return pool_ ? pool_->size() : 1; }  // settings().threads resolved
 
   template <class F>
@@ -230,7 +232,7 @@ class World {
  private:
   // The stages of a step (step.cpp), in the order advance() runs them.
   void advance(double h);
-  StepContext begin_step(double h);
+  void prepare_step(double h);  // fills step_ and next_ for a step of h seconds
   void follow_devices();
   ForceModel grasp_force_model(const DeviceLink& link, const Lpc& grasp) const;
   void collide(StepContext& ctx);
@@ -248,7 +250,7 @@ class World {
   // Co-rotational re-linearisation (relinearise.cpp).
   void start_rotations(const StepContext& ctx, Body& b) const;
   void relinearise(const StepContext& ctx, StageRunner& stage);
-  void record(const SolveReport& report);
+  void add_to_stats(const SolveReport& report);
   // Numeric factorizations the solver has made of the step's bodies so far (the stats' per step).
   int64_t factorizations(const StepContext& ctx) const;
   void check_finite(const StepContext& ctx) const;
@@ -256,7 +258,7 @@ class World {
   void check_forces() const;
   void commit(const StepContext& ctx);
   void publish_force_models();
-  // Undoing a failed step (undo.cpp): what the step may write before it fails.
+  // A failed step (undo.cpp): what the step took from the devices (the host's input) goes back.
   void save_undo();
   void undo();
 
@@ -271,27 +273,17 @@ class World {
   SlotMap<Lpc, IdKind::Lpc> lpcs_;
   SlotMap<Tool, IdKind::Tool> tools_;
   SlotMap<DeviceLink, IdKind::Device> devices_;
-  // The last step's results, and what the next step takes from them.
-  std::vector<Contact> contacts_;
-  ContactRows rows_;                                // the rows of G
-  std::vector<double> lambda_;                      // impulse per row, N s
-  Vec3List curvature_impulse_;                      // per contact: its curvature term's impulse, N s
-  std::vector<Id> step_bodies_, step_tools_;        // the last step's dynamic bodies and tools, by index
+  // The last step's results (published) and the running step's (written by its stages); commit
+  // swaps them. The warm start is keyed by row and rewritten at commit.
+  StepResults last_, next_;
   std::unordered_map<uint64_t, double> warm_start_; // impulses by row key
-  struct {  // relinearise: the energy (J) the steps since it last went down added, net
-    double committed = 0, pending = 0;
-    int64_t pending_step = -1;  // the step whose completion commits `pending`
-  } debt_;
-  WorldStats stats_;
-  WorldStats saved_stats_;
-  decltype(debt_) saved_debt_;
-  struct SavedTool {  // save_undo(): what a failed step puts back
-    Tool* tool;
-    ToolState state;
-    ToolScratch scratch;
+  StepContext step_;                                // the running step's context, kept for its capacity
+  struct SavedPose {  // save_undo(): a device-driven tool's or handle's pose before the step
+    Id target;
+    Vec3 position;
+    Eigen::Quaterniond orientation;
   };
-  std::vector<SavedTool> saved_tools_;
-  Vec3List saved_reactions_;
+  std::vector<SavedPose> saved_poses_;
   int64_t bodies_created_ = 0;
   bool warned_exact_rows_ = false;
   std::vector<BodyOverlap> last_overlaps_;          // of the last add_body

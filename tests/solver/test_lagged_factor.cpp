@@ -144,16 +144,16 @@ static void test_rollback_leaves_the_saved_factor(void**) {
   const Body& b = t.world->body(t.body);
   const LaggedFactor::Key key{0.01, 0, 0, 0};
   LaggedFactor factor;
-  factor.update(b.fem, key, b.A, b.projection, &b.R, 1);  // factors now, then refreshes every step
+  factor.update(b.fem, key, b.A, b.projection, &b.rotations(), 1);  // factors now, then refreshes every step
   step(t);
-  factor.update(b.fem, key, b.A, b.projection, &b.R, 1);  // launches a refresh
+  factor.update(b.fem, key, b.A, b.projection, &b.rotations(), 1);  // launches a refresh
   step(t);
   ByteWriter before;
   factor.save(before);
   BlockValues other = b.A;
   for (Mat3& block : other) block *= 1.5;  // another system, to tell the copies apart
   factor.begin();
-  factor.update(b.fem, key, other, b.projection, &b.R, 1);  // adopts, and stages the next refresh
+  factor.update(b.fem, key, other, b.projection, &b.rotations(), 1);  // adopts, and stages the next refresh
   factor.rollback();
   ByteWriter after;
   factor.save(after);
@@ -174,7 +174,7 @@ static void test_background_columns_are_the_same_bits(void**) {
   stepper.set_background_columns(false);
   std::vector<Mat3> node_rotation;
   for (int k = 0; k < 6; ++k) {
-    compute_node_rotations(b.fem, b.R, node_rotation);
+    compute_node_rotations(b.fem, b.rotations(), node_rotation);
     for (LaggedFactor* f : {&worker, &stepper}) {
       f->update(b.fem, key, b.A, b.projection, &node_rotation, 1);  // refreshes every solve
       f->prepare_columns(t.top_nodes);
@@ -205,7 +205,7 @@ static void test_loads_a_state_with_dense_columns(void**) {
   step(t);
   const Body& b = t.world->body(t.body);
   std::vector<Mat3> node_rotation;
-  compute_node_rotations(b.fem, b.R, node_rotation);
+  compute_node_rotations(b.fem, b.rotations(), node_rotation);
   LaggedFactor factor;
   factor.update(b.fem, LaggedFactor::Key{0.01, 0, 0, 0}, b.A, b.projection, &node_rotation, 0);
   ByteWriter now;

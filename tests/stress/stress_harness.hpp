@@ -481,7 +481,7 @@ class Monitor {
         double frozen = 0;
         for (size_t q = 0; q < b.fem.elements.size(); ++q) {
           const TetElement& el = b.fem.elements[q];
-          frozen += elastic_energy(el, b.fem.lame[q], b.R[q], deformation_gradient(el, b.x));
+          frozen += elastic_energy(el, b.fem.lame[q], b.rotations()[q], deformation_gradient(el, b.x));
         }
         rotation_update_ += en.elastic - frozen;
       }

@@ -192,7 +192,7 @@ static void test_moved_positions_get_their_own_rotations(void**) {
   }
   const Body& a = on.world.body(on.body);
   const Body& b = off.world.body(off.body);
-  for (size_t e = 0; e < a.R.size(); ++e) assert_true(a.R[e] == b.R[e]);
+  for (size_t e = 0; e < a.rotations().size(); ++e) assert_true(a.rotations()[e] == b.rotations()[e]);
   for (size_t i = 0; i < a.x.size(); ++i) assert_true(a.x[i] == b.x[i]);
 }
 
