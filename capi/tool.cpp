@@ -78,6 +78,15 @@ MICA_API mica_status mica_tool_set_pose(mica_world* world, mica_tool_id tool, co
   });
 }
 
+MICA_API mica_status mica_tool_teleport(mica_world* world, mica_tool_id tool, const double position[3],
+                                        const double orientation[4]) {
+  return guarded(world, "mica_tool_teleport", [&] {
+    require(world, "world");
+    world->world.teleport_tool(tool, vec3(position, "position"), quaternion(orientation, "orientation"));
+    return MICA_OK;
+  });
+}
+
 MICA_API mica_status mica_tool_get_pose(const mica_world* world, mica_tool_id tool, double out_position[3],
                                         double out_orientation[4]) {
   return guarded(world, "mica_tool_get_pose", [&] {

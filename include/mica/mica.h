@@ -856,7 +856,9 @@ static inline mica_tool_def mica_tool_def_default(void) {
 }
 
 /** Creates a tool. Every solver handles its contacts (MICA; DIRECT and PCG through the Delassus
- *  matrix). The world's thread (the one thread using the world at a time).
+ *  matrix). Create it at its start pose (`def->position`): mica_tool_set_pose() sweeps a tool from
+ *  its last pose, so a tool created inside a body and then set elsewhere drags the tissue on its
+ *  way; such a creation logs a warning. The world's thread (the one thread using the world at a time).
  *  @param world the world.
  *  @param def the tool (mica_tool_def_default(), then changed).
  *  @param out_tool receives the tool's id.
@@ -872,7 +874,10 @@ MICA_API mica_status mica_tool_create(mica_world* world, const mica_tool_def* de
  *          MICA_ERR_STALE_ID (`tool` is null, of another kind or destroyed); MICA_ERR_WRONG_STATE
  *          (a device drives the tool: destroy it first). */
 MICA_API mica_status mica_tool_destroy(mica_world* world, mica_tool_id tool);
-/** Moves a tool for the next step. The world's thread (the one thread using the world at a time).
+/** Moves a tool for the next step, which sweeps it from its last pose to this one (continuous
+ *  contact: what lies on the way is pushed, as a hand would push it; a fast move does not pass
+ *  through thin tissue). To put a tool somewhere without a sweep (a start pose, a jump of the
+ *  scene), use mica_tool_teleport(). The world's thread (the one thread using the world at a time).
  *  @param world the world.
  *  @param tool the tool.
  *  @param position m.
@@ -881,6 +886,19 @@ MICA_API mica_status mica_tool_destroy(mica_world* world, mica_tool_id tool);
  *          MICA_ERR_STALE_ID (`tool` is null, of another kind or destroyed);
  *          MICA_ERR_INVALID_ARGUMENT (a value not finite, a zero quaternion). */
 MICA_API mica_status mica_tool_set_pose(mica_world* world, mica_tool_id tool, const double position[3],
+                                        const double orientation[4]);
+/** Puts a tool at a pose without a sweep (since 0.7): the next step starts it there, so nothing
+ *  between its last pose and this one is pushed, and the warm starts of its contacts are forgotten.
+ *  For a tool's start pose (or create it there: mica_tool_def.position), a scene's jump, a reset.
+ *  Recorded and replayed. The world's thread (the one thread using the world at a time).
+ *  @param world the world.
+ *  @param tool the tool.
+ *  @param position m.
+ *  @param orientation unit quaternion (w, x, y, z).
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` or a required pointer is NULL);
+ *          MICA_ERR_STALE_ID (`tool` is null, of another kind or destroyed);
+ *          MICA_ERR_INVALID_ARGUMENT (a value not finite, a zero quaternion). */
+MICA_API mica_status mica_tool_teleport(mica_world* world, mica_tool_id tool, const double position[3],
                                         const double orientation[4]);
 /** The tool's current pose. A tool driven by a device takes the device's pose at each step. The
  *  world's thread (the one thread using the world at a time).

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cstdio>
 
+#include "collision/nearest_surface_point.hpp"
 #include "collision/overlap.hpp"
 #include "world/world.hpp"
 
@@ -56,6 +57,24 @@ std::string World::overlap_message(Id created, const BodyOverlap& o) const {
          owner + " is that deep inside " + host + "; body contacts look " + metres(o.reach) +
          " deep), so the two would tangle: they do not collide with each other until their bounding boxes part. "
          "Create them apart (mica_body_def.translation) for contact between them.";
+}
+
+void World::warn_if_inside_a_body(Id tool_id) const {
+  const Tool& t = tool(tool_id);
+  if (!settings_.log || t.shape == ToolShape::Plane) return;  // a plane's origin is any point of it
+  bodies_.for_each([&](Id id, const Body& b) {
+    if (b.bvh.empty() || !b.bvh.bounds().contains(t.position)) return;
+    const SurfaceView view{-1, id, &b.x, &b.surface, &b.surface_node_list, &b.bvh, &b.pseudo_normals, b.surface_edge, 0};
+    const Aabb& box = b.bvh.bounds();
+    const NearestSurfacePoint near = nearest_surface_point(view, t.position, (box.hi - box.lo).norm());
+    if (near.tri < 0 || (t.position - near.point.point).dot(near.outward) >= 0) return;
+    settings_.log(LogLevel::Warning,
+                  "tool (id " + SlotMap<Tool, IdKind::Tool>::hex(tool_id) + ") was created with its origin " +
+                      metres(near.distance) + " inside " + b.name + " (id " + SlotMap<Body, IdKind::Body>::hex(id) +
+                      "): mica_tool_set_pose sweeps a tool from its last pose, so its first move would drag the "
+                      "tissue on its way. Create it at its start pose (mica_tool_def.position), or move it there "
+                      "with mica_tool_teleport.");
+  });
 }
 
 bool World::contacts_skipped(Id a, Id b) const {

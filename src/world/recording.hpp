@@ -19,9 +19,10 @@ namespace mica {
 enum class RecordKind : uint32_t {
   SetGravity = 1, AddBody, RemoveBody, SetNodeForces, SetPositions, SetVelocities, SetMaterials,
   AddLpc, RemoveLpc, SetLpcVelocity, SetLpcTargets, Grab, SetHandlePose,
-  AddTool, RemoveTool, SetToolPose, AddDevice, RemoveDevice, RestoreState, Step
+  AddTool, RemoveTool, SetToolPose, AddDevice, RemoveDevice, RestoreState, Step,
+  TeleportTool  // since 0.7
 };
-constexpr uint32_t kLastRecordKind = uint32_t(RecordKind::Step);
+constexpr uint32_t kLastRecordKind = uint32_t(RecordKind::TeleportTool);
 
 constexpr char kRecordingMagic[8] = {'M', 'I', 'C', 'A', 'R', 'E', 'C', '1'};
 constexpr uint32_t kRecordingVersion = 1;

@@ -149,6 +149,7 @@ void Replay::apply(World& world, RecordKind kind, ByteReader& in) {
     }
     case RecordKind::RemoveTool: take_all(in, id); world.remove_tool(id); break;
     case RecordKind::SetToolPose: take_all(in, id, a, q); world.set_tool_pose(id, a, q); break;
+    case RecordKind::TeleportTool: take_all(in, id, a, q); world.teleport_tool(id, a, q); break;
     case RecordKind::AddDevice: {
       DeviceSettings settings;
       take_all(in, settings, created);

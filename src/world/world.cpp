@@ -190,9 +190,13 @@ Id World::insert_lpc(Id body_id, const std::vector<int32_t>& nodes, const LpcSpe
   return id;
 }
 
-Id World::add_tool(const Tool& tool) {
-  if (!tool.position.allFinite() || !tool.orientation.coeffs().allFinite() || !(tool.orientation.norm() > 1e-12))
+void check_tool_pose(const Vec3& position, const Eigen::Quaterniond& orientation) {
+  if (!position.allFinite() || !orientation.coeffs().allFinite() || !(orientation.norm() > 1e-12))
     fail(Errc::InvalidArgument, "the tool pose must be finite with a non-zero quaternion");
+}
+
+Id World::add_tool(const Tool& tool) {
+  check_tool_pose(tool.position, tool.orientation);
   if (!(tool.margin >= 0 && std::isfinite(tool.margin))) fail(Errc::InvalidArgument, "the contact margin must be finite and >= 0 m");
   if (!(tool.friction >= 0 && std::isfinite(tool.friction))) fail(Errc::InvalidArgument, "the friction coefficient must be finite and >= 0");
   Tool t = tool;
@@ -202,6 +206,7 @@ Id World::add_tool(const Tool& tool) {
   t.previous_orientation = t.orientation;
   const Id id = tools_.insert(std::make_unique<Tool>(t));
   if (recorder_) recorder_->write(RecordKind::AddTool, tool, id);
+  warn_if_inside_a_body(id);
   return id;
 }
 
@@ -266,11 +271,23 @@ void World::remove_tool(Id id) {
 
 void World::set_tool_pose(Id id, const Vec3& position, const Eigen::Quaterniond& orientation) {
   Tool& t = tool(id);
-  if (!position.allFinite() || !orientation.coeffs().allFinite() || !(orientation.norm() > 1e-12))
-    fail(Errc::InvalidArgument, "the tool pose must be finite with a non-zero quaternion");
+  check_tool_pose(position, orientation);
   t.position = position;
   t.orientation = orientation.normalized();
   if (recorder_) recorder_->write(RecordKind::SetToolPose, id, position, orientation);
+}
+
+void World::teleport_tool(Id id, const Vec3& position, const Eigen::Quaterniond& orientation) {
+  Tool& t = tool(id);
+  check_tool_pose(position, orientation);
+  t.position = t.previous_position = position;
+  t.orientation = t.previous_orientation = orientation.normalized();
+  // Its contacts' impulses are of another place: no warm start, no curvature term from them.
+  for (size_t r = 0; r < last_.rows.size(); ++r) {
+    const Contact& c = last_.contacts[size_t(last_.rows.contact[r])];
+    if (c.tool >= 0 && last_.tools[size_t(c.tool)] == id) warm_start_.erase(last_.rows.key[r]);
+  }
+  if (recorder_) recorder_->write(RecordKind::TeleportTool, id, position, orientation);
 }
 
 void World::set_lpc_velocity(Id id, const Vec3& velocity) {

@@ -119,6 +119,8 @@ class Recorder;  // recording.hpp
 
 // Throws Error(InvalidArgument) naming the first setting out of its domain.
 void validate(const WorldSettings& settings);
+// Throws Error(InvalidArgument) for a pose that is not finite or has a zero quaternion.
+void check_tool_pose(const Vec3& position, const Eigen::Quaterniond& orientation);
 
 class World {
  public:
@@ -168,7 +170,12 @@ class World {
   void remove_tool(Id id);
   Tool& tool(Id id) { return tools_.get(id, "tool"); }
   const Tool& tool(Id id) const { return tools_.get(id, "tool"); }
+  // The pose the next step moves the tool to, sweeping from its last pose (continuous contact:
+  // the tool pushes what lies on its way, as a hand does).
   void set_tool_pose(Id id, const Vec3& position, const Eigen::Quaterniond& orientation);
+  // Puts the tool at a pose without a sweep (the pose it comes from is this one): nothing on the way
+  // is pushed, and the warm starts of its contacts are forgotten.
+  void teleport_tool(Id id, const Vec3& position, const Eigen::Quaterniond& orientation);
   // Devices: added and removed only while no servo loop runs. A device drives a tool or a grasp
   // (a constraint with a handle that follows no tool), not both; check_device_target throws as
   // add_device would for the ids of `settings` (StaleId, InvalidArgument), changing nothing.
@@ -240,6 +247,8 @@ class World {
   // Bodies placed overlapping (overlaps.cpp).
   std::vector<BodyOverlap> find_overlaps(Body& created);
   void forget_parted_overlaps();
+  // Logs a warning when a tool's origin is inside a body: its first sweep would drag the tissue.
+  void warn_if_inside_a_body(Id tool) const;
   void apply_loads(Body& b) const;
   void assemble_elements(const StepContext& ctx, Body& b) const;
   void add_contact_stiffness(const StepContext& ctx, Body& b) const;
