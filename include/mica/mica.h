@@ -182,7 +182,8 @@ typedef struct mica_world_def {
   double relaxation;       /**< MICA, Gauss-Seidel sweep: over-relaxation omega in (0, 2); default 1 (the paper) */
   /** Iterative solvers: > 0 stops the solve when the step has used this many milliseconds of
    *  wall-clock time; the step then completes with what the solver reached, mica_step returns
-   *  MICA_WARN_NOT_CONVERGED and the statistics say out_of_time and the residual. Default 0: no budget. */
+   *  MICA_WARN_NOT_CONVERGED and the statistics say out_of_time and the residual. Default 0: no budget;
+   *  a budget above a day (86 400 000 ms, up to DBL_MAX) is no budget either. */
   double time_budget_ms;
   int32_t mica_sweep;      /**< MICA_SWEEP_*; default MICA_SWEEP_FACTORED (0.3-0.4: MICA_SWEEP_GAUSS_SEIDEL);
                                 a caller whose header lacks the field (0.2) gets the default */

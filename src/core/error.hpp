@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 // The core reports failure by throwing mica::Error; the C layer turns it into a status.
 #pragma once
+#include <cstdio>
+#include <cstdlib>
 #include <stdexcept>
 #include <string>
 
@@ -31,5 +33,15 @@ class Error : public std::runtime_error {
 };
 
 [[noreturn]] inline void fail(Errc code, const std::string& message) { throw Error(code, message); }
+
+// A value as a message quotes it: the shortest text that reads back as the same double ("1e+300", "0.5").
+inline std::string number_text(double value) {
+  char text[32];
+  for (int digits = 6; digits <= 17; ++digits) {
+    std::snprintf(text, sizeof text, "%.*g", digits, value);
+    if (std::strtod(text, nullptr) == value || value != value) break;
+  }
+  return text;
+}
 
 }  // namespace mica

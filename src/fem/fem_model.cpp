@@ -16,11 +16,26 @@ namespace {
 // Throws InvalidArgument naming `where` for a material out of its domain.
 void validate_material(const Material& mat, const std::string& where) {
   if (!(mat.youngs_modulus > 0) || !std::isfinite(mat.youngs_modulus))
-    fail(Errc::InvalidArgument, where + ": Young's modulus must be finite and > 0 Pa");
+    fail(Errc::InvalidArgument, where + ": Young's modulus must be finite and > 0 Pa, got " + number_text(mat.youngs_modulus));
   if (!(mat.poisson_ratio >= 0 && mat.poisson_ratio < 0.5))
-    fail(Errc::InvalidArgument, where + ": Poisson ratio must be in [0, 0.5)");
+    fail(Errc::InvalidArgument, where + ": Poisson ratio must be in [0, 0.5), got " + number_text(mat.poisson_ratio));
   if (!(mat.density > 0) || !std::isfinite(mat.density))
-    fail(Errc::InvalidArgument, where + ": density must be finite and > 0 kg/m^3");
+    fail(Errc::InvalidArgument, where + ": density must be finite and > 0 kg/m^3, got " + number_text(mat.density));
+}
+
+// A tet's mass (kg) and stiffness (E times its size, N/m) must lie within this range and its inverse:
+// the step's matrix holds sums of their products with h and h^2, and its factorization squares them,
+// so beyond it the system leaves double precision (E = 1e300 Pa, density = 1e-300 kg/m^3). Real
+// tissue and tools lie far inside (1e-15 kg to 1e7 kg, 1e-6 N/m to 1e13 N/m).
+constexpr double kModelRange = 1e100;
+
+void check_in_range(double value, const char* what, const char* unit, const Material& mat, size_t tet,
+                    const std::string& where) {
+  if (value >= 1 / kModelRange && value <= kModelRange) return;
+  fail(Errc::InvalidArgument, where + ": tet " + std::to_string(tet) + " has a " + what + " of " + number_text(value) +
+                                  " " + unit + " (Young's modulus " + number_text(mat.youngs_modulus) +
+                                  " Pa, density " + number_text(mat.density) +
+                                  " kg/m^3), outside [1e-100, 1e100]: beyond what double precision can solve");
 }
 }  // namespace
 
@@ -52,8 +67,10 @@ FemModel build_fem_model(const TetMesh& mesh, const std::vector<Material>& mater
     const TetElement& el = m.elements.back();
     if (!el.dm_inv.allFinite() || !std::isfinite(materials[e].density * el.volume) ||
         !std::isfinite(materials[e].youngs_modulus * el.volume))
-      fail(Errc::BadMesh, source + ": tet " + std::to_string(e) + " (volume " + std::to_string(el.volume) +
+      fail(Errc::BadMesh, source + ": tet " + std::to_string(e) + " (volume " + number_text(el.volume) +
                               " m^3) is too small or too large to model in double precision");
+    check_in_range(materials[e].density * el.volume, "mass", "kg", materials[e], e, source);
+    check_in_range(materials[e].youngs_modulus * std::cbrt(el.volume), "stiffness", "N/m", materials[e], e, source);
   }
   m.pattern = build_block_pattern(m.node_count(), mesh.tets);
   m.node_element_start.assign(size_t(m.node_count()) + 1, 0);

@@ -153,7 +153,9 @@ TetMesh make_box_grid(const Vec3& lo, const Vec3& hi, const std::array<int32_t, 
   if (!lo.allFinite() || !hi.allFinite()) fail(Errc::InvalidArgument, "box: corners must be finite");
   for (int k = 0; k < 3; ++k) {
     if (cells[k] < 1) fail(Errc::InvalidArgument, "box: cells[" + std::to_string(k) + "] must be >= 1, got " + std::to_string(cells[k]));
-    if (!(hi[k] > lo[k])) fail(Errc::InvalidArgument, "box: hi[" + std::to_string(k) + "] must exceed lo[" + std::to_string(k) + "]");
+    if (!(hi[k] > lo[k]))
+      fail(Errc::InvalidArgument, "box: hi[" + std::to_string(k) + "] must exceed lo[" + std::to_string(k) + "], got " +
+                                      number_text(hi[k]) + " and " + number_text(lo[k]));
   }
   const int64_t nx = cells[0], ny = cells[1], nz = cells[2];
   // Checked in floating point first: the integer products can overflow 64 bits.

@@ -10,6 +10,23 @@
 
 namespace mica {
 
+namespace {
+// CHOLMOD's last message on this thread: CHOLMOD prints nothing (a library writes nothing to the
+// host's stdout), and a failed factorization's error carries the message instead.
+thread_local std::string cholmod_message;
+
+void keep_cholmod_message(int status, const char* file, int line, const char* message) {
+  cholmod_message = std::string(status > 0 ? "CHOLMOD warning " : "CHOLMOD error ") + std::to_string(status) + ": " +
+                    (message ? message : "") + " (" + (file ? file : "") + ":" + std::to_string(line) + ")";
+}
+}  // namespace
+
+DirectSolver::DirectSolver() {
+  cholmod_common& common = llt_.cholmod();
+  common.print = 0;
+  common.error_handler = keep_cholmod_message;
+}
+
 DirectSolver::~DirectSolver() {
   for (cholmod_dense** d : {&x_, &y_, &e_})
     if (*d) cholmod_free_dense(d, &llt_.cholmod());
@@ -153,10 +170,13 @@ void DirectSolver::factorize(const ProjectedSystem& sys) {
   double* values = lower_.valuePtr();
   for (size_t q = 0; q < value_source_.size(); ++q) values[q] = source[value_source_[q]];
   by_hand_.unbind();
+  cholmod_message.clear();
   llt_.factorize(lower_);
   ++factorizations_;
   if (llt_.info() != Eigen::Success)
-    fail(Errc::Numerical, "the system matrix is not positive definite (CHOLMOD factorization failed)");
+    fail(Errc::Numerical, "the system matrix is not positive definite (" +
+                              (cholmod_message.empty() ? std::string("CHOLMOD factorization failed") : cholmod_message) +
+                              ")");
   // The half copy's probe multiplies by the factored system itself (the blocks just copied).
   auto multiply = [&](const double* x, double* y) {
     const size_t n = size_t(p.rows);

@@ -14,7 +14,7 @@ namespace mica {
 
 class DirectSolver : public LinearSolver {
  public:
-  DirectSolver() = default;
+  DirectSolver();
   ~DirectSolver() override;
   DirectSolver(const DirectSolver&) = delete;  // owns CHOLMOD workspaces
   DirectSolver& operator=(const DirectSolver&) = delete;

@@ -48,9 +48,8 @@ std::vector<BodyOverlap> World::find_overlaps(Body& created) {
 }
 
 std::string World::overlap_message(Id created, const BodyOverlap& o) const {
-  using Bodies = SlotMap<Body, IdKind::Body>;
-  const std::string a = body(created).name + " (id " + Bodies::hex(created) + ")";
-  const std::string b = body(o.other).name + " (id " + Bodies::hex(o.other) + ")";
+  const std::string& a = body(created).name;  // "body 0x...": its id
+  const std::string& b = body(o.other).name;
   const std::string& owner = body(o.node_of_created ? created : o.other).name;
   const std::string& host = body(o.node_of_created ? o.other : created).name;
   return a + " was created overlapping " + b + " by " + metres(o.depth) + " (node " + std::to_string(o.node) + " of " +
@@ -70,8 +69,7 @@ void World::warn_if_inside_a_body(Id tool_id) const {
     if (near.tri < 0 || (t.position - near.point.point).dot(near.outward) >= 0) return;
     settings_.log(LogLevel::Warning,
                   "tool (id " + SlotMap<Tool, IdKind::Tool>::hex(tool_id) + ") was created with its origin " +
-                      metres(near.distance) + " inside " + b.name + " (id " + SlotMap<Body, IdKind::Body>::hex(id) +
-                      "): mica_tool_set_pose sweeps a tool from its last pose, so its first move would drag the "
+                      metres(near.distance) + " inside " + b.name + ": mica_tool_set_pose sweeps a tool from its last pose, so its first move would drag the "
                       "tissue on its way. Create it at its start pose (mica_tool_def.position), or move it there "
                       "with mica_tool_teleport.");
   });

@@ -91,7 +91,8 @@ void World::prepare_step(double h) {
   StepContext& ctx = step_;  // its lists keep their capacity from step to step
   ctx.start = StepContext::Clock::now();
   ctx.deadline.reset();
-  if (settings_.time_budget_ms > 0)
+  constexpr double kNoBudgetAboveMs = 86400e3;  // a budget beyond a day is no budget (nor a clock overflow)
+  if (settings_.time_budget_ms > 0 && settings_.time_budget_ms <= kNoBudgetAboveMs)
     ctx.deadline = ctx.start + std::chrono::duration_cast<StepContext::Clock::duration>(
                                    std::chrono::duration<double, std::milli>(settings_.time_budget_ms));
   ctx.pool = pool_.get();
@@ -409,7 +410,14 @@ void World::solve(const StepContext& ctx) {
                   "Delassus matrix with one linear solve per row, which takes seconds above some hundred rows "
                   "(docs/solvers.md); MICA_SOLVER_MICA scales to such contact sets");
   }
-  add_to_stats(solver_->solve(ctx, solver_bodies_, rows, lambda));
+  try {
+    add_to_stats(solver_->solve(ctx, solver_bodies_, rows, lambda));
+  } catch (const Error& e) {
+    if (e.code() != Errc::Numerical) throw;
+    std::string bodies;  // the solve is of every dynamic body at once: name them
+    for (const Body* b : ctx.dynamic) bodies += (bodies.empty() ? "" : ", ") + b->name;
+    fail(Errc::Numerical, "the velocity solve of " + bodies + " failed: " + e.what() + "; the step was undone");
+  }
 }
 
 void World::compute_forces(const StepContext& ctx) {

@@ -29,7 +29,7 @@ void validate(const WorldSettings& s) {
     if (!ok) fail(Errc::InvalidArgument, message);
   };
   require_finite(s.gravity, "gravity");
-  require(s.tolerance > 0 && std::isfinite(s.tolerance), "tolerance must be finite and > 0");
+  require(s.tolerance > 0 && std::isfinite(s.tolerance), "tolerance must be finite and > 0, got " + number_text(s.tolerance));
   require(s.max_iterations >= 1, "max_iterations must be >= 1");
   require(s.pgs_sweeps >= 1, "pgs_sweeps must be >= 1");
   require(s.max_recovery_speed > 0 && std::isfinite(s.max_recovery_speed),
@@ -73,13 +73,8 @@ Id World::add_body(const TetMesh& mesh, const BodySettings& settings, const Vec3
   if (!(beta >= 0) || !std::isfinite(beta)) fail(Errc::InvalidArgument, "rayleigh_beta must be finite and >= 0");
   TetMesh placed = mesh;  // the rest shape sits where the body is placed
   for (Vec3& p : placed.nodes) p += translation;
-  auto body = std::make_unique<Body>(placed, settings, "body " + std::to_string(bodies_created_), uint64_t(bodies_created_));
-  const QualityReport& q = body->fem.quality;
-  if (!q.slivers.empty() && settings_.log)
-    settings_.log(LogLevel::Warning, body->name + ": " + std::to_string(q.slivers.size()) +
-                                         " sliver elements (aspect ratio above 100), the first is tet " +
-                                         std::to_string(q.slivers.front()) + "; worst aspect " +
-                                         std::to_string(q.worst_aspect) + ". They slow iterative solvers.");
+  // Named by its id once it has one (messages name what the host holds); until then, while it is made.
+  auto body = std::make_unique<Body>(placed, settings, "the new body", uint64_t(bodies_created_));
   if (!settings.is_static)
     for (Vec3List* w : {&body->v, &body->v_previous})
       for (Vec3& u : *w) u = velocity;
@@ -90,8 +85,16 @@ Id World::add_body(const TetMesh& mesh, const BodySettings& settings, const Vec3
   }
   std::vector<BodyOverlap> overlaps = find_overlaps(*body);  // may throw: nothing changed yet
   overlapping_.reserve(overlapping_.size() + overlaps.size());
+  Body& created = *body;
   const Id id = bodies_.insert(std::move(body));
   ++bodies_created_;
+  created.name = "body " + SlotMap<Body, IdKind::Body>::hex(id);
+  const QualityReport& q = created.fem.quality;
+  if (!q.slivers.empty() && settings_.log)
+    settings_.log(LogLevel::Warning, created.name + ": " + std::to_string(q.slivers.size()) +
+                                         " sliver elements (aspect ratio above 100), the first is tet " +
+                                         std::to_string(q.slivers.front()) + "; worst aspect " +
+                                         std::to_string(q.worst_aspect) + ". They slow iterative solvers.");
   last_overlaps_ = std::move(overlaps);
   for (const BodyOverlap& o : last_overlaps_) {
     overlapping_.emplace_back(id, o.other);

@@ -281,6 +281,11 @@ static const double kBadYoungs[] = {0.0, -1e4};
 static void youngs_outside(mica_body_def* d, int i) { d->youngs_modulus = kBadYoungs[i]; }
 static const double kBadPoisson[] = {0.5, 0.7, -0.1};
 static void poisson_outside(mica_body_def* d, int i) { d->poisson_ratio = kBadPoisson[i]; }
+/* Finite, positive, but beyond what the step's matrix can hold in double precision. */
+static const double kHugeYoungs[] = {1e300, 1e200};
+static void youngs_huge(mica_body_def* d, int i) { d->youngs_modulus = kHugeYoungs[i]; }
+static const double kTinyDensity[] = {1e-300, 1e-200};
+static void density_tiny(mica_body_def* d, int i) { d->density = kTinyDensity[i]; }
 static const double kBadDensity[] = {0.0, -1};
 static void density_outside(mica_body_def* d, int i) { d->density = kBadDensity[i]; }
 static void alpha_negative(mica_body_def* d, int i) {
@@ -341,8 +346,12 @@ static const bad_case kDefCases[] = {
      {.body_def = velocity2_nonfinite}},
     {"body def: youngs_modulus <= 0", create_box_spoiled, MICA_ERR_INVALID_ARGUMENT, NULL, COUNT_OF(kBadYoungs),
      {.body_def = youngs_outside}},
-    {"body def: poisson_ratio outside [0, 0.5)", create_box_spoiled, MICA_ERR_INVALID_ARGUMENT, NULL,
+    {"body def: poisson_ratio outside [0, 0.5)", create_box_spoiled, MICA_ERR_INVALID_ARGUMENT, "got",
      COUNT_OF(kBadPoisson), {.body_def = poisson_outside}},
+    {"body def: youngs_modulus beyond double precision", create_box_spoiled, MICA_ERR_INVALID_ARGUMENT,
+     "stiffness", COUNT_OF(kHugeYoungs), {.body_def = youngs_huge}},
+    {"body def: density beyond double precision", create_box_spoiled, MICA_ERR_INVALID_ARGUMENT, "mass",
+     COUNT_OF(kTinyDensity), {.body_def = density_tiny}},
     {"body def: density <= 0", create_box_spoiled, MICA_ERR_INVALID_ARGUMENT, NULL, COUNT_OF(kBadDensity),
      {.body_def = density_outside}},
     {"body def: rayleigh_alpha < 0", create_box_spoiled, MICA_ERR_INVALID_ARGUMENT, NULL, 1,

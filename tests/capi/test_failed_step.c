@@ -9,6 +9,7 @@
 #include <setjmp.h>
 #include <stdint.h>
 #include <stdlib.h>
+#include <stdio.h>
 #include <string.h>
 #include <cmocka.h>
 
@@ -172,6 +173,10 @@ static void test_a_failed_step_changes_no_readout(void** state) {
     readout before = read_world(&failing, 1);
     set_all_forces(&failing, failing.box.body, 1e308);
     assert_int_equal(mica_step(failing.w, 0.01), MICA_ERR_NUMERICAL);
+    /* The message names the body by the id the host holds. */
+    char id[32];
+    snprintf(id, sizeof id, "body 0x%llx", (unsigned long long)failing.box.body);
+    assert_non_null(strstr(mica_world_last_error(failing.w), id));
     set_all_forces(&failing, failing.box.body, 0);
     readout after = read_world(&failing, 1);
     assert_same_readout(&before, &after);

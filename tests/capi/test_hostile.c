@@ -8,6 +8,7 @@
  *
  * Files are written only to a fresh directory under /tmp, removed at the end. */
 #define _POSIX_C_SOURCE 200809L
+#include <float.h>
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -782,11 +783,36 @@ static void test_tool_closed_around_a_body(void** state) {
   mica_world_destroy(w);
 }
 
+/* A host's "no real limit" for the time budget (1e300, DBL_MAX) is no budget: the step converges
+ * as without one (0.6 overflowed the clock's duration and stopped every step at once). */
+static void test_a_huge_time_budget_is_no_budget(void** state) {
+  (void)state;
+  const double budgets[] = {0, 1e300, DBL_MAX, 86400e3 * 2};
+  int32_t iterations[4];
+  for (int k = 0; k < 4; ++k) {
+    mica_world_def wd = mica_world_def_default();
+    wd.time_budget_ms = budgets[k];
+    mica_world* w = NULL;
+    assert_int_equal(mica_world_create(&wd, &w), MICA_OK);
+    add_block(w);
+    add_sphere(w, 0.002);
+    for (int s = 0; s < 3; ++s) assert_int_equal(mica_step(w, 0.01), MICA_OK);
+    mica_world_stats stats = {sizeof stats};
+    assert_int_equal(mica_world_get_stats(w, &stats), MICA_OK);
+    assert_int_equal(stats.out_of_time, 0);
+    assert_int_equal(stats.converged, 1);
+    iterations[k] = stats.solver_iterations;
+    assert_int_equal(iterations[k], iterations[0]);
+    mica_world_destroy(w);
+  }
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_duplicate_tets_are_refused),
       cmocka_unit_test(test_device_poses_are_validated),
       cmocka_unit_test(test_time_steps_below_the_floor),
+      cmocka_unit_test(test_a_huge_time_budget_is_no_budget),
       cmocka_unit_test(test_failed_step_leaves_the_device_tool),
       cmocka_unit_test(test_failed_step_keeps_the_factor_schedule),
       cmocka_unit_test(test_loaders_refuse_special_and_huge_files),

@@ -3,6 +3,12 @@
 // CHOLMOD (DirectSolver) against a dense Cholesky of the same matrix (also as the nodes held still
 // change, which the factor leaves out), and projected PCG
 // (PcgSolver) against CHOLMOD, for solve and solve_homogeneous; PCG stops at its deadline.
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstring>
+
+#include "core/error.hpp"
 #include "solver/direct_solver.hpp"  // before cmocka (test_util.hpp)
 #include "solver/pcg.hpp"
 #include "solver/solver_problem.hpp"
@@ -118,10 +124,47 @@ static void test_pcg_stops_at_its_deadline(void**) {
   assert_false(r.converged);
 }
 
+// A system that is not positive definite: the factorization throws Error(Numerical) with
+// CHOLMOD's reason, and nothing reaches the process's stdout or stderr (CHOLMOD prints by default).
+static void test_direct_failure_prints_nothing(void**) {
+  SolverProblem p(0, 2, false);
+  for (Mat3& block : p.A) block = -block;  // negative definite
+  const ProjectedSystem sys{p.fem.pattern, p.A, p.projection};
+  std::fflush(stdout);
+  std::fflush(stderr);
+  FILE* capture = std::tmpfile();
+  assert_non_null(capture);
+  const int saved_out = dup(1), saved_err = dup(2);
+  dup2(fileno(capture), 1);
+  dup2(fileno(capture), 2);
+  std::string message;
+  try {
+    DirectSolver direct;
+    direct.analyze(p.fem.pattern);
+    direct.factorize(sys);
+  } catch (const Error& e) {
+    message = e.what();
+  }
+  std::fflush(stdout);
+  std::fflush(stderr);
+  dup2(saved_out, 1);
+  dup2(saved_err, 2);
+  close(saved_out);
+  close(saved_err);
+  std::fseek(capture, 0, SEEK_END);
+  const long printed = std::ftell(capture);
+  std::fclose(capture);
+  print_message("message: %s; %ld bytes printed\n", message.c_str(), printed);
+  assert_int_equal(printed, 0);
+  assert_non_null(std::strstr(message.c_str(), "not positive definite"));
+  assert_non_null(std::strstr(message.c_str(), "CHOLMOD warning"));
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_direct_matches_dense),
       cmocka_unit_test(test_direct_follows_the_held_nodes),
+      cmocka_unit_test(test_direct_failure_prints_nothing),
       cmocka_unit_test(test_pcg_matches_direct),
       cmocka_unit_test(test_pcg_stops_at_its_deadline),
   };
