@@ -165,6 +165,15 @@ class Behaviour(unittest.TestCase):
         with self.assertRaises(TypeError):
             mica.world_def(no_such_field=1)
 
+    def test_version_and_type_marker(self):
+        # mica.__version__ is the header's version, which the loaded library (built with it) reports.
+        v = mica.version()
+        self.assertEqual(mica.__version__, "%d.%d.%d" % (v // 10000, v // 100 % 100, v % 100))
+        self.assertEqual(mica.__version__, "%d.%d.%d" % (mica.MICA_VERSION_MAJOR, mica.MICA_VERSION_MINOR,
+                                                         mica.MICA_VERSION_PATCH))
+        # PEP 561: without py.typed, type checkers treat the package as untyped.
+        self.assertTrue(os.path.isfile(os.path.join(os.path.dirname(mica.__file__), "py.typed")))
+
     def test_errors_raise_with_the_message(self):
         with mica.World() as world:
             with self.assertRaises(mica.MicaError) as e:

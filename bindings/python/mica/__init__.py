@@ -35,7 +35,10 @@ from typing import Any, Callable, Optional, Sequence, Tuple, Union
 import numpy as np
 
 from . import _native as native
-from ._native import MICA_VERSION_NUMBER
+from ._native import MICA_VERSION_MAJOR, MICA_VERSION_MINOR, MICA_VERSION_NUMBER, MICA_VERSION_PATCH
+
+# The binding's version: that of the header it mirrors (mica.version() is the loaded library's).
+__version__ = "%d.%d.%d" % (MICA_VERSION_MAJOR, MICA_VERSION_MINOR, MICA_VERSION_PATCH)
 
 _HERE = os.path.dirname(os.path.abspath(__file__))
 
