@@ -142,8 +142,8 @@ M.lpc_def = def_maker("mica_lpc_def", "mica_lpc_def_init")
 M.tool_def = def_maker("mica_tool_def", "mica_tool_def_init")
 M.device_def = def_maker("mica_device_def", "mica_device_def_init")
 
--- A C array of the n (default 3) numbers of a Lua table; `name` (what the values are, for the
--- message) names them when the table has another length.
+-- A C array (of `ctype`, default double) of the n (default 3) numbers of a Lua table; `name` says
+-- what they are in the message raised when the table has another length.
 local function vec(values, n, name, ctype)
   n = n or 3
   local out = ffi.new((ctype or "double") .. "[?]", math.max(n, 1))

@@ -229,7 +229,7 @@ class Behaviour(unittest.TestCase):
             grab = body.grab((0, 1, 0), 0.1)
             refused("set_handle_pose orientation: expected 4 values, got 2", grab.set_handle_pose, (0, 1, 0), (1, 0))
             refused("set_velocity velocity: expected 3 values, got 2", grab.set_velocity, (0, 1))
-            refused("gravity: expected 3 values, got 2", world.set_gravity, (0, -9.81))
+            refused("set_gravity gravity: expected 3 values, got 2", world.set_gravity, (0, -9.81))
 
             # Arrays of rows: each row has its width (a flat array, a multiple of it).
             n = body.counts()[0]

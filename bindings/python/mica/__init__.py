@@ -373,7 +373,7 @@ class World:
         return self._check(native.mica_step(handle, dt), "mica_step") == native.MICA_OK
 
     def set_gravity(self, gravity: Vec3) -> None:
-        self._check(native.mica_world_set_gravity(self.handle, _doubles(gravity, 3, "gravity")),
+        self._check(native.mica_world_set_gravity(self.handle, _doubles(gravity, 3, "set_gravity gravity")),
                     "mica_world_set_gravity")
 
     def stats(self) -> native.mica_world_stats:
