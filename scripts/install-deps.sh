@@ -5,7 +5,7 @@
 set -eu
 
 PACKAGES="g++ cmake make pkg-config libeigen3-dev libsuitesparse-dev libopenblas0 libccd-dev libcmocka-dev
-doxygen python3 python3-numpy python3-matplotlib libsiconos-numerics-dev
+doxygen python3 python3-numpy python3-matplotlib python3-venv python3-pip python3-setuptools libsiconos-numerics-dev
 luajit mono-mcs mono-runtime libmono-system-numerics-vectors4.0-cil abigail-tools clang-14 libclang-rt-14-dev llvm-14 graphviz"
 
 missing=""

@@ -64,14 +64,15 @@ Error.__tostring = function(e)
 end
 M.Error = Error
 
+local function raise(status, message)
+  error(setmetatable({ status = status, message = message, name = ffi.string(C.mica_status_string(status)) },
+                     Error))
+end
+
 -- Raises a mica.Error for status < 0 (message from mica_world_last_error(world_ptr), which may
 -- be nil); returns the status otherwise, so warnings (status > 0) reach the caller.
 function M.check(status, world_ptr)
-  if status < 0 then
-    local message = ffi.string(C.mica_world_last_error(world_ptr))
-    error(setmetatable({ status = status, message = message,
-                         name = ffi.string(C.mica_status_string(status)) }, Error), 2)
-  end
+  if status < 0 then raise(status, ffi.string(C.mica_world_last_error(world_ptr))) end
   return status
 end
 local check = M.check
@@ -80,11 +81,44 @@ function M.version() return C.mica_version() end
 
 -- Definitions -----------------------------------------------------------------------------
 
--- Copies a table of field values (Lua tables for arrays) over a def.
+-- The element count of a fixed-size C array (a cdata such as a def's double[3] field), else nil.
+local function array_length(a)
+  if type(a) ~= "cdata" or not tostring(ffi.typeof(a)):find("%]>$") then return nil end
+  -- Its size over the distance between two elements (an element may itself be an array).
+  return ffi.sizeof(a) / tonumber(ffi.cast("const char*", a + 1) - ffi.cast("const char*", a))
+end
+
+-- Copies a Lua table of exactly n numbers (of n tables for an array of arrays) into the C array
+-- `array`; any other length raises "<name>: expected n values". (LuaJIT's own table initialiser
+-- would repeat a lone value or leave the rest zero, or unset in a double[?].)
+local function copy_values(array, n, values, name)
+  if type(values) ~= "table" or #values ~= n then
+    error(string.format("%s: expected %d values, got %s", name, n,
+                        type(values) == "table" and #values or "a " .. type(values)), 0)
+  end
+  for i = 1, n do
+    local element, where = array[i - 1], name .. "[" .. (i - 1) .. "]"
+    local inner = array_length(element)
+    if inner then
+      copy_values(element, inner, values[i], where)
+    elseif type(values[i]) ~= "number" then
+      error(where .. ": expected a number, got a " .. type(values[i]), 0)
+    else
+      array[i - 1] = values[i]
+    end
+  end
+end
+
+-- Copies a table of field values (Lua tables for arrays, of the array's length) over a def.
 local function fill(def, fields)
   for k, v in pairs(fields or {}) do
     assert(k ~= "struct_size", "struct_size is set by the *_init function")
-    def[k] = v
+    local n = type(v) == "table" and array_length(def[k])
+    if n then
+      copy_values(def[k], n, v, tostring(ffi.typeof(def)):match("<(.-)>") .. "." .. k)
+    else
+      def[k] = v
+    end
   end
   return def
 end
@@ -108,16 +142,27 @@ M.lpc_def = def_maker("mica_lpc_def", "mica_lpc_def_init")
 M.tool_def = def_maker("mica_tool_def", "mica_tool_def_init")
 M.device_def = def_maker("mica_device_def", "mica_device_def_init")
 
-local function vec(values, n)
-  return ffi.new("double[?]", n or 3, values)
+-- A C array (of `ctype`, default double) of the n (default 3) numbers of a Lua table; `name` says
+-- what they are in the message raised when the table has another length.
+local function vec(values, n, name, ctype)
+  n = n or 3
+  local out = ffi.new((ctype or "double") .. "[?]", math.max(n, 1))
+  copy_values(out, n, values, name or "vec")
+  return out
 end
 M.vec = vec
+local IDENTITY = { 1, 0, 0, 0 } -- the quaternion (w, x, y, z) of no rotation
 
 -- World -----------------------------------------------------------------------------------
 
 local World = {}
-World.__index = World
 M.World = World
+-- A closed world has no `ptr`: reading it (every method does) raises a mica.Error
+-- (MICA_ERR_WRONG_STATE, "the world is closed").
+World.__index = function(_, key)
+  if key == "ptr" then raise(C.MICA_ERR_WRONG_STATE, "the world is closed") end
+  return World[key]
+end
 
 -- Creates a world from a table of mica_world_def fields (or a filled mica_world_def). The
 -- world is destroyed by world:close() or, failing that, by the garbage collector (ffi.gc).
@@ -132,13 +177,15 @@ end
 -- for its devices.
 -- A replay's world (replay.world) belongs to the replay: close() leaves it to replay:close().
 function World:close()
-  if self.ptr ~= nil and self.replay == nil then
+  if not self:closed() and self.replay == nil then
     C.mica_world_destroy(ffi.gc(self.ptr, nil))
     self.ptr = nil
     for _, cb in ipairs(self.callbacks) do cb:free() end
     self.callbacks = {}
   end
 end
+
+function World:closed() return rawget(self, "ptr") == nil end
 
 function World:check(status) return check(status, self.ptr) end
 
@@ -152,8 +199,9 @@ end
 
 function World:create_box(lo, hi, cells, tets_per_cell, fields)
   local id = ffi.new("mica_body_id[1]")
-  self:check(C.mica_body_create_box(self.ptr, M.body_def(fields), vec(lo), vec(hi),
-                                    ffi.new("int32_t[3]", cells), tets_per_cell or 5, id))
+  self:check(C.mica_body_create_box(self.ptr, M.body_def(fields), vec(lo, 3, "create_box lo"),
+                                    vec(hi, 3, "create_box hi"), vec(cells, 3, "create_box cells", "int32_t"),
+                                    tets_per_cell or 5, id))
   return id[0]
 end
 
@@ -192,7 +240,7 @@ local function read_indices(self, call, width)
 end
 
 function World:select_nodes_by_plane(body, point, normal, tolerance, use_rest)
-  local p, n = vec(point), vec(normal)
+  local p, n = vec(point, 3, "select_nodes_by_plane point"), vec(normal, 3, "select_nodes_by_plane normal")
   return read_indices(self, function(out, cap, count)
     return C.mica_body_select_nodes_by_plane(self.ptr, body, p, n, tolerance or 1e-9,
                                              use_rest == false and 0 or 1, out, cap, count)
@@ -250,7 +298,13 @@ function World:von_mises(body)
   end, 1)
 end
 
+-- A constraint on `nodes` of `body`: a Lua table of 0-based node indices (then add_lpc(body, nodes,
+-- fields)), or an int32_t array and its count, as select_nodes_by_plane returns them.
 function World:add_lpc(body, nodes, count, fields)
+  if type(nodes) == "table" then
+    if type(count) ~= "number" then count, fields = #nodes, count end
+    nodes = vec(nodes, count, "add_lpc nodes", "int32_t")
+  end
   local id = ffi.new("mica_lpc_id[1]")
   self:check(C.mica_add_lpc(self.ptr, body, nodes, count, M.lpc_def(fields), id))
   return id[0]
@@ -262,16 +316,19 @@ function World:remove_lpc(lpc) self:check(C.mica_lpc_remove(self.ptr, lpc)) end
 -- id the handle follows that tool (forceps). Returns the constraint's id.
 function World:grab(body, center, radius, tool)
   local id = ffi.new("mica_lpc_id[1]")
-  self:check(C.mica_lpc_grab(self.ptr, body, vec(center), radius, tool or C.MICA_NULL_ID, id))
+  self:check(C.mica_lpc_grab(self.ptr, body, vec(center, 3, "grab center"), radius, tool or C.MICA_NULL_ID, id))
   return id[0]
 end
 
 -- Moves a grab's handle: position (m) and unit quaternion {w, x, y, z} (default identity).
 function World:set_handle_pose(lpc, position, orientation)
-  self:check(C.mica_lpc_set_handle_pose(self.ptr, lpc, vec(position), vec(orientation or { 1, 0, 0, 0 }, 4)))
+  self:check(C.mica_lpc_set_handle_pose(self.ptr, lpc, vec(position, 3, "set_handle_pose position"),
+                                        vec(orientation or IDENTITY, 4, "set_handle_pose orientation")))
 end
 
-function World:set_lpc_velocity(lpc, velocity) self:check(C.mica_lpc_set_velocity(self.ptr, lpc, vec(velocity))) end
+function World:set_lpc_velocity(lpc, velocity)
+  self:check(C.mica_lpc_set_velocity(self.ptr, lpc, vec(velocity, 3, "set_lpc_velocity velocity")))
+end
 
 -- Target positions {x1, y1, z1, ...} (m), one per node of the constraint.
 function World:set_lpc_targets(lpc, targets)
@@ -287,7 +344,8 @@ function World:lpc_reaction(lpc)
 end
 
 function World:set_tool_pose(tool, position, orientation)
-  self:check(C.mica_tool_set_pose(self.ptr, tool, vec(position), vec(orientation or { 1, 0, 0, 0 }, 4)))
+  self:check(C.mica_tool_set_pose(self.ptr, tool, vec(position, 3, "set_tool_pose position"),
+                                  vec(orientation or IDENTITY, 4, "set_tool_pose orientation")))
 end
 
 -- Force (double[3], N), torque (double[3], N m) and contacts of a tool in the last step.

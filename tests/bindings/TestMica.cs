@@ -316,6 +316,14 @@ static class TestMica
             double[] p = new double[3], q = new double[4];
             tool.GetPose(p, q);
             Expect(p[2] == 3 && q[0] == 1, "tool pose");
+            // Created at a position without unsafe code (double[] and Vector3); the def's is replaced.
+            world.CreateTool(tdef, new double[] { 0.5, 2, 0.25 }).GetPose(p, q);
+            Expect(p[0] == 0.5 && p[1] == 2 && p[2] == 0.25, "CreateTool(def, position)");
+            world.CreateTool(tdef, new System.Numerics.Vector3(1, 2, 3)).GetPose(p, q);
+            Expect(p[0] == 1 && p[1] == 2 && p[2] == 3, "CreateTool(def, Vector3)");
+            bool refused = false;
+            try { world.CreateTool(tdef, new double[] { 0.5 }); } catch (ArgumentException) { refused = true; }
+            Expect(refused && world.GetIds(MicaNative.MICA_OBJECT_TOOL).Length == 3, "a position of 1 value is refused");
             var stats = world.GetStats();
             Expect(stats.step_count == 1 && stats.Stage(MicaNative.MICA_STAGE_SOLVE).runs_last_step == 1, "stats");
         }

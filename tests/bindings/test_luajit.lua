@@ -142,6 +142,95 @@ test("errors raise mica.Error with the library's message", function()
   world:close() -- twice is harmless
 end)
 
+-- Runs fn (which must raise) and checks the message names the problem: a Lua string or a mica.Error.
+local function expect_refused(pattern, fn, ...)
+  local ok, err = pcall(fn, ...)
+  local message = type(err) == "table" and err.message or tostring(err)
+  expect(not ok and message:find(pattern, 1, true), "expected '" .. pattern .. "', got " .. tostring(ok and "no error" or message))
+  return err
+end
+
+test("a table of the wrong length is refused, naming what and where", function()
+  local world = mica.world{ gravity = { 0, 0, 0 } }
+  local tool = world:create_tool{ radius = 0.01, position = { 0.1, 0.2, 0.3 } }
+  local p, q = ffi.new("double[3]"), ffi.new("double[4]")
+  local function pose()
+    world:check(C.mica_tool_get_pose(world.ptr, tool, p, q))
+    return { p[0], p[1], p[2] }
+  end
+  local function same(a, b) return a[1] == b[1] and a[2] == b[2] and a[3] == b[3] end
+  expect(same(pose(), { 0.1, 0.2, 0.3 }), "a def's position of 3 values is taken as given")
+  for _, short in ipairs({ { 0.2 }, { 0.1, 0.2 }, { 0.1, 0.2, 0.3, 0.4 }, {} }) do
+    expect_refused("set_tool_pose position: expected 3 values, got " .. #short, world.set_tool_pose, world, tool, short)
+  end
+  expect_refused("set_tool_pose position[1]: expected a number, got a string", world.set_tool_pose, world, tool,
+                 { 0, "y", 0 })
+  expect_refused("set_tool_pose orientation: expected 4 values, got 3", world.set_tool_pose, world, tool,
+                 { 0, 0.3, 0 }, { 1, 0, 0 })
+  expect_refused("set_tool_pose position: expected 3 values, got a number", world.set_tool_pose, world, tool, 0.2)
+  expect(same(pose(), { 0.1, 0.2, 0.3 }), "a refused pose leaves the tool where it was")
+  world:set_tool_pose(tool, { 0.1, 0.25, 0.3 })
+  expect(same(pose(), { 0.1, 0.25, 0.3 }), "a pose of 3 values is taken as given")
+
+  expect_refused("mica_tool_def.position: expected 3 values, got 1", world.create_tool, world, { position = { 0.5 } })
+  expect_refused("mica_tool_def.orientation: expected 4 values, got 2", world.create_tool, world,
+                 { orientation = { 1, 0 } })
+  expect_refused("mica_world_def.gravity: expected 3 values, got 2", mica.world, { gravity = { 0, -9.81 } })
+  expect_refused("mica_lpc_def.direction: expected 2 values, got 1", mica.lpc_def, { direction = { { 1, 0, 0 } } })
+  expect_refused("mica_lpc_def.direction[1]: expected 3 values, got 2", mica.lpc_def,
+                 { direction = { { 1, 0, 0 }, { 0, 1 } } })
+  local d = mica.lpc_def{ direction = { { 1, 0, 0 }, { 0, 1, 0 } } }
+  expect(d.direction[0][0] == 1 and d.direction[1][1] == 1 and d.direction[1][0] == 0, "an array of arrays is copied")
+  local _, tools = world:ids(C.MICA_OBJECT_TOOL)
+  expect(tools == 1, "no tool was made from a refused def")
+
+  expect_refused("create_box cells: expected 3 values, got 2", world.create_box, world, { 0, 0, 0 }, { 1, 1, 1 }, { 2, 2 })
+  expect_refused("create_box lo: expected 3 values, got 1", world.create_box, world, { 0 }, { 1, 1, 1 }, { 2, 2, 2 })
+  local body = world:create_box({ 0, 0, 0 }, { 1, 1, 1 }, { 1, 1, 1 })
+  expect_refused("select_nodes_by_plane normal: expected 3 values, got 2", world.select_nodes_by_plane, world, body,
+                 { 0, 0, 0 }, { 0, 1 })
+  expect_refused("grab center: expected 3 values, got 4", world.grab, world, body, { 0, 0, 0, 0 }, 0.1)
+  local grab = world:grab(body, { 0, 1, 0 }, 0.1)
+  expect_refused("set_handle_pose orientation: expected 4 values, got 1", world.set_handle_pose, world, grab,
+                 { 0, 1, 0 }, { 1 })
+  expect_refused("set_lpc_velocity velocity: expected 3 values, got 0", world.set_lpc_velocity, world, grab, {})
+  world:close()
+end)
+
+test("add_lpc takes a Lua table of nodes", function()
+  local world = mica.world{ gravity = { 0, 0, 0 } }
+  local body = world:create_box({ 0, 0, 0 }, { 1, 1, 1 }, { 1, 1, 1 })
+  local function nodes_of(lpc)
+    local out, n = ffi.new("int32_t[8]"), ffi.new("int32_t[1]")
+    world:check(C.mica_lpc_get_nodes(world.ptr, lpc, out, 8, n))
+    local list = {}
+    for i = 0, n[0] - 1 do list[#list + 1] = out[i] end
+    table.sort(list)
+    return table.concat(list, " ")
+  end
+  expect(nodes_of(world:add_lpc(body, { 4, 0, 2 })) == "0 2 4", "the nodes of a table")
+  local plane = world:add_lpc(body, { 1, 3 }, { kind = C.MICA_LPC_PLANE, direction = { { 0, 1, 0 }, { 0, 0, 0 } } })
+  expect(nodes_of(plane) == "1 3", "a table of nodes and the def's fields")
+  local bottom, n = world:select_nodes_by_plane(body, { 0, 0, 0 }, { 0, 1, 0 })
+  expect(nodes_of(world:add_lpc(body, bottom, n)) ~= "", "an int32_t array and its count, as before")
+  expect_refused("add_lpc nodes: expected 3 values, got 2", world.add_lpc, world, body, { 5, 6 }, 3)
+  expect_refused("add_lpc nodes[1]: expected a number, got a string", world.add_lpc, world, body, { 5, "6" })
+  world:close()
+end)
+
+test("a closed world says so", function()
+  local world = mica.world()
+  local body = world:create_box({ 0, 0, 0 }, { 1, 1, 1 }, { 1, 1, 1 })
+  expect(not world:closed(), "an open world")
+  world:close()
+  expect(world:closed(), "closed")
+  local err = expect_refused("the world is closed", world.step, world, 0.01)
+  expect(getmetatable(err) == mica.Error and err.status == C.MICA_ERR_WRONG_STATE, "a mica.Error, MICA_ERR_WRONG_STATE")
+  expect_refused("the world is closed", world.positions, world, body)
+  expect_refused("the world is closed", world.create_tool, world, { radius = 0.01 })
+  world:close() -- closing again is harmless
+end)
+
 test("positions view is zero-copy", function()
   local world = mica.world()
   local body = world:create_box({ 0, 0, 0 }, { 1, 1, 1 }, { 2, 2, 2 })
@@ -463,9 +552,9 @@ test("a recorded session replays bit for bit, with the recorded ids", function()
   end
   expect(k == RECORDED_STEPS, "the step count: " .. k)
   world:close() -- the replay's world is the replay's: this leaves it alone
-  expect(world.ptr ~= nil and not replay:step(), "the end stays the end")
+  expect(not world:closed() and not replay:step(), "the end stays the end")
   replay:close()
-  expect(world.ptr == nil, "closing the replay closes its world")
+  expect(world:closed(), "closing the replay closes its world")
   replay:close() -- twice is harmless
   os.remove(path)
 end)

@@ -165,6 +165,15 @@ class Behaviour(unittest.TestCase):
         with self.assertRaises(TypeError):
             mica.world_def(no_such_field=1)
 
+    def test_version_and_type_marker(self):
+        # mica.__version__ is the header's version, which the loaded library (built with it) reports.
+        v = mica.version()
+        self.assertEqual(mica.__version__, "%d.%d.%d" % (v // 10000, v // 100 % 100, v % 100))
+        self.assertEqual(mica.__version__, "%d.%d.%d" % (mica.MICA_VERSION_MAJOR, mica.MICA_VERSION_MINOR,
+                                                         mica.MICA_VERSION_PATCH))
+        # PEP 561: without py.typed, type checkers treat the package as untyped.
+        self.assertTrue(os.path.isfile(os.path.join(os.path.dirname(mica.__file__), "py.typed")))
+
     def test_errors_raise_with_the_message(self):
         with mica.World() as world:
             with self.assertRaises(mica.MicaError) as e:
@@ -182,6 +191,71 @@ class Behaviour(unittest.TestCase):
         with self.assertRaises(mica.MicaError) as e:
             mica.World(header_version=(mica.MICA_VERSION_MAJOR + 1) * 10000)
         self.assertEqual(e.exception.status, mica.MICA_ERR_VERSION_MISMATCH)
+
+    def test_wrong_length_sequences_are_refused(self):
+        # A fixed-size array takes exactly its count of values: never padded, never an IndexError.
+        with mica.World(gravity=(0, 0, 0)) as world:
+            def refused(message, call, *args, **kwargs):
+                with self.assertRaises(ValueError) as e:
+                    call(*args, **kwargs)
+                self.assertEqual(str(e.exception), message)
+
+            for cells in ((2, 2), (2, 2, 2, 2), ()):
+                refused("create_box cells: expected 3 values, got %d" % len(cells),
+                        world.create_box, (0, 0, 0), (1, 1, 1), cells)
+            refused("create_box lo: expected 3 values, got 2", world.create_box, (0, 0), (1, 1, 1), (1, 1, 1))
+            refused("create_box hi: expected 3 values, got 4", world.create_box, (0, 0, 0), (1, 1, 1, 1), (1, 1, 1))
+            with self.assertRaises(TypeError) as e:
+                world.create_box((0, 0, 0), (1, 1, 1), 2)
+            self.assertEqual(str(e.exception), "create_box cells: expected 3 values, got int")
+            self.assertEqual(world.ids(mica.MICA_OBJECT_BODY), [], "no body from a refused call")
+            body = world.create_box((0, 0, 0), (1, 1, 1), np.array([1, 1, 1]))
+
+            tool = world.create_tool(radius=0.01, position=(0.1, 2, 0.3))
+            refused("mica_tool_def.position: expected 3 values, got 1", world.create_tool, position=(0.5,))
+            refused("mica_tool_def.orientation: expected 4 values, got 3", world.create_tool, orientation=(1, 0, 0))
+            refused("mica_lpc_def.direction[1]: expected 3 values, got 2", mica.lpc_def,
+                    direction=((1, 0, 0), (0, 1)))
+            refused("mica_world_def.gravity: expected 3 values, got 4", mica.World, gravity=(0, 0, 0, 0))
+            for position in ((0.2,), (0.1, 0.2), (0.1, 0.2, 0.3, 0.4)):
+                refused("set_pose position: expected 3 values, got %d" % len(position), tool.set_pose, position)
+            refused("set_pose orientation: expected 4 values, got 5", tool.set_pose, (0, 2, 0), (1, 0, 0, 0, 0))
+            np.testing.assert_array_equal(tool.pose()[0], (0.1, 2, 0.3), "a refused pose leaves the tool alone")
+
+            refused("select_nodes_by_plane normal: expected 3 values, got 2", body.select_nodes_by_plane,
+                    (0, 0, 0), (0, 1))
+            refused("select_nodes_in_box hi: expected 3 values, got 2", body.select_nodes_in_box, (0, 0, 0), (1, 1))
+            refused("grab center: expected 3 values, got 1", body.grab, (0,), 0.1)
+            grab = body.grab((0, 1, 0), 0.1)
+            refused("set_handle_pose orientation: expected 4 values, got 2", grab.set_handle_pose, (0, 1, 0), (1, 0))
+            refused("set_velocity velocity: expected 3 values, got 2", grab.set_velocity, (0, 1))
+            refused("set_gravity gravity: expected 3 values, got 2", world.set_gravity, (0, -9.81))
+
+            # Arrays of rows: each row has its width (a flat array, a multiple of it).
+            n = body.counts()[0]
+            refused("mica_body_set_positions: expected 3 values a row, got an array of shape (%d, 2)" % n,
+                    body.set_positions, np.zeros((n, 2)))
+            refused("create_body nodes: expected 3 values a row, got an array of shape (6, 2)",
+                    world.create_body, np.zeros((6, 2)), [0, 1, 2, 3])
+            refused("create_body tets: expected 4 values a row, got an array of shape (3,)",
+                    world.create_body, np.eye(4, 3), [0, 1, 2])
+            refused("set_targets targets: expected 3 values a row, got an array of shape (2, 4)",
+                    grab.set_targets, np.zeros((2, 4)))
+
+    @unittest.skipIf("mica_device_create" in native.missing, "the loaded libmica has no device functions yet")
+    def test_a_trajectory_of_the_wrong_length_is_reported(self):
+        # The trajectory runs inside a C callback: its error goes to sys.unraisablehook.
+        reported = []
+        hook, sys.unraisablehook = sys.unraisablehook, lambda u: reported.append(str(u.exc_value))
+        try:
+            with mica.World(gravity=(0, 0, 0)) as world:
+                device = world.create_device(definition=mica.device_def(backend=mica.MICA_DEVICE_SIMULATED),
+                                             tool=world.create_tool(radius=0.01), trajectory=lambda t: (0, 0.1))
+                device.poll()
+        finally:
+            sys.unraisablehook = hook
+        self.assertTrue(reported, "the trajectory was called")
+        self.assertRegex(reported[0], r"^trajectory\(.*\): expected 3 values, got 2$")
 
     def test_warning_when_not_converged(self):
         with mica.World(solver=mica.MICA_SOLVER_PCG, max_iterations=1, tolerance=1e-14) as world:

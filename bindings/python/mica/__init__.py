@@ -35,7 +35,10 @@ from typing import Any, Callable, Optional, Sequence, Tuple, Union
 import numpy as np
 
 from . import _native as native
-from ._native import MICA_VERSION_NUMBER
+from ._native import MICA_VERSION_MAJOR, MICA_VERSION_MINOR, MICA_VERSION_NUMBER, MICA_VERSION_PATCH
+
+# The binding's version: that of the header it mirrors (mica.version() is the loaded library's).
+__version__ = "%d.%d.%d" % (MICA_VERSION_MAJOR, MICA_VERSION_MINOR, MICA_VERSION_PATCH)
 
 _HERE = os.path.dirname(os.path.abspath(__file__))
 
@@ -100,13 +103,23 @@ def version() -> int:
     return native.mica_version()
 
 
-def _assign(array, value):
+def _expect_length(values, n, name):
+    # A fixed-size array takes exactly n values: ctypes would pad a short sequence with zeros
+    # and refuse a long one with an IndexError naming nothing.
+    try:
+        got = len(values)
+    except TypeError:
+        raise TypeError("%s: expected %d values, got %s" % (name, n, type(values).__name__)) from None
+    if got != n:
+        raise ValueError("%s: expected %d values, got %d" % (name, n, got))
+
+
+def _assign(array, value, name):
     # Copies a (nested) Python sequence into a ctypes array field.
-    if len(value) != len(array):
-        raise ValueError("expected %d values, got %d" % (len(array), len(value)))
+    _expect_length(value, len(array), name)
     for i, v in enumerate(value):
         if isinstance(array[i], ctypes.Array):
-            _assign(array[i], v)
+            _assign(array[i], v, "%s[%d]" % (name, i))
         else:
             array[i] = v
 
@@ -118,7 +131,7 @@ def _fill(struct, fields):
             raise TypeError("%s has no settable field '%s'" % (type(struct).__name__, key))
         current = getattr(struct, key)
         if isinstance(current, ctypes.Array) and not isinstance(value, ctypes.Array):
-            _assign(current, value)
+            _assign(current, value, "%s.%s" % (type(struct).__name__, key))
         else:
             setattr(struct, key, value)
     return struct
@@ -161,11 +174,22 @@ def device_def(**fields: Any) -> native.mica_device_def:
     return _fill(d, fields)
 
 
-def _doubles(values, n):
-    a = (c_double * n)(*values)
-    if len(values) != n:
-        raise ValueError("expected %d values, got %d" % (n, len(values)))
-    return a
+def _array(ctype, values, n, name):
+    """A ctypes array of exactly n values (`name` says what they are when the length is wrong)."""
+    _expect_length(values, n, name)
+    return (ctype * n)(*values)
+
+
+def _doubles(values, n, name):
+    return _array(c_double, values, n, name)
+
+
+def _rows(values, width, dtype, name):
+    """`values` as a C-contiguous (k, width) array: a flat sequence of k * width values or k rows of width."""
+    a = np.ascontiguousarray(values, dtype=dtype)
+    if (a.ndim > 1 and a.shape[-1] != width) or a.size % width:
+        raise ValueError("%s: expected %d values a row, got an array of shape %s" % (name, width, a.shape))
+    return a.reshape(-1, width)
 
 
 def _id_of(obj):
@@ -349,7 +373,8 @@ class World:
         return self._check(native.mica_step(handle, dt), "mica_step") == native.MICA_OK
 
     def set_gravity(self, gravity: Vec3) -> None:
-        self._check(native.mica_world_set_gravity(self.handle, _doubles(gravity, 3)), "mica_world_set_gravity")
+        self._check(native.mica_world_set_gravity(self.handle, _doubles(gravity, 3, "set_gravity gravity")),
+                    "mica_world_set_gravity")
 
     def stats(self) -> native.mica_world_stats:
         """A mica_world_stats of the last step (stages indexed by MICA_STAGE_*)."""
@@ -411,8 +436,8 @@ class World:
                     **fields: Any) -> Body:
         """A body from nodes (n, 3) in m and tets (m, 4) of 0-based indices."""
         d = _fill(definition if definition is not None else body_def(), fields)
-        nodes = np.ascontiguousarray(nodes, dtype=np.float64).reshape(-1, 3)
-        tets = np.ascontiguousarray(tets, dtype=np.int32).reshape(-1, 4)
+        nodes = _rows(nodes, 3, np.float64, "create_body nodes")
+        tets = _rows(tets, 4, np.int32, "create_body tets")
         out = native.mica_body_id()
         self._check(native.mica_body_create(self.handle, byref(d), nodes.ctypes.data_as(POINTER(c_double)),
                                             len(nodes), tets.ctypes.data_as(POINTER(c_int32)), len(tets),
@@ -432,10 +457,11 @@ class World:
                    definition: Optional[native.mica_body_def] = None, **fields: Any) -> Body:
         """A box [lo, hi] (m) of cells[0] x cells[1] x cells[2] cubes, 5 or 6 tets each."""
         d = _fill(definition if definition is not None else body_def(), fields)
-        c = (c_int32 * 3)(*cells)
         out = native.mica_body_id()
-        self._check(native.mica_body_create_box(self.handle, byref(d), _doubles(lo, 3), _doubles(hi, 3), c,
-                                                tets_per_cell, byref(out)), "mica_body_create_box")
+        self._check(native.mica_body_create_box(self.handle, byref(d), _doubles(lo, 3, "create_box lo"),
+                                                _doubles(hi, 3, "create_box hi"),
+                                                _array(c_int32, cells, 3, "create_box cells"), tets_per_cell,
+                                                byref(out)), "mica_body_create_box")
         return Body(self, out.value)
 
     def create_tool(self, definition: Optional[native.mica_tool_def] = None, hull_points: Optional[ArrayLike] = None,
@@ -443,7 +469,7 @@ class World:
         """A kinematic tool; fields of mica_tool_def (shape, radius, position, ...)."""
         d = _fill(definition if definition is not None else tool_def(), fields)
         if hull_points is not None:
-            pts = np.ascontiguousarray(hull_points, dtype=np.float64).reshape(-1, 3)
+            pts = _rows(hull_points, 3, np.float64, "create_tool hull_points")
             d.hull_points = pts.ctypes.data_as(POINTER(c_double))  # copied by the library
             d.hull_point_count = len(pts)
         out = native.mica_tool_id()
@@ -472,7 +498,8 @@ class World:
         if trajectory is not None:
             def on_trajectory(t, position, user):
                 p = trajectory(t)
-                position[0], position[1], position[2] = p[0], p[1], p[2]
+                _expect_length(p, 3, "trajectory(%g)" % t)  # an error here is reported, not raised (a callback)
+                position[0], position[1], position[2] = p
             d.trajectory = native.mica_trajectory_fn(on_trajectory)
             self._keepalive.append(d.trajectory)
         out = native.mica_device_id()
@@ -610,7 +637,7 @@ class Body(_Object):
         return self._get(native.mica_body_get_surface, 3, np.int32, "mica_body_get_surface")
 
     def select_nodes_in_box(self, lo: Vec3, hi: Vec3, use_rest: bool = True) -> np.ndarray:
-        w, lo, hi = self.world, _doubles(lo, 3), _doubles(hi, 3)
+        w, lo, hi = self.world, _doubles(lo, 3, "select_nodes_in_box lo"), _doubles(hi, 3, "select_nodes_in_box hi")
         return _read_items(lambda out, cap, cnt: w._check(native.mica_body_select_nodes_in_box(
             w.handle, self.id, lo, hi, int(use_rest), out, cap, cnt), "mica_body_select_nodes_in_box"),
             1, np.int32).ravel()
@@ -618,14 +645,15 @@ class Body(_Object):
     def select_nodes_by_plane(self, point: Vec3, normal: Vec3, tolerance: float = 1e-9,
                               use_rest: bool = True) -> np.ndarray:
         """Nodes with (p - point) . normal <= tolerance."""
-        w, p, nrm = self.world, _doubles(point, 3), _doubles(normal, 3)
+        w = self.world
+        p, nrm = _doubles(point, 3, "select_nodes_by_plane point"), _doubles(normal, 3, "select_nodes_by_plane normal")
         return _read_items(lambda out, cap, cnt: w._check(native.mica_body_select_nodes_by_plane(
             w.handle, self.id, p, nrm, tolerance, int(use_rest), out, cap, cnt), "mica_body_select_nodes_by_plane"),
             1, np.int32).ravel()
 
     def set_node_forces(self, nodes: ArrayLike, forces: ArrayLike) -> None:
         nodes = np.ascontiguousarray(nodes, dtype=np.int32).ravel()
-        forces = np.ascontiguousarray(forces, dtype=np.float64).reshape(-1, 3)
+        forces = _rows(forces, 3, np.float64, "set_node_forces forces")
         if len(forces) != len(nodes):
             raise ValueError("one force per node")
         self.world._check(native.mica_body_set_node_forces(
@@ -633,7 +661,7 @@ class Body(_Object):
             forces.ctypes.data_as(POINTER(c_double)), len(nodes)), "mica_body_set_node_forces")
 
     def _set_nodes(self, fn, values, name):
-        values = np.ascontiguousarray(values, dtype=np.float64).reshape(-1, 3)
+        values = _rows(values, 3, np.float64, name)
         self.world._check(fn(self.world.handle, self.id, values.ctypes.data_as(POINTER(c_double)), len(values)), name)
 
     def set_positions(self, positions: ArrayLike) -> None:
@@ -702,7 +730,7 @@ class Body(_Object):
     def grab(self, center: Vec3, radius: float, tool: Optional[Tool] = None) -> Lpc:
         """Holds the nodes within `radius` of `center` on a handle (following `tool` if given)."""
         out = native.mica_lpc_id()
-        self.world._check(native.mica_lpc_grab(self.world.handle, self.id, _doubles(center, 3), radius,
+        self.world._check(native.mica_lpc_grab(self.world.handle, self.id, _doubles(center, 3, "grab center"), radius,
                                                _id_of(tool), byref(out)), "mica_lpc_grab")
         return Lpc(self.world, out.value)
 
@@ -719,18 +747,20 @@ class Lpc(_Object):
     """A linear projection constraint group (fixed nodes, a plane, a grab)."""
 
     def set_velocity(self, velocity: Vec3) -> None:
-        self.world._check(native.mica_lpc_set_velocity(self.world.handle, self.id, _doubles(velocity, 3)),
+        self.world._check(native.mica_lpc_set_velocity(self.world.handle, self.id,
+                                                       _doubles(velocity, 3, "set_velocity velocity")),
                           "mica_lpc_set_velocity")
 
     def set_targets(self, targets: ArrayLike) -> None:
-        t = np.ascontiguousarray(targets, dtype=np.float64).reshape(-1, 3)
+        t = _rows(targets, 3, np.float64, "set_targets targets")
         self.world._check(native.mica_lpc_set_targets(self.world.handle, self.id,
                                                       t.ctypes.data_as(POINTER(c_double)), len(t)),
                           "mica_lpc_set_targets")
 
     def set_handle_pose(self, position: Vec3, orientation: Quat = (1, 0, 0, 0)) -> None:
-        self.world._check(native.mica_lpc_set_handle_pose(self.world.handle, self.id, _doubles(position, 3),
-                                                          _doubles(orientation, 4)), "mica_lpc_set_handle_pose")
+        self.world._check(native.mica_lpc_set_handle_pose(
+            self.world.handle, self.id, _doubles(position, 3, "set_handle_pose position"),
+            _doubles(orientation, 4, "set_handle_pose orientation")), "mica_lpc_set_handle_pose")
 
     def nodes(self) -> np.ndarray:
         w = self.world
@@ -751,8 +781,9 @@ class Tool(_Object):
     """A kinematic rigid tool: the host sets its pose, the bodies push back on it."""
 
     def set_pose(self, position: Vec3, orientation: Quat = (1, 0, 0, 0)) -> None:
-        self.world._check(native.mica_tool_set_pose(self.world.handle, self.id, _doubles(position, 3),
-                                                    _doubles(orientation, 4)), "mica_tool_set_pose")
+        self.world._check(native.mica_tool_set_pose(
+            self.world.handle, self.id, _doubles(position, 3, "set_pose position"),
+            _doubles(orientation, 4, "set_pose orientation")), "mica_tool_set_pose")
 
     def pose(self) -> Tuple[np.ndarray, np.ndarray]:
         """(position m, orientation quaternion w, x, y, z) as numpy vectors; a tool driven by a

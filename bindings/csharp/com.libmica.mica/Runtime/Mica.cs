@@ -360,6 +360,15 @@ namespace LibMica
             return new Tool(this, id);
         }
 
+        /// <summary>A tool created at `position` (m, def.position; no unsafe code needed). Create it
+        /// where it starts: SetPose moves it along a sweep from its last pose, pushing what lies on the way.</summary>
+        public unsafe Tool CreateTool(MicaNative.mica_tool_def def, double[] position)
+        {
+            Mica.Vec(position, 3, "position");
+            for (int i = 0; i < 3; ++i) def.position[i] = position[i];
+            return CreateTool(def);
+        }
+
         /// <summary>A device driving `tool`: with a backend, its methods are the callback table;
         /// without, the def's own backend (MICA_DEVICE_NULL by default).</summary>
         public Device CreateDevice(MicaNative.mica_device_def def, Tool tool, DeviceBackend backend = null)

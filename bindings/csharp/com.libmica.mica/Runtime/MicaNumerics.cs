@@ -26,6 +26,12 @@ namespace LibMica
         /// <summary>Gravity, m/s^2.</summary>
         public static void SetGravity(this World world, Vector3 gravity) { world.SetGravity(ToArray(gravity)); }
 
+        /// <summary>A tool created at `position` (m): see World.CreateTool(def, double[]).</summary>
+        public static Tool CreateTool(this World world, MicaNative.mica_tool_def def, Vector3 position)
+        {
+            return world.CreateTool(def, ToArray(position));
+        }
+
         /// <summary>The tool's pose: position (m) and orientation.</summary>
         public static void SetPose(this Tool tool, Vector3 position, Quaternion orientation)
         {

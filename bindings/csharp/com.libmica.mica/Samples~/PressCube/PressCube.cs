@@ -22,6 +22,12 @@ public sealed class PressCube : MonoBehaviour
 
     void Start()
     {
+        if (Probe == null)
+        {
+            Debug.LogError("PressCube: assign Probe, the Transform the sphere follows");
+            enabled = false;
+            return;
+        }
         var def = Mica.WorldDef();   // the haptic default: MICA with the factored sweep
         def.time_budget_ms = 10;     // a step never takes longer than a frame's share
         world = new World(def, (level, text) => Debug.Log("libmica: " + text));
@@ -34,17 +40,18 @@ public sealed class PressCube : MonoBehaviour
                     Mica.LpcDef());
         var tool = Mica.ToolDef();
         tool.radius = ProbeRadius;
-        sphere = world.CreateTool(tool);
+        // Made where the probe is: SetPose moves the sphere along a sweep from its last pose, so a
+        // sphere made at the origin, inside the cube, would drag the tissue up to the probe.
+        sphere = world.CreateTool(tool, ToMica(Probe.position));
     }
+
+    // Unity's frame is left-handed: z flips between it and libmica's.
+    static System.Numerics.Vector3 ToMica(Vector3 p) { return new System.Numerics.Vector3(p.x, p.y, -p.z); }
 
     void FixedUpdate()
     {
         if (world == null) return;
-        if (Probe != null)
-        {
-            var p = Probe.position;
-            sphere.SetPose(new System.Numerics.Vector3(p.x, p.y, -p.z));
-        }
+        if (Probe != null) sphere.SetPose(ToMica(Probe.position));
         world.Step(Time.fixedDeltaTime);
         positions = cube.GetPositions(positions);
         var f = sphere.GetForceVector();

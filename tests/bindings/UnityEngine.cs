@@ -1,0 +1,46 @@
+// SPDX-License-Identifier: Apache-2.0
+// The few UnityEngine types the documented C# samples use, so that test_doc_samples.py compiles
+// and runs them on Mono outside Unity: Debug writes to the console; a MonoBehaviour is a plain
+// object whose Start, FixedUpdate and OnDestroy the test calls in Unity's order.
+namespace UnityEngine
+{
+    public struct Vector3
+    {
+        public float x, y, z;
+        public Vector3(float x, float y, float z) { this.x = x; this.y = y; this.z = z; }
+        public static Vector3 one { get { return new Vector3(1, 1, 1); } }
+        public static Vector3 operator *(Vector3 v, float s) { return new Vector3(v.x * s, v.y * s, v.z * s); }
+    }
+
+    public struct Color
+    {
+        public static readonly Color red = new Color();
+    }
+
+    public class Transform
+    {
+        public Vector3 position;
+    }
+
+    public class MonoBehaviour
+    {
+        public bool enabled = true;
+    }
+
+    public static class Debug
+    {
+        public static void Log(object message) { System.Console.WriteLine(message); }
+        public static void LogError(object message) { System.Console.Error.WriteLine(message); }
+    }
+
+    public static class Time
+    {
+        public static float fixedDeltaTime = 0.02f; // Unity's default
+    }
+
+    public static class Gizmos
+    {
+        public static Color color;
+        public static void DrawCube(Vector3 center, Vector3 size) { }
+    }
+}
