@@ -1,7 +1,9 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: Apache-2.0
 """Draws the accuracy-against-time study (scripts/study.sh) from the CSVs in its folder, and
-writes tables.md (the tables of docs/accuracy-vs-time.md and docs/performance.md).
+writes tables.md (the tables of docs/accuracy-vs-time.md and docs/performance.md). The tables the
+docs include are wrapped in <!-- study:begin NAME --> / <!-- study:end NAME --> markers;
+scripts/study_docs.py compares them with (or copies them into) the docs.
 
   error_vs_time.png          position and tool-force error against ms per step, one front per
                              solver and mode (fixed tolerance, fixed iterations), exact as a line
@@ -17,13 +19,16 @@ writes tables.md (the tables of docs/accuracy-vs-time.md and docs/performance.md
                              the Hertz force against depth
   scaling.png                ms per step, iterations and ms per iteration against tets
 and, in tables.md only, the force quality of a held tool and of loading (contact.csv, from
-bench/bench_contact.c).
+bench/bench_contact.c), and the performance tables (perf-*) from the benchmarks' output the study
+keeps as <stage>.txt (nidus, refresh, linear, defaults, factor, factor_omp, servo_idle, servo) with
+the commands in commands.txt.
 
 usage: study_plots.py <study-folder>
 """
 import csv
 import math
 import os
+import re
 import sys
 from collections import OrderedDict, defaultdict
 
@@ -512,13 +517,6 @@ def tables(rows, anchor_rows, filt, scal, comments, out, contact=()):
             w(f"| {r['mode']} | {r['N']} | {r['delay_ms']} | {r['delay_theory_ms']} | {g(r['ripple_rms_N_per_ms'])} | "
               f"{g(r['ripple_raw_N_per_ms'])} | {g(r['max_jump_N'])} | {g(r['max_jump_raw_N'])} | "
               f"{g(r['peak_raw_N'], '{:.4f}')} | {g(r['peak_filtered_N'], '{:.4f}')} |")
-    if scal:
-        w("\n### Scaling (0.1 m cube, MICA factored sweep, tol 1e-6, one core)\n")
-        w("| cells | nodes | tets | median ms | p95 ms | iters/step | ms/iteration | memory (B/tet) |")
-        w("|---|---|---|---|---|---|---|---|")
-        for r in scal:
-            w(f"| {r['cells']}^3 | {r['nodes']} | {r['tets']} | {g(r['ms_median'])} | {g(r['ms_p95'])} | "
-              f"{g(r['iterations'], '{:.1f}')} | {g(r['ms_per_iteration'], '{:.4f}')} | {r['mem_B_per_tet']} |")
     if contact:
         w("\n### Force quality (bench_contact: tool pressed 10 mm and held 1 s)\n")
         w("| body | tool | cells | dt (ms) | solver | F end (N) | alt. run | late change | loading drop "
@@ -533,6 +531,208 @@ def tables(rows, anchor_rows, filt, scal, comments, out, contact=()):
               f"{verdict} |")
     with open(os.path.join(out, "tables.md"), "w") as f:
         f.write("\n".join(lines) + "\n")
+
+
+# ---- the performance tables (docs/performance.md), from the benchmarks' own output
+
+def read_text(folder, name):
+    path = os.path.join(folder, name + ".txt")
+    if not os.path.exists(path):
+        return None
+    with open(path) as f:
+        return f.read()
+
+
+def commands(folder):
+    """Each stage's command as the docs print it (study.sh writes commands.txt: name|command)."""
+    out = {}
+    path = os.path.join(folder, "commands.txt")
+    if os.path.exists(path):
+        with open(path) as f:
+            for line in f:
+                if "|" in line:
+                    name, cmd = line.rstrip("\n").split("|", 1)
+                    # The 4-thread factorization: the study's environment without OMP_THREAD_LIMIT.
+                    cmd = cmd.replace("OMP_THREAD_LIMIT=1 OPENBLAS_NUM_THREADS=1 env -u OMP_THREAD_LIMIT ",
+                                      "OPENBLAS_NUM_THREADS=1 ")
+                    out[name] = cmd
+    return out
+
+
+def nidus_sections(text):
+    """bench_nidus's output: {section title: {key: value text}} (keys as printed, e.g. 'median ms/step')."""
+    sections, cur = OrderedDict(), None
+    for line in (text or "").splitlines():
+        if line.startswith("## "):
+            cur = sections.setdefault(line[3:].strip(), {})
+        elif cur is not None and line.startswith("# bench_nidus:"):
+            m = re.search(r"load average ([\d.]+)", line)
+            cur["load"] = m.group(1) if m else "?"
+        elif cur is not None and line.startswith("# mesh "):
+            m = re.search(r"(\d+) tets", line)
+            cur["tets"] = m.group(1) if m else "?"
+        elif cur is not None and not line.startswith("#"):
+            m = re.match(r"^(\S.*?)\s{2,}(.*)$", line)
+            if m:
+                cur[m.group(1).strip()] = m.group(2).strip()
+    return sections
+
+
+def first_num(v, default=math.nan):
+    m = re.search(r"[-+]?\d+(?:\.\d+)?(?:e[-+]?\d+)?", v or "")
+    return float(m.group(0)) if m else default
+
+
+def held_b_per_tet(sec):
+    m = re.search(r"held (\d+) B/tet", sec.get("memory, after 1 step", ""))
+    return int(m.group(1)) if m else None
+
+
+def stages_of(sec):
+    return {k: float(v) for k, v in re.findall(r"(\w+) ([\d.]+)", sec.get("mean ms/step by stage", ""))}
+
+
+def perf_lines(folder):
+    cmds = commands(folder)
+    lines = []
+    w = lines.append
+
+    def cmd(name):
+        return f"`{cmds[name]}`" if name in cmds else "(not run)"
+
+    def block(name, body):
+        w(f"\n<!-- study:begin {name} -->")
+        lines.extend(body)
+        w(f"<!-- study:end {name} -->")
+
+    nidus = nidus_sections(read_text(folder, "nidus"))
+    fac = nidus.get("factored sweep")
+    if fac:
+        st = stages_of(fac)
+        other = sum(v for k, v in st.items() if k not in ("rotations", "elements", "solve"))
+        held = held_b_per_tet(fac)
+        force = fac.get("tool force", "").split(",")[0]
+        body = ["| the nidus step (factored sweep, tol 1e-6, one core) | |", "|---|---|",
+                f"| median / p95 ms a step | **{first_num(fac['median ms/step']):.2f}** / "
+                f"**{first_num(fac['p95 ms/step']):.2f}** (max {first_num(fac['max ms/step']):.2f}) |",
+                f"| the stepping thread's CPU time, median | {first_num(fac['median CPU ms/step']):.2f} ms |",
+                f"| where it goes (mean ms a step) | rotations {st.get('rotations', math.nan):.2f}, elements "
+                f"{st.get('elements', math.nan):.2f}, solve {st.get('solve', math.nan):.2f}, the rest {other:.2f} |",
+                f"| conjugate-gradient iterations / velocity solves a step | {first_num(fac['iterations/step']):.1f} / "
+                f"{first_num(fac['solves/step']):.2f} |",
+                f"| memory held after the first step | {held} B per tet "
+                f"({held * first_num(fac.get('tets')) / 1e6:.1f} MB for {fac.get('tets')} tets) |" if held else "| memory held | - |",
+                f"| tool force at the end | {force} |",
+                "",
+                f"Load average at the start: {fac.get('load', '?')}. Command: {cmd('nidus')}"]
+        block("perf-nidus", body)
+
+    rows = []
+    d = nidus_sections(read_text(folder, "defaults"))
+    dw = d.get("the default world")
+    if dw:
+        base = first_num(dw["median ms/step"])
+        for title, label in (("the default world", "the default world: MICA, factored sweep, tol 1e-8, cap 200"),
+                             ("solver DIRECT", "`solver = MICA_SOLVER_DIRECT` (exact, the default before 0.5)"),
+                             ("MICA, Gauss-Seidel sweep", "`mica_sweep = MICA_SWEEP_GAUSS_SEIDEL` (the paper's sweep)")):
+            sec = d.get(title)
+            if not sec:
+                continue
+            med = first_num(sec["median ms/step"])
+            capped = re.search(r"(\d+) stopped at the cap", sec.get("iterations/step", ""))
+            note = f"{capped.group(1)} of the steps stopped at the cap" if capped and capped.group(1) != "0" else "every step converged"
+            rows.append(f"| {label} | {med:.2f} | {first_num(sec['p95 ms/step']):.2f} | "
+                        f"{first_num(sec['iterations/step']):.1f} | {note} | "
+                        f"{'1' if sec is dw else f'{med / base:.1f}x'} | defaults |")
+    r = nidus_sections(read_text(folder, "refresh"))
+    rf, rr = r.get("factored sweep"), next((v for k, v in r.items() if "refreshed" in k), None)
+    if rf and rr:
+        m = re.search(r"every (\d+) steps", next(k for k in r if "refreshed" in k))
+        every = m.group(1) if m else "?"
+        base = first_num(rf["median ms/step"])
+        for sec, label in ((rf, "factored sweep, tol 1e-6, `refactor_interval = 0`, not pinned"),
+                           (rr, f"the same, `refactor_interval = {every}` (a second core factors)")):
+            med = first_num(sec["median ms/step"])
+            rows.append(f"| {label} | {med:.2f} | {first_num(sec['p95 ms/step']):.2f} | "
+                        f"{first_num(sec['iterations/step']):.1f} | "
+                        f"{first_num(sec.get('factorizations', '0')):.0f} factorizations in the timed steps | "
+                        f"{'1' if sec is rf else f'{med / base:.2f}x'} | refresh |")
+    lin = nidus_sections(read_text(folder, "linear")).get("factored sweep")
+    if lin and fac:
+        base = first_num(fac["median ms/step"])
+        med = first_num(lin["median ms/step"])
+        rows.append(f"| factored sweep, tol 1e-6, co-rotational body (the `nidus` run above) | {base:.2f} | "
+                    f"{first_num(fac['p95 ms/step']):.2f} | {first_num(fac['iterations/step']):.1f} | "
+                    f"tool force {fac.get('tool force', '').split(',')[0]} | 1 | nidus |")
+        rows.append(f"| the same, `mica_body_def.model = MICA_MODEL_LINEAR` | {med:.2f} | "
+                    f"{first_num(lin['p95 ms/step']):.2f} | {first_num(lin['iterations/step']):.1f} | "
+                    f"tool force {lin.get('tool force', '').split(',')[0]} | {med / base:.2f}x | linear |")
+    if rows:
+        used = []
+        for r_ in rows:
+            k = r_.rsplit("|", 2)[-2].strip()
+            if k not in used:
+                used.append(k)
+        body = ["| the nidus scene | median ms | p95 ms | iterations a step | | time against the first row of its run | run |",
+                "|---|---|---|---|---|---|---|"] + rows + [""] + [f"- {k}: {cmd(k)}" for k in used]
+        block("perf-knobs", body)
+
+    def factor_ms(text):
+        m = re.search(r"lowest fifth held.*?factor\s+([\d.]+) ms", text or "", re.S)
+        return float(m.group(1)) if m else None
+
+    def pair_ms(text):
+        m = re.search(r"lowest fifth held.*?half precision ([\d.]+) ms", text or "", re.S)
+        return float(m.group(1)) if m else None
+
+    f1, f4 = factor_ms(read_text(folder, "factor")), factor_ms(read_text(folder, "factor_omp"))
+    if f1:
+        body = ["| the nidus system, its lowest fifth held | ms | |", "|---|---|---|",
+                f"| a factorization (CHOLMOD, OpenBLAS on one thread, `OMP_THREAD_LIMIT=1`) | {f1:.1f} | 1 |"]
+        if f4:
+            body.append(f"| the same with CHOLMOD's OpenMP threads (Debian's build: 4) on the same one core | "
+                        f"{f4:.1f} | {f4 / f1:.1f}x |")
+        pm = pair_ms(read_text(folder, "factor"))
+        if pm:
+            body.append(f"| one preconditioner solve pair (half precision), once per conjugate-gradient iteration | "
+                        f"{pm:.3f} | |")
+        body += ["", f"- {cmd('factor')}"] + ([f"- {cmd('factor_omp')}"] if f4 else [])
+        block("perf-factor", body)
+
+    srows = []
+    for name, label in (("servo_idle", "nothing (`idle`)"), ("servo", "the nidus, factored sweep, `refactor_interval = 0`")):
+        t = read_text(folder, name)
+        if not t:
+            continue
+        sps = re.search(r"\(([\d.]+) steps/s\)", t)
+        fifo = "SCHED_FIFO 80" if "SCHED_FIFO 80" in t else "fair scheduler"
+        cost = re.search(r"poll cost \(us\):\s+median ([\d.]+)\s+p99 ([\d.]+)", t)
+        late = re.search(r"late \(ms\):\s+median [\d.]+\s+p99 ([\d.]+)\s+p99.9 ([\d.]+)\s+max ([\d.]+).*?(\d+) of (\d+) cycles",
+                         t)
+        if not (cost and late):
+            continue
+        srows.append(f"| {label} | {sps.group(1) if sps and name != 'servo_idle' else '-'} | {cost.group(1)} / "
+                     f"{cost.group(2)} | {late.group(1)} / {late.group(2)} / {late.group(3)} | {late.group(4)} of "
+                     f"{late.group(5)} | {fifo} |")
+    if srows:
+        body = ["| stepping alongside | steps/s | one poll, median / p99 (us) | late, p99 / p99.9 / max (ms) "
+                "| cycles late by > 0.5 ms | servo thread |", "|---|---|---|---|---|---|"] + srows + [""]
+        body += [f"- {cmd(n)}" for n in ("servo_idle", "servo") if n in cmds]
+        block("perf-servo", body)
+
+    scal, _ = read(os.path.join(folder, "scaling.csv"))
+    if scal:
+        body = ["| cells | nodes | tets | median ms | p95 ms | iterations a step | ms per iteration "
+                "| memory held (B per tet) | rotations, elements, solve (mean ms) |",
+                "|---|---|---|---|---|---|---|---|---|"]
+        for r_ in scal:
+            body.append(f"| {r_['cells']}^3 | {r_['nodes']} | {r_['tets']} | {g(r_['ms_median'])} | {g(r_['ms_p95'])} | "
+                        f"{g(r_['iterations'], '{:.1f}')} | {g(r_['ms_per_iteration'], '{:.3g}')} | "
+                        f"{g(r_.get('mem_held_B_per_tet'), '{:.0f}')} | {g(r_.get('ms_rotations'), '{:.2f}')}, "
+                        f"{g(r_.get('ms_elements'), '{:.2f}')}, {g(r_.get('ms_solve'), '{:.3g}')} |")
+        body += ["", f"Command: {cmd('scaling')}"]
+        block("perf-scaling", body)
+    return lines
 
 
 def main(folder):
@@ -555,6 +755,10 @@ def main(folder):
     tables(rows, anchor_rows, filt, scal,
            {"sweep": c_sweep, "anchors": c_anchor, "filter": c_filter, "scaling": c_scal, "contact": c_contact}, folder,
            contact)
+    extra = perf_lines(folder)
+    if extra:
+        with open(os.path.join(folder, "tables.md"), "a") as f:
+            f.write("\n## Performance (docs/performance.md)\n" + "\n".join(extra) + "\n")
     print(f"plots and tables.md in {folder}")
 
 
