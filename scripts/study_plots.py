@@ -571,6 +571,8 @@ def nidus_sections(text):
         elif cur is not None and line.startswith("# mesh "):
             m = re.search(r"(\d+) tets", line)
             cur["tets"] = m.group(1) if m else "?"
+        elif cur is not None and line.startswith("mean ms/step by stage "):
+            cur["mean ms/step by stage"] = line[len("mean ms/step by stage "):]
         elif cur is not None and not line.startswith("#"):
             m = re.match(r"^(\S.*?)\s{2,}(.*)$", line)
             if m:
@@ -592,6 +594,77 @@ def stages_of(sec):
     return {k: float(v) for k, v in re.findall(r"(\w+) ([\d.]+)", sec.get("mean ms/step by stage", ""))}
 
 
+def source_of_run(folder):
+    """When the run was (its nidus output's time) and the commit of the source it ran."""
+    root = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..")
+    stamp = "?"
+    path = os.path.join(folder, "nidus.txt")
+    if os.path.exists(path):
+        import datetime
+        stamp = datetime.datetime.utcfromtimestamp(os.path.getmtime(path)).strftime("%Y-%m-%d %H:%M UTC")
+    try:
+        import subprocess
+        commit = subprocess.run(["git", "-C", root, "rev-parse", "--short", "HEAD"], stdout=subprocess.PIPE,
+                                stderr=subprocess.DEVNULL, universal_newlines=True).stdout.strip() or "?"
+        dirty = subprocess.run(["git", "-C", root, "status", "--porcelain", "--untracked-files=no", "--", "src",
+                                "capi", "include", "bench", "scenes", "CMakeLists.txt"], stdout=subprocess.PIPE,
+                               stderr=subprocess.DEVNULL, universal_newlines=True).stdout.strip()
+        commit += " with local changes to the library or benchmarks" if dirty else ""
+    except OSError:
+        commit = "?"
+    return stamp, commit
+
+
+def headline(folder, fac, cmds, block):
+    """The figures a reader asks first, each from one of the runs below it."""
+    rows, used = [], []
+
+    def row(what, figure, run):
+        rows.append(f"| {what} | {figure} | {run} |")
+        for r in run.split(", "):
+            if r not in used:
+                used.append(r)
+
+    if fac:
+        row("the nidus step (9668 tets, a tool moving in contact), one core: median / p95",
+            f"**{first_num(fac['median ms/step']):.2f} / {first_num(fac['p95 ms/step']):.2f} ms**", "nidus")
+        row("its conjugate-gradient iterations a step", f"{first_num(fac['iterations/step']):.1f}", "nidus")
+        held = held_b_per_tet(fac)
+        if held:
+            row("memory the world holds, nidus", f"**{held} B per tet**", "nidus")
+    d = nidus_sections(read_text(folder, "defaults"))
+    if d.get("the default world") and d.get("solver DIRECT"):
+        a, b = first_num(d["the default world"]["median ms/step"]), first_num(d["solver DIRECT"]["median ms/step"])
+        row("the default world against the exact solver (`MICA_SOLVER_DIRECT`), nidus: median step",
+            f"{a:.2f} against {b:.2f} ms: {b / a:.1f}x faster", "defaults")
+    scal, _ = read(os.path.join(folder, "scaling.csv"))
+    if scal:
+        pick = [scal[0]] + [r for r in scal if 30000 <= num(r["tets"]) <= 40000][:1] + [scal[-1]]
+        row("the scaling curve (a cube, one core): median step at " + " / ".join(f"{int(num(r['tets'])):,} tets"
+                                                                                  for r in pick),
+            "**" + " / ".join(f"{g(r['ms_median'])}" for r in pick) + " ms**", "scaling")
+        held = [num(r.get("mem_held_B_per_tet")) for r in scal if fin(num(r.get("mem_held_B_per_tet")))]
+        if held:
+            row("memory the world holds along the curve", f"{min(held):.0f}-{max(held):.0f} B per tet", "scaling")
+    servo, idle = read_text(folder, "servo"), read_text(folder, "servo_idle")
+    if servo:
+        cost = re.search(r"poll cost \(us\):\s+median ([\d.]+)", servo)
+        late = re.search(r"late \(ms\):.*?p99.9 ([\d.]+)", servo)
+        late_idle = re.search(r"late \(ms\):.*?p99.9 ([\d.]+)", idle or "")
+        if cost:
+            row("the 1 kHz servo loop beside the stepping nidus: one poll, median", f"{cost.group(1)} us", "servo")
+        if late and late_idle:
+            row("its cycles' lateness, p99.9, beside the nidus / with nothing stepping",
+                f"{late.group(1)} / {late_idle.group(1)} ms", "servo, servo_idle")
+    if not rows:
+        return
+    stamp, commit = source_of_run(folder)
+    body = ["| | | run |", "|---|---|---|"] + rows + [""]
+    body += [f"- {k}: `{cmds[k]}`" if k in cmds else f"- {k}: (not run)" for k in used]
+    body += ["", f"Measured {stamp} by `scripts/study.sh` (its `perf` part), source {commit}."]
+    block("perf-headline", body)
+
+
 def perf_lines(folder):
     cmds = commands(folder)
     lines = []
@@ -607,6 +680,7 @@ def perf_lines(folder):
 
     nidus = nidus_sections(read_text(folder, "nidus"))
     fac = nidus.get("factored sweep")
+    headline(folder, fac, cmds, block)
     if fac:
         st = stages_of(fac)
         other = sum(v for k, v in st.items() if k not in ("rotations", "elements", "solve"))
@@ -623,6 +697,8 @@ def perf_lines(folder):
                 f"| memory held after the first step | {held} B per tet "
                 f"({held * first_num(fac.get('tets')) / 1e6:.1f} MB for {fac.get('tets')} tets) |" if held else "| memory held | - |",
                 f"| tool force at the end | {force} |",
+                f"| contact nodes whose velocity change reverses from one step to the next | "
+                f"{fac.get('velocity reversals', '-').split(' of ')[0]} |",
                 "",
                 f"Load average at the start: {fac.get('load', '?')}. Command: {cmd('nidus')}"]
         block("perf-nidus", body)
@@ -677,25 +753,63 @@ def perf_lines(folder):
                 "|---|---|---|---|---|---|---|"] + rows + [""] + [f"- {k}: {cmd(k)}" for k in used]
         block("perf-knobs", body)
 
-    def factor_ms(text):
-        m = re.search(r"lowest fifth held.*?factor\s+([\d.]+) ms", text or "", re.S)
-        return float(m.group(1)) if m else None
+    def factor_parts(text):
+        """bench_factor's figures: CHOLMOD's own factorizations, and DirectSolver's free and held."""
+        out = {}
+        for kind, label in (("simplicial", r"simplicial LDL\^T"), ("supernodal", r"supernodal LL\^T \(AMD\)")):
+            m = re.search(label + r"\s+analyse\s+([\d.]+) ms\s+factor\s+([\d.]+) ms\s+solve 1 rhs\s+([\d.]+) ms",
+                          text or "")
+            if m:
+                out[kind] = tuple(float(x) for x in m.groups())
+        for key, head in (("free", "no node held"), ("held", "the lowest fifth held")):
+            i = (text or "").find("DirectSolver, " + head)
+            if i < 0:
+                continue
+            part = text[i:]
+            j = part.find("DirectSolver, ", 10)
+            part = part[:j] if j > 0 else part
+            f = {}
+            for name, pat in (("nnz", r"\(([\d.]+) M nonzeros in L\)"), ("flops", r"([\d.e+]+) flops"),
+                              ("analyse", r"analyse ([\d.]+) ms"), ("again", r"ordering known: ([\d.]+) ms"),
+                              ("factor", r"\), factor ([\d.]+) ms"), ("cholmod", r"cholmod_solve2 ([\d.]+) ms"),
+                              ("hand", r"by hand ([\d.]+) ms"), ("single", r"single precision ([\d.]+) ms"),
+                              ("half", r"half precision ([\d.]+) ms"),
+                              ("half_diff", r"half precision [\d.]+ ms \([\d.]+x single, difference ([\d.e+-]+)\)"),
+                              ("columns", r"(\d+) nodes in ([\d.]+) ms")):
+                m = re.search(pat, part)
+                if m:
+                    f[name] = m.group(1) if name != "columns" else (m.group(1), m.group(2))
+            out[key] = f
+        return out
 
-    def pair_ms(text):
-        m = re.search(r"lowest fifth held.*?half precision ([\d.]+) ms", text or "", re.S)
-        return float(m.group(1)) if m else None
+    fa, fo = factor_parts(read_text(folder, "factor")), factor_parts(read_text(folder, "factor_omp"))
+    if fa.get("held"):
+        fr, he = fa.get("free", {}), fa["held"]
 
-    f1, f4 = factor_ms(read_text(folder, "factor")), factor_ms(read_text(folder, "factor_omp"))
-    if f1:
-        body = ["| the nidus system, its lowest fifth held | ms | |", "|---|---|---|",
-                f"| a factorization (CHOLMOD, OpenBLAS on one thread, `OMP_THREAD_LIMIT=1`) | {f1:.1f} | 1 |"]
+        def both(fn):
+            return f"{fn(fr) if fr else '-'} | {fn(he)}"
+
+        body = ["| the nidus system (`DirectSolver`: CHOLMOD, supernodal) | no node held | its lowest fifth held "
+                "(the benchmark's scene) |", "|---|---|---|",
+                "| nonzeros in L; flops a factorization | " + both(lambda f: f"{f.get('nnz')} M; {f.get('flops')}") + " |",
+                "| the first analysis (it finds the ordering); again, the ordering known (ms) | "
+                + both(lambda f: f"{f.get('analyse')}; {f.get('again')}") + " |",
+                "| a factorization, one thread (ms) | " + both(lambda f: f"**{f.get('factor')}**") + " |"]
+        f4 = fo.get("held", {}).get("factor")
         if f4:
-            body.append(f"| the same with CHOLMOD's OpenMP threads (Debian's build: 4) on the same one core | "
-                        f"{f4:.1f} | {f4 / f1:.1f}x |")
-        pm = pair_ms(read_text(folder, "factor"))
-        if pm:
-            body.append(f"| one preconditioner solve pair (half precision), once per conjugate-gradient iteration | "
-                        f"{pm:.3f} | |")
+            f1 = float(he["factor"])
+            body.append(f"| the same with CHOLMOD's OpenMP threads (4 in Debian's build) on the same core (ms) | "
+                        f"{fo.get('free', {}).get('factor', '-')} | {f4} ({float(f4) / f1:.1f}x) |")
+        body += ["| a solve pair with the factor: `cholmod_solve2`; by hand in double; single; half precision (ms) | "
+                 + both(lambda f: f"{f.get('cholmod')}; {f.get('hand')}; {f.get('single')}; **{f.get('half')}**") + " |",
+                 "| the half-precision pair's relative difference from the double one | "
+                 + both(lambda f: f"{f.get('half_diff')}") + " |",
+                 "| the half columns of " + (he.get("columns", ("?", ""))[0]) + " contact nodes (ms) | "
+                 + both(lambda f: f"{f.get('columns', ('', '-'))[1]}") + " |"]
+        sn, sp = fa.get("supernodal"), fa.get("simplicial")
+        if sn and sp:
+            body.append(f"| CHOLMOD's supernodal LL^T against its simplicial LDL^T (AMD ordering, no node held): "
+                        f"factorization (ms) | {sn[1]} against {sp[1]} ({sp[1] / sn[1]:.1f}x) | |")
         body += ["", f"- {cmd('factor')}"] + ([f"- {cmd('factor_omp')}"] if f4 else [])
         block("perf-factor", body)
 
