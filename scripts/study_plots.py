@@ -459,12 +459,15 @@ def tables(rows, anchor_rows, filt, scal, comments, out, contact=()):
     for group, title in (("tolerance", "Fixed tolerance (cap 100000)"),
                          ("iterations", "Fixed iterations (tolerance 1e-300, the cap varies)")):
         w(f"\n### {title}\n")
+        w(f"<!-- study:begin accuracy-{group} -->")
         w(head)
         w(sep)
         for r in rows:
             if r["group"] == group or (group == "tolerance" and r["group"] == "tolerance" and r["solver"] == "exact"):
                 w(row(r))
+        w(f"<!-- study:end accuracy-{group} -->")
     w("\n### Other knobs\n")
+    w("<!-- study:begin accuracy-knobs -->")
     w("| group | solver | setting | median ms | p95 ms | iters/step | pos. RMS err vs exact, same scene (m) "
       "| model error (m or N) | force err (N) | penetration (m) | status |")
     w("|---|---|---|---|---|---|---|---|---|---|---|")
@@ -483,7 +486,9 @@ def tables(rows, anchor_rows, filt, scal, comments, out, contact=()):
         w(f"| {gr} | {r['solver']} | {setting} | {g(r['ms_median'])} | {g(r['ms_p95'])} | "
           f"{g(r['iters_mean'], '{:.1f}')} | {g(r['disp_rms_err_m'])} | {model} | {g(r['force_err_N'])} | "
           f"{g(r['penetration_m'])} | {r['status']} |")
+    w("<!-- study:end accuracy-knobs -->")
     w("\n### Stiffness (tol 1e-8, 50 steps)\n")
+    w("<!-- study:begin accuracy-stiffness -->")
     w("| E (Pa) | solver | median ms | p95 ms | iters/step (max) | pos. RMS err (m) | force err (N) | status |")
     w("|---|---|---|---|---|---|---|---|")
     for r in rows:
@@ -491,7 +496,9 @@ def tables(rows, anchor_rows, filt, scal, comments, out, contact=()):
             w(f"| {num(r['E_Pa']):.0e} | {r['solver']} | {g(r['ms_median'])} | {g(r['ms_p95'])} | "
               f"{g(r['iters_mean'], '{:.1f}')} ({g(r['iters_max'], '{:.0f}')}) | {g(r['disp_rms_err_m'])} | "
               f"{g(r['force_err_N'])} | {r['status']} |")
+    w("<!-- study:end accuracy-stiffness -->")
     w("\n### Energy drift (undamped free vibration, 1 s)\n")
+    w("<!-- study:begin accuracy-drift -->")
     w("| solver | tol | median ms | iters/step | energy end / start | pos. RMS err vs exact (m) |")
     w("|---|---|---|---|---|---|")
     for r in rows:
@@ -499,8 +506,10 @@ def tables(rows, anchor_rows, filt, scal, comments, out, contact=()):
             tol = "-" if r["solver"] == "exact" else f"{num(r['tol']):.0e}"
             w(f"| {r['solver']} | {tol} | {g(r['ms_median'])} | {g(r['iters_mean'], '{:.1f}')} | "
               f"{g(r['energy_ratio_end'], '{:.3g}')} | {g(r['disp_rms_err_m'])} |")
+    w("<!-- study:end accuracy-drift -->")
     if anchor_rows:
         w("\n### Analytic anchors\n")
+        w("<!-- study:begin accuracy-anchors -->")
         w("| test | model | h (m) | nodes | tets | FEM | theory | rel. error | vs Timoshenko (beam) | ms |")
         w("|---|---|---|---|---|---|---|---|---|---|")
         for r in anchor_rows:
@@ -508,8 +517,10 @@ def tables(rows, anchor_rows, filt, scal, comments, out, contact=()):
                      else f"(last 3 steps spread {g(r.get('spread'), '{:.1%}')})")
             w(f"| {r['test']} | {r['model']} | {g(r['h_m'])} | {r['nodes']} | {r['tets']} | {g(r['fem'], '{:.5g}')} | "
               f"{g(r['theory'], '{:.5g}')} | {g(r['rel_error'], '{:+.2%}')} | {extra} | {g(r['ms'], '{:.0f}')} |")
+        w("<!-- study:end accuracy-anchors -->")
     if filt:
         w("\n### Filter window (device side)\n")
+        w("<!-- study:begin accuracy-filter -->")
         w("| mode | N | delay (ms) | (N-1)/2 | ripple (N/ms) | raw ripple | largest jump (N) | raw jump (N) "
           "| peak raw (N) | peak rendered (N) |")
         w("|---|---|---|---|---|---|---|---|---|---|")
@@ -517,8 +528,10 @@ def tables(rows, anchor_rows, filt, scal, comments, out, contact=()):
             w(f"| {r['mode']} | {r['N']} | {r['delay_ms']} | {r['delay_theory_ms']} | {g(r['ripple_rms_N_per_ms'])} | "
               f"{g(r['ripple_raw_N_per_ms'])} | {g(r['max_jump_N'])} | {g(r['max_jump_raw_N'])} | "
               f"{g(r['peak_raw_N'], '{:.4f}')} | {g(r['peak_filtered_N'], '{:.4f}')} |")
+        w("<!-- study:end accuracy-filter -->")
     if contact:
         w("\n### Force quality (bench_contact: tool pressed 10 mm and held 1 s)\n")
+        w("<!-- study:begin accuracy-contact -->")
         w("| body | tool | cells | dt (ms) | solver | F end (N) | alt. run | late change | loading drop "
           "| ms/step | iters/step | verdict |")
         w("|---|---|---|---|---|---|---|---|---|---|---|---|")
@@ -529,6 +542,7 @@ def tables(rows, anchor_rows, filt, scal, comments, out, contact=()):
               f"{r['solver']} | {g(r['force_N'], '{:.4f}')} | {r['alt_run']} | {g(r['late_rel'], '{:.2e}')} | "
               f"{g(r['load_drop_rel'], '{:.3%}')} | {g(r['ms_median'], '{:.1f}')} | {g(r['iters_mean'], '{:.1f}')} | "
               f"{verdict} |")
+        w("<!-- study:end accuracy-contact -->")
     with open(os.path.join(out, "tables.md"), "w") as f:
         f.write("\n".join(lines) + "\n")
 
