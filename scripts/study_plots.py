@@ -763,7 +763,7 @@ def perf_lines(folder):
             k = r_.rsplit("|", 2)[-2].strip()
             if k not in used:
                 used.append(k)
-        body = ["| the nidus scene | median ms | p95 ms | iterations a step | | time against the first row of its run | run |",
+        body = ["| the nidus scene | median ms | p95 ms | iterations a step | note | time against the first row of its run | run |",
                 "|---|---|---|---|---|---|---|"] + rows + [""] + [f"- {k}: {cmd(k)}" for k in used]
         block("perf-knobs", body)
 
