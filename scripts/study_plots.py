@@ -438,34 +438,9 @@ def g(v, fmt="{:.3g}"):
     return "-" if not fin(x) else fmt.format(x)
 
 
-def tables(rows, anchor_rows, filt, scal, comments, out, contact=()):
-    lines = []
-    w = lines.append
-    w("<!-- written by scripts/study_plots.py -->")
-    for name, c in comments.items():
-        if c:
-            w(f"<!-- {name}: {c} -->")
-    head = ("| solver | tol | cap | median ms | p95 ms | iters/step (max) | pos. RMS err (m) | pos. max err (m) "
-            "| force err (N) | energy err | status |")
-    sep = "|---|---|---|---|---|---|---|---|---|---|---|"
 
-    def row(r, extra_tol=True):
-        tol = "-" if r["solver"] == "exact" else f"{num(r['tol']):.0e}"
-        cap = "-" if r["solver"] == "exact" else r["cap"]
-        return (f"| {r['solver']} | {tol} | {cap} | {g(r['ms_median'])} | {g(r['ms_p95'])} | "
-                f"{g(r['iters_mean'], '{:.1f}')} ({g(r['iters_max'], '{:.0f}')}) | {g(r['disp_rms_err_m'])} | "
-                f"{g(r['disp_max_err_m'])} | {g(r['force_err_N'])} | {g(r['energy_err_rel'])} | {r['status']} |")
-
-    for group, title in (("tolerance", "Fixed tolerance (cap 100000)"),
-                         ("iterations", "Fixed iterations (tolerance 1e-300, the cap varies)")):
-        w(f"\n### {title}\n")
-        w(f"<!-- study:begin accuracy-{group} -->")
-        w(head)
-        w(sep)
-        for r in rows:
-            if r["group"] == group or (group == "tolerance" and r["group"] == "tolerance" and r["solver"] == "exact"):
-                w(row(r))
-        w(f"<!-- study:end accuracy-{group} -->")
+def sweep_tables(rows, w):
+    """The other knobs, stiffness and energy drift tables of the sweep (sweep.csv)."""
     w("\n### Other knobs\n")
     w("<!-- study:begin accuracy-knobs -->")
     w("| group | solver | setting | median ms | p95 ms | iters/step | pos. RMS err vs exact, same scene (m) "
@@ -507,6 +482,39 @@ def tables(rows, anchor_rows, filt, scal, comments, out, contact=()):
             w(f"| {r['solver']} | {tol} | {g(r['ms_median'])} | {g(r['iters_mean'], '{:.1f}')} | "
               f"{g(r['energy_ratio_end'], '{:.3g}')} | {g(r['disp_rms_err_m'])} |")
     w("<!-- study:end accuracy-drift -->")
+
+
+def tables(rows, anchor_rows, filt, scal, comments, out, contact=()):
+    lines = []
+    w = lines.append
+    w("<!-- written by scripts/study_plots.py -->")
+    for name, c in comments.items():
+        if c:
+            w(f"<!-- {name}: {c} -->")
+    head = ("| solver | tol | cap | median ms | p95 ms | iters/step (max) | pos. RMS err (m) | pos. max err (m) "
+            "| force err (N) | energy err | status |")
+    sep = "|---|---|---|---|---|---|---|---|---|---|---|"
+
+    def row(r, extra_tol=True):
+        tol = "-" if r["solver"] == "exact" else f"{num(r['tol']):.0e}"
+        cap = "-" if r["solver"] == "exact" else r["cap"]
+        return (f"| {r['solver']} | {tol} | {cap} | {g(r['ms_median'])} | {g(r['ms_p95'])} | "
+                f"{g(r['iters_mean'], '{:.1f}')} ({g(r['iters_max'], '{:.0f}')}) | {g(r['disp_rms_err_m'])} | "
+                f"{g(r['disp_max_err_m'])} | {g(r['force_err_N'])} | {g(r['energy_err_rel'])} | {r['status']} |")
+
+    # The sweep's tables only when it ran (the `perf` part of the study leaves it out).
+    for group, title in (() if not rows else (("tolerance", "Fixed tolerance (cap 100000)"),
+                         ("iterations", "Fixed iterations (tolerance 1e-300, the cap varies)"))):
+        w(f"\n### {title}\n")
+        w(f"<!-- study:begin accuracy-{group} -->")
+        w(head)
+        w(sep)
+        for r in rows:
+            if r["group"] == group or (group == "tolerance" and r["group"] == "tolerance" and r["solver"] == "exact"):
+                w(row(r))
+        w(f"<!-- study:end accuracy-{group} -->")
+    if rows:
+        sweep_tables(rows, w)
     if anchor_rows:
         w("\n### Analytic anchors\n")
         w("<!-- study:begin accuracy-anchors -->")
