@@ -10,7 +10,7 @@
 #   scripts/study.sh            the whole study: a few minutes on a 2-core machine
 #   scripts/study.sh perf       the performance part only (docs/performance.md: the nidus scene,
 #                               the default world against the other solvers, the factorization,
-#                               the servo loop, the scaling curve): about two minutes
+#                               the servo loop, the scaling curve): about a minute once built
 #   scripts/study.sh quick      a smoke test: a few configurations of each part
 #
 # Environment: MICA_STUDY_BUILD (default ./build-study) is the CMake build folder;
@@ -80,7 +80,7 @@ perf_stages=(
   "nidus|4|$pin $nidus_bin $mesh 1e-6 ${nidus_steps[0]} ${nidus_steps[1]} 1e4 0.01 0 0"
   "refresh|6|$nidus_bin $mesh 1e-6 ${nidus_steps[0]} ${nidus_steps[1]} 1e4 0.01 0 6"
   "linear|3|$pin $nidus_bin $mesh 1e-6 ${nidus_steps[0]} ${nidus_steps[1]} 1e4 0.01 0 0 linear"
-  "defaults|15|$pin $nidus_bin --defaults $mesh $defaults_steps"
+  "defaults|8|$pin $nidus_bin --defaults $mesh $defaults_steps"
   "factor|2|$pin $factor_bin $mesh"
   "factor_omp|3|env -u OMP_THREAD_LIMIT $pin $factor_bin $mesh"
   "servo_idle|$servo_s|$servo_bin $servo_s idle"
@@ -91,14 +91,14 @@ stages=(
   "anchors|90|$bin/study_anchors $out ${quick[*]:-}"
   "filter|35|$bin/study_filter $out"
   "${perf_stages[@]}"
-  "scaling|215|$pin $nidus_bin --scaling $out/scaling.csv $scaling_max factored"
+  "scaling|15|$pin $nidus_bin --scaling $out/scaling.csv $scaling_max factored"
   "contact|90|$pin $contact_bin $contact_set --csv $out/contact.csv"
   "plots|6|/usr/bin/python3 $root/scripts/study_plots.py $out"
 )
 if [[ $mode == perf ]]; then
   stages=(
     "${perf_stages[@]}"
-    "scaling|215|$pin $nidus_bin --scaling $out/scaling.csv $scaling_max factored"
+    "scaling|15|$pin $nidus_bin --scaling $out/scaling.csv $scaling_max factored"
     "plots|6|/usr/bin/python3 $root/scripts/study_plots.py $out"
   )
 fi
