@@ -37,6 +37,8 @@ def blocks(text):
 def drift(old, new):
     """The largest relative change between the numbers of two blocks, and where, or None when the
     words around the numbers differ (a changed layout)."""
+    # The line saying when and on which commit a run was made is not a figure.
+    old, new = (("\n".join(l for l in t.split("\n") if not l.startswith("Measured "))) for t in (old, new))
     if NUMBER.sub("#", old) != NUMBER.sub("#", new):
         return None
     worst, where = 0.0, ""
