@@ -1,7 +1,9 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: Apache-2.0
 """Draws the accuracy-against-time study (scripts/study.sh) from the CSVs in its folder, and
-writes tables.md (the tables of docs/accuracy-vs-time.md and docs/performance.md).
+writes tables.md (the tables of docs/accuracy-vs-time.md and docs/performance.md). The tables the
+docs include are wrapped in <!-- study:begin NAME --> / <!-- study:end NAME --> markers;
+scripts/study_docs.py compares them with (or copies them into) the docs.
 
   error_vs_time.png          position and tool-force error against ms per step, one front per
                              solver and mode (fixed tolerance, fixed iterations), exact as a line
@@ -17,13 +19,16 @@ writes tables.md (the tables of docs/accuracy-vs-time.md and docs/performance.md
                              the Hertz force against depth
   scaling.png                ms per step, iterations and ms per iteration against tets
 and, in tables.md only, the force quality of a held tool and of loading (contact.csv, from
-bench/bench_contact.c).
+bench/bench_contact.c), and the performance tables (perf-*) from the benchmarks' output the study
+keeps as <stage>.txt (nidus, refresh, linear, defaults, factor, factor_omp, servo_idle, servo) with
+the commands in commands.txt.
 
 usage: study_plots.py <study-folder>
 """
 import csv
 import math
 import os
+import re
 import sys
 from collections import OrderedDict, defaultdict
 
@@ -433,33 +438,11 @@ def g(v, fmt="{:.3g}"):
     return "-" if not fin(x) else fmt.format(x)
 
 
-def tables(rows, anchor_rows, filt, scal, comments, out, contact=()):
-    lines = []
-    w = lines.append
-    w("<!-- written by scripts/study_plots.py -->")
-    for name, c in comments.items():
-        if c:
-            w(f"<!-- {name}: {c} -->")
-    head = ("| solver | tol | cap | median ms | p95 ms | iters/step (max) | pos. RMS err (m) | pos. max err (m) "
-            "| force err (N) | energy err | status |")
-    sep = "|---|---|---|---|---|---|---|---|---|---|---|"
 
-    def row(r, extra_tol=True):
-        tol = "-" if r["solver"] == "exact" else f"{num(r['tol']):.0e}"
-        cap = "-" if r["solver"] == "exact" else r["cap"]
-        return (f"| {r['solver']} | {tol} | {cap} | {g(r['ms_median'])} | {g(r['ms_p95'])} | "
-                f"{g(r['iters_mean'], '{:.1f}')} ({g(r['iters_max'], '{:.0f}')}) | {g(r['disp_rms_err_m'])} | "
-                f"{g(r['disp_max_err_m'])} | {g(r['force_err_N'])} | {g(r['energy_err_rel'])} | {r['status']} |")
-
-    for group, title in (("tolerance", "Fixed tolerance (cap 100000)"),
-                         ("iterations", "Fixed iterations (tolerance 1e-300, the cap varies)")):
-        w(f"\n### {title}\n")
-        w(head)
-        w(sep)
-        for r in rows:
-            if r["group"] == group or (group == "tolerance" and r["group"] == "tolerance" and r["solver"] == "exact"):
-                w(row(r))
+def sweep_tables(rows, w):
+    """The other knobs, stiffness and energy drift tables of the sweep (sweep.csv)."""
     w("\n### Other knobs\n")
+    w("<!-- study:begin accuracy-knobs -->")
     w("| group | solver | setting | median ms | p95 ms | iters/step | pos. RMS err vs exact, same scene (m) "
       "| model error (m or N) | force err (N) | penetration (m) | status |")
     w("|---|---|---|---|---|---|---|---|---|---|---|")
@@ -478,7 +461,9 @@ def tables(rows, anchor_rows, filt, scal, comments, out, contact=()):
         w(f"| {gr} | {r['solver']} | {setting} | {g(r['ms_median'])} | {g(r['ms_p95'])} | "
           f"{g(r['iters_mean'], '{:.1f}')} | {g(r['disp_rms_err_m'])} | {model} | {g(r['force_err_N'])} | "
           f"{g(r['penetration_m'])} | {r['status']} |")
+    w("<!-- study:end accuracy-knobs -->")
     w("\n### Stiffness (tol 1e-8, 50 steps)\n")
+    w("<!-- study:begin accuracy-stiffness -->")
     w("| E (Pa) | solver | median ms | p95 ms | iters/step (max) | pos. RMS err (m) | force err (N) | status |")
     w("|---|---|---|---|---|---|---|---|")
     for r in rows:
@@ -486,7 +471,9 @@ def tables(rows, anchor_rows, filt, scal, comments, out, contact=()):
             w(f"| {num(r['E_Pa']):.0e} | {r['solver']} | {g(r['ms_median'])} | {g(r['ms_p95'])} | "
               f"{g(r['iters_mean'], '{:.1f}')} ({g(r['iters_max'], '{:.0f}')}) | {g(r['disp_rms_err_m'])} | "
               f"{g(r['force_err_N'])} | {r['status']} |")
+    w("<!-- study:end accuracy-stiffness -->")
     w("\n### Energy drift (undamped free vibration, 1 s)\n")
+    w("<!-- study:begin accuracy-drift -->")
     w("| solver | tol | median ms | iters/step | energy end / start | pos. RMS err vs exact (m) |")
     w("|---|---|---|---|---|---|")
     for r in rows:
@@ -494,8 +481,43 @@ def tables(rows, anchor_rows, filt, scal, comments, out, contact=()):
             tol = "-" if r["solver"] == "exact" else f"{num(r['tol']):.0e}"
             w(f"| {r['solver']} | {tol} | {g(r['ms_median'])} | {g(r['iters_mean'], '{:.1f}')} | "
               f"{g(r['energy_ratio_end'], '{:.3g}')} | {g(r['disp_rms_err_m'])} |")
+    w("<!-- study:end accuracy-drift -->")
+
+
+def tables(rows, anchor_rows, filt, scal, comments, out, contact=()):
+    lines = []
+    w = lines.append
+    w("<!-- written by scripts/study_plots.py -->")
+    for name, c in comments.items():
+        if c:
+            w(f"<!-- {name}: {c} -->")
+    head = ("| solver | tol | cap | median ms | p95 ms | iters/step (max) | pos. RMS err (m) | pos. max err (m) "
+            "| force err (N) | energy err | status |")
+    sep = "|---|---|---|---|---|---|---|---|---|---|---|"
+
+    def row(r, extra_tol=True):
+        tol = "-" if r["solver"] == "exact" else f"{num(r['tol']):.0e}"
+        cap = "-" if r["solver"] == "exact" else r["cap"]
+        return (f"| {r['solver']} | {tol} | {cap} | {g(r['ms_median'])} | {g(r['ms_p95'])} | "
+                f"{g(r['iters_mean'], '{:.1f}')} ({g(r['iters_max'], '{:.0f}')}) | {g(r['disp_rms_err_m'])} | "
+                f"{g(r['disp_max_err_m'])} | {g(r['force_err_N'])} | {g(r['energy_err_rel'])} | {r['status']} |")
+
+    # The sweep's tables only when it ran (the `perf` part of the study leaves it out).
+    for group, title in (() if not rows else (("tolerance", "Fixed tolerance (cap 100000)"),
+                         ("iterations", "Fixed iterations (tolerance 1e-300, the cap varies)"))):
+        w(f"\n### {title}\n")
+        w(f"<!-- study:begin accuracy-{group} -->")
+        w(head)
+        w(sep)
+        for r in rows:
+            if r["group"] == group or (group == "tolerance" and r["group"] == "tolerance" and r["solver"] == "exact"):
+                w(row(r))
+        w(f"<!-- study:end accuracy-{group} -->")
+    if rows:
+        sweep_tables(rows, w)
     if anchor_rows:
         w("\n### Analytic anchors\n")
+        w("<!-- study:begin accuracy-anchors -->")
         w("| test | model | h (m) | nodes | tets | FEM | theory | rel. error | vs Timoshenko (beam) | ms |")
         w("|---|---|---|---|---|---|---|---|---|---|")
         for r in anchor_rows:
@@ -503,8 +525,10 @@ def tables(rows, anchor_rows, filt, scal, comments, out, contact=()):
                      else f"(last 3 steps spread {g(r.get('spread'), '{:.1%}')})")
             w(f"| {r['test']} | {r['model']} | {g(r['h_m'])} | {r['nodes']} | {r['tets']} | {g(r['fem'], '{:.5g}')} | "
               f"{g(r['theory'], '{:.5g}')} | {g(r['rel_error'], '{:+.2%}')} | {extra} | {g(r['ms'], '{:.0f}')} |")
+        w("<!-- study:end accuracy-anchors -->")
     if filt:
         w("\n### Filter window (device side)\n")
+        w("<!-- study:begin accuracy-filter -->")
         w("| mode | N | delay (ms) | (N-1)/2 | ripple (N/ms) | raw ripple | largest jump (N) | raw jump (N) "
           "| peak raw (N) | peak rendered (N) |")
         w("|---|---|---|---|---|---|---|---|---|---|")
@@ -512,15 +536,10 @@ def tables(rows, anchor_rows, filt, scal, comments, out, contact=()):
             w(f"| {r['mode']} | {r['N']} | {r['delay_ms']} | {r['delay_theory_ms']} | {g(r['ripple_rms_N_per_ms'])} | "
               f"{g(r['ripple_raw_N_per_ms'])} | {g(r['max_jump_N'])} | {g(r['max_jump_raw_N'])} | "
               f"{g(r['peak_raw_N'], '{:.4f}')} | {g(r['peak_filtered_N'], '{:.4f}')} |")
-    if scal:
-        w("\n### Scaling (0.1 m cube, MICA factored sweep, tol 1e-6, one core)\n")
-        w("| cells | nodes | tets | median ms | p95 ms | iters/step | ms/iteration | memory (B/tet) |")
-        w("|---|---|---|---|---|---|---|---|")
-        for r in scal:
-            w(f"| {r['cells']}^3 | {r['nodes']} | {r['tets']} | {g(r['ms_median'])} | {g(r['ms_p95'])} | "
-              f"{g(r['iterations'], '{:.1f}')} | {g(r['ms_per_iteration'], '{:.4f}')} | {r['mem_B_per_tet']} |")
+        w("<!-- study:end accuracy-filter -->")
     if contact:
         w("\n### Force quality (bench_contact: tool pressed 10 mm and held 1 s)\n")
+        w("<!-- study:begin accuracy-contact -->")
         w("| body | tool | cells | dt (ms) | solver | F end (N) | alt. run | late change | loading drop "
           "| ms/step | iters/step | verdict |")
         w("|---|---|---|---|---|---|---|---|---|---|---|---|")
@@ -531,8 +550,325 @@ def tables(rows, anchor_rows, filt, scal, comments, out, contact=()):
               f"{r['solver']} | {g(r['force_N'], '{:.4f}')} | {r['alt_run']} | {g(r['late_rel'], '{:.2e}')} | "
               f"{g(r['load_drop_rel'], '{:.3%}')} | {g(r['ms_median'], '{:.1f}')} | {g(r['iters_mean'], '{:.1f}')} | "
               f"{verdict} |")
+        w("<!-- study:end accuracy-contact -->")
     with open(os.path.join(out, "tables.md"), "w") as f:
         f.write("\n".join(lines) + "\n")
+
+
+# ---- the performance tables (docs/performance.md), from the benchmarks' own output
+
+def read_text(folder, name):
+    path = os.path.join(folder, name + ".txt")
+    if not os.path.exists(path):
+        return None
+    with open(path) as f:
+        return f.read()
+
+
+def commands(folder):
+    """Each stage's command as the docs print it (study.sh writes commands.txt: name|command)."""
+    out = {}
+    path = os.path.join(folder, "commands.txt")
+    if os.path.exists(path):
+        with open(path) as f:
+            for line in f:
+                if "|" in line:
+                    name, cmd = line.rstrip("\n").split("|", 1)
+                    # The 4-thread factorization: the study's environment without OMP_THREAD_LIMIT.
+                    cmd = cmd.replace("OMP_THREAD_LIMIT=1 OPENBLAS_NUM_THREADS=1 env -u OMP_THREAD_LIMIT ",
+                                      "OPENBLAS_NUM_THREADS=1 ")
+                    out[name] = cmd
+    return out
+
+
+def nidus_sections(text):
+    """bench_nidus's output: {section title: {key: value text}} (keys as printed, e.g. 'median ms/step')."""
+    sections, cur = OrderedDict(), None
+    for line in (text or "").splitlines():
+        if line.startswith("## "):
+            cur = sections.setdefault(line[3:].strip(), {})
+        elif cur is not None and line.startswith("# bench_nidus:"):
+            m = re.search(r"load average ([\d.]+)", line)
+            cur["load"] = m.group(1) if m else "?"
+        elif cur is not None and line.startswith("# mesh "):
+            m = re.search(r"(\d+) tets", line)
+            cur["tets"] = m.group(1) if m else "?"
+        elif cur is not None and line.startswith("mean ms/step by stage "):
+            cur["mean ms/step by stage"] = line[len("mean ms/step by stage "):]
+        elif cur is not None and not line.startswith("#"):
+            m = re.match(r"^(\S.*?)\s{2,}(.*)$", line)
+            if m:
+                cur[m.group(1).strip()] = m.group(2).strip()
+    return sections
+
+
+def first_num(v, default=math.nan):
+    m = re.search(r"[-+]?\d+(?:\.\d+)?(?:e[-+]?\d+)?", v or "")
+    return float(m.group(0)) if m else default
+
+
+def held_b_per_tet(sec):
+    m = re.search(r"held (\d+) B/tet", sec.get("memory, after 1 step", ""))
+    return int(m.group(1)) if m else None
+
+
+def stages_of(sec):
+    return {k: float(v) for k, v in re.findall(r"(\w+) ([\d.]+)", sec.get("mean ms/step by stage", ""))}
+
+
+def source_of_run(folder):
+    """When the run was (its nidus output's time) and the commit of the source it ran."""
+    root = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..")
+    stamp = "?"
+    path = os.path.join(folder, "nidus.txt")
+    if os.path.exists(path):
+        import datetime
+        stamp = datetime.datetime.utcfromtimestamp(os.path.getmtime(path)).strftime("%Y-%m-%d %H:%M UTC")
+    try:
+        import subprocess
+        commit = subprocess.run(["git", "-C", root, "rev-parse", "--short", "HEAD"], stdout=subprocess.PIPE,
+                                stderr=subprocess.DEVNULL, universal_newlines=True).stdout.strip() or "?"
+        dirty = subprocess.run(["git", "-C", root, "status", "--porcelain", "--untracked-files=no", "--", "src",
+                                "capi", "include", "bench", "scenes", "CMakeLists.txt"], stdout=subprocess.PIPE,
+                               stderr=subprocess.DEVNULL, universal_newlines=True).stdout.strip()
+        commit += " with local changes to the library or benchmarks" if dirty else ""
+    except OSError:
+        commit = "?"
+    return stamp, commit
+
+
+def headline(folder, fac, cmds, block):
+    """The figures a reader asks first, each from one of the runs below it."""
+    rows, used = [], []
+
+    def row(what, figure, run):
+        rows.append(f"| {what} | {figure} | {run} |")
+        for r in run.split(", "):
+            if r not in used:
+                used.append(r)
+
+    if fac:
+        row("the nidus step (9668 tets, a tool moving in contact), one core: median / p95",
+            f"**{first_num(fac['median ms/step']):.2f} / {first_num(fac['p95 ms/step']):.2f} ms**", "nidus")
+        row("its conjugate-gradient iterations a step", f"{first_num(fac['iterations/step']):.1f}", "nidus")
+        held = held_b_per_tet(fac)
+        if held:
+            row("memory the world holds, nidus", f"**{held} B per tet**", "nidus")
+    d = nidus_sections(read_text(folder, "defaults"))
+    if d.get("the default world") and d.get("solver DIRECT"):
+        a, b = first_num(d["the default world"]["median ms/step"]), first_num(d["solver DIRECT"]["median ms/step"])
+        row("the default world against the exact solver (`MICA_SOLVER_DIRECT`), nidus: median step",
+            f"{a:.2f} against {b:.2f} ms: {b / a:.1f}x faster", "defaults")
+    scal, _ = read(os.path.join(folder, "scaling.csv"))
+    if scal:
+        pick = [scal[0]] + [r for r in scal if 30000 <= num(r["tets"]) <= 40000][:1] + [scal[-1]]
+        row("the scaling curve (a cube, one core): median step at " + " / ".join(f"{int(num(r['tets'])):,} tets"
+                                                                                  for r in pick),
+            "**" + " / ".join(f"{g(r['ms_median'])}" for r in pick) + " ms**", "scaling")
+        held = [num(r.get("mem_held_B_per_tet")) for r in scal if fin(num(r.get("mem_held_B_per_tet")))]
+        if held:
+            row("memory the world holds along the curve", f"{min(held):.0f}-{max(held):.0f} B per tet", "scaling")
+    servo, idle = read_text(folder, "servo"), read_text(folder, "servo_idle")
+    if servo:
+        cost = re.search(r"poll cost \(us\):\s+median ([\d.]+)", servo)
+        late = re.search(r"late \(ms\):.*?p99.9 ([\d.]+)", servo)
+        late_idle = re.search(r"late \(ms\):.*?p99.9 ([\d.]+)", idle or "")
+        if cost:
+            row("the 1 kHz servo loop beside the stepping nidus: one poll, median", f"{cost.group(1)} us", "servo")
+        if late and late_idle:
+            row("its cycles' lateness, p99.9, beside the nidus / with nothing stepping",
+                f"{late.group(1)} / {late_idle.group(1)} ms", "servo, servo_idle")
+    if not rows:
+        return
+    stamp, commit = source_of_run(folder)
+    body = ["| | | run |", "|---|---|---|"] + rows + [""]
+    body += [f"- {k}: `{cmds[k]}`" if k in cmds else f"- {k}: (not run)" for k in used]
+    body += ["", f"Measured {stamp} by `scripts/study.sh` (its `perf` part), source {commit}."]
+    block("perf-headline", body)
+
+
+def perf_lines(folder):
+    cmds = commands(folder)
+    lines = []
+    w = lines.append
+
+    def cmd(name):
+        return f"`{cmds[name]}`" if name in cmds else "(not run)"
+
+    def block(name, body):
+        w(f"\n<!-- study:begin {name} -->")
+        lines.extend(body)
+        w(f"<!-- study:end {name} -->")
+
+    nidus = nidus_sections(read_text(folder, "nidus"))
+    fac = nidus.get("factored sweep")
+    headline(folder, fac, cmds, block)
+    if fac:
+        st = stages_of(fac)
+        other = sum(v for k, v in st.items() if k not in ("rotations", "elements", "solve"))
+        held = held_b_per_tet(fac)
+        force = fac.get("tool force", "").split(",")[0]
+        body = ["| the nidus step (factored sweep, tol 1e-6, one core) | |", "|---|---|",
+                f"| median / p95 ms a step | **{first_num(fac['median ms/step']):.2f}** / "
+                f"**{first_num(fac['p95 ms/step']):.2f}** (max {first_num(fac['max ms/step']):.2f}) |",
+                f"| the stepping thread's CPU time, median | {first_num(fac['median CPU ms/step']):.2f} ms |",
+                f"| where it goes (mean ms a step) | rotations {st.get('rotations', math.nan):.2f}, elements "
+                f"{st.get('elements', math.nan):.2f}, solve {st.get('solve', math.nan):.2f}, the rest {other:.2f} |",
+                f"| conjugate-gradient iterations / velocity solves a step | {first_num(fac['iterations/step']):.1f} / "
+                f"{first_num(fac['solves/step']):.2f} |",
+                f"| memory held after the first step | {held} B per tet "
+                f"({held * first_num(fac.get('tets')) / 1e6:.1f} MB for {fac.get('tets')} tets) |" if held else "| memory held | - |",
+                f"| tool force at the end | {force} |",
+                f"| contact nodes whose velocity change reverses from one step to the next | "
+                f"{fac.get('velocity reversals', '-').split(' of ')[0]} |",
+                "",
+                f"Load average at the start: {fac.get('load', '?')}. Command: {cmd('nidus')}"]
+        block("perf-nidus", body)
+
+    rows = []
+    d = nidus_sections(read_text(folder, "defaults"))
+    dw = d.get("the default world")
+    if dw:
+        base = first_num(dw["median ms/step"])
+        for title, label in (("the default world", "the default world: MICA, factored sweep, tol 1e-8, cap 200"),
+                             ("solver DIRECT", "`solver = MICA_SOLVER_DIRECT` (exact, the default before 0.5)"),
+                             ("MICA, Gauss-Seidel sweep", "`mica_sweep = MICA_SWEEP_GAUSS_SEIDEL` (the paper's sweep)")):
+            sec = d.get(title)
+            if not sec:
+                continue
+            med = first_num(sec["median ms/step"])
+            capped = re.search(r"(\d+) stopped at the cap", sec.get("iterations/step", ""))
+            note = f"{capped.group(1)} of the steps stopped at the cap" if capped and capped.group(1) != "0" else "every step converged"
+            rows.append(f"| {label} | {med:.2f} | {first_num(sec['p95 ms/step']):.2f} | "
+                        f"{first_num(sec['iterations/step']):.1f} | {note} | "
+                        f"{'1' if sec is dw else f'{med / base:.1f}x'} | defaults |")
+    r = nidus_sections(read_text(folder, "refresh"))
+    rf, rr = r.get("factored sweep"), next((v for k, v in r.items() if "refreshed" in k), None)
+    if rf and rr:
+        m = re.search(r"every (\d+) steps", next(k for k in r if "refreshed" in k))
+        every = m.group(1) if m else "?"
+        base = first_num(rf["median ms/step"])
+        for sec, label in ((rf, "factored sweep, tol 1e-6, `refactor_interval = 0`, not pinned"),
+                           (rr, f"the same, `refactor_interval = {every}` (a second core factors)")):
+            med = first_num(sec["median ms/step"])
+            rows.append(f"| {label} | {med:.2f} | {first_num(sec['p95 ms/step']):.2f} | "
+                        f"{first_num(sec['iterations/step']):.1f} | "
+                        f"{first_num(sec.get('factorizations', '0')):.0f} factorizations in the timed steps | "
+                        f"{'1' if sec is rf else f'{med / base:.2f}x'} | refresh |")
+    lin = nidus_sections(read_text(folder, "linear")).get("factored sweep")
+    if lin and fac:
+        base = first_num(fac["median ms/step"])
+        med = first_num(lin["median ms/step"])
+        rows.append(f"| factored sweep, tol 1e-6, co-rotational body (the `nidus` run above) | {base:.2f} | "
+                    f"{first_num(fac['p95 ms/step']):.2f} | {first_num(fac['iterations/step']):.1f} | "
+                    f"tool force {fac.get('tool force', '').split(',')[0]} | 1 | nidus |")
+        rows.append(f"| the same, `mica_body_def.model = MICA_MODEL_LINEAR` | {med:.2f} | "
+                    f"{first_num(lin['p95 ms/step']):.2f} | {first_num(lin['iterations/step']):.1f} | "
+                    f"tool force {lin.get('tool force', '').split(',')[0]} | {med / base:.2f}x | linear |")
+    if rows:
+        used = []
+        for r_ in rows:
+            k = r_.rsplit("|", 2)[-2].strip()
+            if k not in used:
+                used.append(k)
+        body = ["| the nidus scene | median ms | p95 ms | iterations a step | note | time against the first row of its run | run |",
+                "|---|---|---|---|---|---|---|"] + rows + [""] + [f"- {k}: {cmd(k)}" for k in used]
+        block("perf-knobs", body)
+
+    def factor_parts(text):
+        """bench_factor's figures: CHOLMOD's own factorizations, and DirectSolver's free and held."""
+        out = {}
+        for kind, label in (("simplicial", r"simplicial LDL\^T"), ("supernodal", r"supernodal LL\^T \(AMD\)")):
+            m = re.search(label + r"\s+analyse\s+([\d.]+) ms\s+factor\s+([\d.]+) ms\s+solve 1 rhs\s+([\d.]+) ms",
+                          text or "")
+            if m:
+                out[kind] = tuple(float(x) for x in m.groups())
+        for key, head in (("free", "no node held"), ("held", "the lowest fifth held")):
+            i = (text or "").find("DirectSolver, " + head)
+            if i < 0:
+                continue
+            part = text[i:]
+            j = part.find("DirectSolver, ", 10)
+            part = part[:j] if j > 0 else part
+            f = {}
+            for name, pat in (("nnz", r"\(([\d.]+) M nonzeros in L\)"), ("flops", r"([\d.e+]+) flops"),
+                              ("analyse", r"analyse ([\d.]+) ms"), ("again", r"ordering known: ([\d.]+) ms"),
+                              ("factor", r"\), factor ([\d.]+) ms"), ("cholmod", r"cholmod_solve2 ([\d.]+) ms"),
+                              ("hand", r"by hand ([\d.]+) ms"), ("single", r"single precision ([\d.]+) ms"),
+                              ("half", r"half precision ([\d.]+) ms"),
+                              ("half_diff", r"half precision [\d.]+ ms \([\d.]+x single, difference ([\d.e+-]+)\)"),
+                              ("columns", r"(\d+) nodes in ([\d.]+) ms")):
+                m = re.search(pat, part)
+                if m:
+                    f[name] = m.group(1) if name != "columns" else (m.group(1), m.group(2))
+            out[key] = f
+        return out
+
+    fa, fo = factor_parts(read_text(folder, "factor")), factor_parts(read_text(folder, "factor_omp"))
+    if fa.get("held"):
+        fr, he = fa.get("free", {}), fa["held"]
+
+        def both(fn):
+            return f"{fn(fr) if fr else '-'} | {fn(he)}"
+
+        body = ["| the nidus system (`DirectSolver`: CHOLMOD, supernodal) | no node held | its lowest fifth held "
+                "(the benchmark's scene) |", "|---|---|---|",
+                "| nonzeros in L; flops a factorization | " + both(lambda f: f"{f.get('nnz')} M; {f.get('flops')}") + " |",
+                "| the first analysis (it finds the ordering); again, the ordering known (ms) | "
+                + both(lambda f: f"{f.get('analyse')}; {f.get('again')}") + " |",
+                "| a factorization, one thread (ms) | " + both(lambda f: f"**{f.get('factor')}**") + " |"]
+        f4 = fo.get("held", {}).get("factor")
+        if f4:
+            f1 = float(he["factor"])
+            body.append(f"| the same with CHOLMOD's OpenMP threads (4 in Debian's build) on the same core (ms) | "
+                        f"{fo.get('free', {}).get('factor', '-')} | {f4} ({float(f4) / f1:.1f}x) |")
+        body += ["| a solve pair with the factor: `cholmod_solve2`; by hand in double; single; half precision (ms) | "
+                 + both(lambda f: f"{f.get('cholmod')}; {f.get('hand')}; {f.get('single')}; **{f.get('half')}**") + " |",
+                 "| the half-precision pair's relative difference from the double one | "
+                 + both(lambda f: f"{f.get('half_diff')}") + " |",
+                 "| the half columns of " + (he.get("columns", ("?", ""))[0]) + " contact nodes (ms) | "
+                 + both(lambda f: f"{f.get('columns', ('', '-'))[1]}") + " |"]
+        sn, sp = fa.get("supernodal"), fa.get("simplicial")
+        if sn and sp:
+            body.append(f"| CHOLMOD's supernodal LL^T against its simplicial LDL^T (AMD ordering, no node held): "
+                        f"factorization (ms) | {sn[1]} against {sp[1]} ({sp[1] / sn[1]:.1f}x) | |")
+        body += ["", f"- {cmd('factor')}"] + ([f"- {cmd('factor_omp')}"] if f4 else [])
+        block("perf-factor", body)
+
+    srows = []
+    for name, label in (("servo_idle", "nothing (`idle`)"), ("servo", "the nidus, factored sweep, `refactor_interval = 0`")):
+        t = read_text(folder, name)
+        if not t:
+            continue
+        sps = re.search(r"\(([\d.]+) steps/s\)", t)
+        fifo = "SCHED_FIFO 80" if "SCHED_FIFO 80" in t else "fair scheduler"
+        cost = re.search(r"poll cost \(us\):\s+median ([\d.]+)\s+p99 ([\d.]+)", t)
+        late = re.search(r"late \(ms\):\s+median [\d.]+\s+p99 ([\d.]+)\s+p99.9 ([\d.]+)\s+max ([\d.]+).*?(\d+) of (\d+) cycles",
+                         t)
+        if not (cost and late):
+            continue
+        srows.append(f"| {label} | {sps.group(1) if sps and name != 'servo_idle' else '-'} | {cost.group(1)} / "
+                     f"{cost.group(2)} | {late.group(1)} / {late.group(2)} / {late.group(3)} | {late.group(4)} of "
+                     f"{late.group(5)} | {fifo} |")
+    if srows:
+        body = ["| stepping alongside | steps/s | one poll, median / p99 (us) | late, p99 / p99.9 / max (ms) "
+                "| cycles late by > 0.5 ms | servo thread |", "|---|---|---|---|---|---|"] + srows + [""]
+        body += [f"- {cmd(n)}" for n in ("servo_idle", "servo") if n in cmds]
+        block("perf-servo", body)
+
+    scal, _ = read(os.path.join(folder, "scaling.csv"))
+    if scal:
+        body = ["| cells | nodes | tets | median ms | p95 ms | iterations a step | ms per iteration "
+                "| memory held (B per tet) | rotations, elements, solve (mean ms) |",
+                "|---|---|---|---|---|---|---|---|---|"]
+        for r_ in scal:
+            body.append(f"| {r_['cells']}^3 | {r_['nodes']} | {r_['tets']} | {g(r_['ms_median'])} | {g(r_['ms_p95'])} | "
+                        f"{g(r_['iterations'], '{:.1f}')} | {g(r_['ms_per_iteration'], '{:.3g}')} | "
+                        f"{g(r_.get('mem_held_B_per_tet'), '{:.0f}')} | {g(r_.get('ms_rotations'), '{:.2f}')}, "
+                        f"{g(r_.get('ms_elements'), '{:.2f}')}, {g(r_.get('ms_solve'), '{:.3g}')} |")
+        body += ["", f"Command: {cmd('scaling')}"]
+        block("perf-scaling", body)
+    return lines
 
 
 def main(folder):
@@ -555,6 +891,10 @@ def main(folder):
     tables(rows, anchor_rows, filt, scal,
            {"sweep": c_sweep, "anchors": c_anchor, "filter": c_filter, "scaling": c_scal, "contact": c_contact}, folder,
            contact)
+    extra = perf_lines(folder)
+    if extra:
+        with open(os.path.join(folder, "tables.md"), "a") as f:
+            f.write("\n## Performance (docs/performance.md)\n" + "\n".join(extra) + "\n")
     print(f"plots and tables.md in {folder}")
 
 
