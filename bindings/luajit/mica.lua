@@ -343,6 +343,11 @@ function World:lpc_reaction(lpc)
   return force
 end
 
+function World:teleport_tool(tool, position, orientation)
+  self:check(C.mica_tool_teleport(self.ptr, tool, vec(position, 3, "teleport_tool position"),
+                                  vec(orientation or IDENTITY, 4, "teleport_tool orientation")))
+end
+
 function World:set_tool_pose(tool, position, orientation)
   self:check(C.mica_tool_set_pose(self.ptr, tool, vec(position, 3, "set_tool_pose position"),
                                   vec(orientation or IDENTITY, 4, "set_tool_pose orientation")))

@@ -489,6 +489,9 @@ static class TestMica
             double[] p = new double[3], q = new double[4];
             tool.GetPose(p, q);
             Expect(p[1] == 2, "a wrapped raw tool id");
+            tool.Teleport(new double[] { 0, 3, 0 });
+            tool.GetPose(p, q);
+            Expect(p[1] == 3, "a teleport puts the tool where it is told");
             var same = new Body(world, body.Id);
             same.GetCounts(out nodes, out tets, out triangles);
             Expect(tets > 0, "a wrapped body id");

@@ -171,6 +171,19 @@ test("a table of the wrong length is refused, naming what and where", function()
   expect(same(pose(), { 0.1, 0.2, 0.3 }), "a refused pose leaves the tool where it was")
   world:set_tool_pose(tool, { 0.1, 0.25, 0.3 })
   expect(same(pose(), { 0.1, 0.25, 0.3 }), "a pose of 3 values is taken as given")
+  expect_refused("teleport_tool position: expected 3 values, got 1", world.teleport_tool, world, tool, { 0.2 })
+
+  -- A teleport is no sweep: a sphere made inside a box and put above it touches nothing.
+  local lift = mica.world{ gravity = { 0, 0, 0 } }
+  lift:create_box({ 0, 0, 0 }, { 0.1, 0.1, 0.1 }, { 2, 2, 2 })
+  local inside = lift:create_tool{ radius = 0.01, position = { 0.05, 0.05, 0.05 } }
+  lift:teleport_tool(inside, { 0.05, 0.2, 0.05 })
+  lift:step(0.01)
+  local force = ffi.new("double[3]")
+  local contacts = ffi.new("int32_t[1]")
+  lift:check(C.mica_tool_get_force(lift.ptr, inside, force, nil, contacts))
+  expect(force[0] == 0 and force[1] == 0 and force[2] == 0 and contacts[0] == 0, "a teleported tool swept nothing")
+  lift:close()
 
   expect_refused("mica_tool_def.position: expected 3 values, got 1", world.create_tool, world, { position = { 0.5 } })
   expect_refused("mica_tool_def.orientation: expected 4 values, got 2", world.create_tool, world,

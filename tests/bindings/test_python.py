@@ -243,6 +243,19 @@ class Behaviour(unittest.TestCase):
                     grab.set_targets, np.zeros((2, 4)))
 
     @unittest.skipIf("mica_device_create" in native.missing, "the loaded libmica has no device functions yet")
+    def test_teleport_is_no_sweep(self):
+        """A sphere made inside a box and teleported above it touches nothing; set_pose would sweep."""
+        with mica.World(gravity=(0, 0, 0)) as world:
+            world.create_box((0, 0, 0), (0.1, 0.1, 0.1), (2, 2, 2), 5)
+            tool = world.create_tool(radius=0.01, position=(0.05, 0.05, 0.05))
+            tool.teleport((0.05, 0.2, 0.05))
+            world.step(0.01)
+            force, _, contacts = tool.force()
+            self.assertEqual((tuple(force), contacts), ((0.0, 0.0, 0.0), 0))
+            self.assertEqual(tuple(tool.pose()[0]), (0.05, 0.2, 0.05))
+            with self.assertRaisesRegex(ValueError, "teleport position: expected 3 values, got 1"):
+                tool.teleport((0.2,))
+
     def test_a_trajectory_of_the_wrong_length_is_reported(self):
         # The trajectory runs inside a C callback: its error goes to sys.unraisablehook.
         reported = []

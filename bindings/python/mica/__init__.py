@@ -781,9 +781,16 @@ class Tool(_Object):
     """A kinematic rigid tool: the host sets its pose, the bodies push back on it."""
 
     def set_pose(self, position: Vec3, orientation: Quat = (1, 0, 0, 0)) -> None:
+        """The pose for the next step, which sweeps the tool there from its last pose."""
         self.world._check(native.mica_tool_set_pose(
             self.world.handle, self.id, _doubles(position, 3, "set_pose position"),
             _doubles(orientation, 4, "set_pose orientation")), "mica_tool_set_pose")
+
+    def teleport(self, position: Vec3, orientation: Quat = (1, 0, 0, 0)) -> None:
+        """Puts the tool at a pose without a sweep (nothing on the way is pushed)."""
+        self.world._check(native.mica_tool_teleport(
+            self.world.handle, self.id, _doubles(position, 3, "teleport position"),
+            _doubles(orientation, 4, "teleport orientation")), "mica_tool_teleport")
 
     def pose(self) -> Tuple[np.ndarray, np.ndarray]:
         """(position m, orientation quaternion w, x, y, z) as numpy vectors; a tool driven by a

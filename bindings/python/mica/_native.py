@@ -386,6 +386,7 @@ PROTOTYPES = {
     "mica_tool_create": (mica_status, [mica_world_p, _p(mica_tool_def), _p(mica_tool_id)]),
     "mica_tool_destroy": (mica_status, [mica_world_p, mica_tool_id]),
     "mica_tool_set_pose": (mica_status, [mica_world_p, mica_tool_id, _p(_d), _p(_d)]),
+    "mica_tool_teleport": (mica_status, [mica_world_p, mica_tool_id, _p(_d), _p(_d)]),
     "mica_tool_get_pose": (mica_status, [mica_world_p, mica_tool_id, _p(_d), _p(_d)]),
     "mica_tool_get_force": (mica_status, [mica_world_p, mica_tool_id, _p(_d), _p(_d), _p(_i)]),
     # stepping, statistics, output

@@ -654,9 +654,17 @@ namespace LibMica
         /// <summary>Wraps a tool id of `world` (one the raw MicaNative calls returned).</summary>
         public Tool(World world, ulong id) { World = world; Id = id; }
 
+        /// <summary>The pose for the next step, which sweeps the tool there from its last pose.</summary>
         public void SetPose(double[] position, double[] orientation = null)
         {
             World.Check(MicaNative.mica_tool_set_pose(World.Handle, Id, Mica.Vec(position, 3, "position"),
+                                                      Mica.Vec(orientation ?? Identity, 4, "orientation")));
+        }
+
+        /// <summary>Puts the tool at a pose without a sweep (nothing on the way is pushed).</summary>
+        public void Teleport(double[] position, double[] orientation = null)
+        {
+            World.Check(MicaNative.mica_tool_teleport(World.Handle, Id, Mica.Vec(position, 3, "position"),
                                                       Mica.Vec(orientation ?? Identity, 4, "orientation")));
         }
 

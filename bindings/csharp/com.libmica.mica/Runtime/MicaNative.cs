@@ -500,6 +500,9 @@ namespace LibMica
         public static extern int mica_tool_set_pose(WorldHandle world, ulong tool, double[] position, double[] orientation);
 
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern int mica_tool_teleport(WorldHandle world, ulong tool, double[] position, double[] orientation);
+
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
         public static extern int mica_tool_get_pose(WorldHandle world, ulong tool, double[] out_position,
                                                     double[] out_orientation);
 
