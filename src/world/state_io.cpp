@@ -21,8 +21,11 @@
 // work arrays, and a linear body's assembled matrix (reassembled: the same bits).
 #include <algorithm>
 #include <cstring>
+#include <functional>
+#include <type_traits>
 
 #include "core/byte_stream.hpp"
+#include "world/state_fields.hpp"
 #include "world/recording.hpp"
 #include "world/world.hpp"
 
@@ -120,27 +123,9 @@ std::string shape_difference(const Shape& saved, const Shape& here) {
   return {};
 }
 
-// What a restore reads for a body before it changes anything.
-struct BodyData {
-  Vec3List x, v, v_previous, node_forces;
-  uint8_t has_node_forces = 0;
-  BodyState::EndRotations end;
-  std::vector<uint8_t> solver;
-};
-
-struct ToolData {
-  Vec3 position, previous_position, force, torque;
-  Eigen::Quaterniond orientation, previous_orientation;
-  Mat3 stiffness;
-  int32_t contact_count;
-  int32_t unused = 0;
-};
-
 // A state copies these structs as bytes: a padding byte would be uninitialised, and two saves of
 // one state could differ in it. Each size is the sum of its fields'.
 static_assert(sizeof(StateShape::BodyShape) == 2 * 4 + 4 * 1, "BodyShape has padding");
-static_assert(sizeof(ToolData) == 4 * sizeof(Vec3) + 2 * sizeof(Eigen::Quaterniond) + sizeof(Mat3) + 2 * 4,
-              "ToolData has padding");
 static_assert(sizeof(BodyPoint) == 6 * 4 + 3 * 8, "BodyPoint has padding");
 static_assert(sizeof(Contact) == 8 + 2 * sizeof(BodyPoint) + 3 * sizeof(Vec3) + 2 * 8 + 4 * 4 + 8, "Contact has padding");
 static_assert(sizeof(RowTerm) == 2 * 4 + 8, "RowTerm has padding");
@@ -148,14 +133,136 @@ static_assert(sizeof(StageStats) == 2 * 4 + 3 * 8, "StageStats has padding");
 static_assert(sizeof(WorldStats) == 8 + kStageCount * sizeof(StageStats) + 2 * 8 + 4 + 2 * 1 + 2 * 1 + 2 * 4,
               "WorldStats has padding");
 
-struct LpcData {
-  Vec3 velocity, reaction;
-  uint8_t has_handle = 0;
-  std::unique_ptr<Handle> handle;  // made while reading: putting it in place cannot fail
-};
-
 void require(bool ok, const std::string& message) {
   if (!ok) fail(Errc::Parse, message + ": corrupt state");
+}
+
+template <class T>
+struct is_vector : std::false_type {};
+template <class T, class A>
+struct is_vector<std::vector<T, A>> : std::true_type {};
+
+// Writes each field of the list (state_fields.hpp).
+struct StateWriter {
+  ByteWriter& out;
+
+  template <class T>
+  void operator()(const char*, const T& field, uint32_t) {
+    if constexpr (is_vector<T>::value)
+      out.put_vector(field);
+    else
+      out.put(field);
+  }
+  void operator()(const char*, const bool& field, uint32_t) { out.put(uint8_t(field)); }
+  void operator()(const char* what, const std::unique_ptr<Handle>& handle, uint32_t flags) {
+    (*this)(what, handle != nullptr, flags);
+    if (!handle) return;
+    out.put_vector(handle->offsets);
+    out.put(handle->position);
+    out.put(handle->orientation);
+    out.put(handle->tool);
+  }
+};
+
+// Reads each field of the list and checks it against the flags and the object it goes into (the
+// body's node and tet counts, a handle's nodes and tool). In the check pass the values are read and
+// dropped; in the apply pass, after every check passed, the same bytes are read into the fields.
+struct StateReader {
+  ByteReader in;
+  bool apply = false;
+  size_t nodes = 0, elements = 0;           // of the body whose fields are read
+  const std::vector<int32_t>* lpc_nodes = nullptr;  // of the constraint whose handle is read
+  std::function<bool(Id)> has_tool;         // for a handle's tool
+
+  template <class T>
+  void operator()(const char* what, T& field, uint32_t flags) {
+    T value{};
+    if constexpr (is_vector<T>::value) {
+      in.get_vector(value, what);
+      const size_t n = value.size();
+      require(!(flags & kPerNode) || n == nodes, std::string(what) + " do not match the body's node count");
+      require(!(flags & kPerNodeOrNone) || n == nodes || n == 0, std::string(what) + " do not match the body's node count");
+      require(!(flags & kPerElement) || n == elements, std::string(what) + " do not match the body's tet count");
+      if constexpr (std::is_same<T, Vec3List>::value)
+        require(!(flags & kFinite) || flat(value).allFinite(), std::string(what) + " are not finite");
+    } else {
+      value = in.get<T>(what);
+    }
+    if (apply) field = std::move(value);  // a vector of the same size is copied in place (a positions view stays valid)
+  }
+  void operator()(const char* what, bool& field, uint32_t) {
+    const bool value = in.get<uint8_t>(what) != 0;
+    if (apply) field = value;
+  }
+  void operator()(const char* what, std::unique_ptr<Handle>& field, uint32_t) {
+    if (!(in.get<uint8_t>(what) != 0)) {
+      if (apply) field.reset();
+      return;
+    }
+    auto h = std::make_unique<Handle>();
+    in.get_vector(h->offsets, what);
+    h->position = in.get<Vec3>(what);
+    h->orientation = in.get<Eigen::Quaterniond>(what);
+    h->tool = in.get<uint64_t>(what);
+    require(h->offsets.size() == lpc_nodes->size(), "a constraint's handle does not match its node count");
+    if (h->tool && !has_tool(h->tool))
+      fail(Errc::InvalidArgument, "the state has a grab following a tool this world does not have (id " +
+                                      std::to_string(h->tool) + ")");
+    if (apply) field = std::move(h);
+  }
+};
+
+// Hashes the fields marked kFingerprint, in the list's order.
+struct StateHasher {
+  uint64_t hash = fnv1a(nullptr, 0);
+
+  template <class T>
+  void operator()(const char*, const T& field, uint32_t flags) {
+    if (!(flags & kFingerprint)) return;
+    if constexpr (is_vector<T>::value)
+      hash = fnv1a(field.data(), field.size() * sizeof(typename T::value_type), hash);
+    else
+      hash = fnv1a(&field, sizeof field, hash);
+  }
+};
+
+// What the contacts readout dereferences must be in range: the last step's results of a state
+// about to be restored.
+void check_results(const StepResults& r, const std::function<const Body*(Id)>& find_body,
+                   const std::function<bool(Id)>& has_tool) {
+  const ContactRows& rows = r.rows;
+  const size_t nr = rows.direction.size();
+  require(rows.start.size() == nr + 1 && rows.bias.size() == nr && rows.normal_of.size() == nr && rows.mu.size() == nr &&
+              rows.contact.size() == nr && rows.key.size() == nr && r.lambda.size() == nr,
+          "the contact rows disagree in length");
+  require(r.curvature_impulse.size() == r.contacts.size(), "the contacts disagree in length");
+  for (Id id : r.bodies) require(find_body(id) && find_body(id)->is_dynamic(), "a step body is not in this world");
+  for (Id id : r.tools) require(has_tool(id), "a step tool is not in this world");
+  for (size_t k = 0; k < nr; ++k)
+    require(rows.contact[k] >= 0 && size_t(rows.contact[k]) < r.contacts.size() && rows.start[k] <= rows.start[k + 1] &&
+                size_t(rows.start[k + 1]) <= rows.terms.size() && rows.normal_of[k] < int32_t(k),
+            "a contact row is out of range");
+  auto point_ok = [&](const BodyPoint& p) {
+    if (p.count == 0) return true;
+    if (p.count < 0 || p.count > 3 || p.body < 0 || size_t(p.body) >= r.bodies.size()) return false;
+    const int32_t n = find_body(r.bodies[size_t(p.body)])->fem.node_count();
+    for (int k = 0; k < p.count; ++k)
+      if (p.nodes[k] < 0 || p.nodes[k] >= n) return false;
+    return true;
+  };
+  for (const Contact& c : r.contacts)
+    require(point_ok(c.a) && c.a.count > 0 && point_ok(c.b) && c.tool < int32_t(r.tools.size()),
+            "a contact names a body, node or tool out of range");
+  for (const RowTerm& t : rows.terms)
+    require(t.body >= 0 && size_t(t.body) < r.bodies.size() && t.node >= 0 &&
+                t.node < find_body(r.bodies[size_t(t.body)])->fem.node_count(),
+            "a contact row names a body or node out of range");
+}
+
+void check_filter(const DeviceLink::FilterState& f, int32_t window) {
+  require(f.average.samples.size() == size_t(window) && f.average.next >= 0 && f.average.next < window &&
+              f.average.count >= 0 && f.average.count <= window && f.average.since_resum >= 0,
+          "a device's filter does not match its window");
 }
 
 }  // namespace
@@ -177,6 +284,27 @@ void World::state_shape(StateShape& s) const {
   s.sweep = int32_t(settings_.mica_sweep);
 }
 
+// The list in its order: the world's part, then per body, tool, constraint and device. The
+// visitor is called with each object's fields (const_cast: a writer or hasher visits a const
+// world and changes nothing). `body_extra(v, body)` adds what the solver keeps for the body.
+template <class V, class BodyExtra>
+void World::visit_world_state(V& v, BodyExtra&& body_extra) const {
+  World& w = const_cast<World&>(*this);
+  visit_state(v, w.last_);
+  v("the warm-start impulses", w.warm_start_list_, kPlain);
+  v("the overlapping bodies", w.overlapping_, kPlain);
+  w.bodies_.for_each([&](Id, Body& b) {
+    visit_state(v, static_cast<BodyState&>(b));
+    body_extra(v, b);
+  });
+  w.tools_.for_each([&](Id, Tool& t) { visit_state(v, static_cast<ToolState&>(t)); });
+  w.lpcs_.for_each([&](Id, Lpc& c) { visit_state(v, c); });
+  w.devices_.for_each([&](Id, DeviceLink& link) {
+    DeviceLink::FilterState f = link.filter_state();
+    visit_state(v, f);
+  });
+}
+
 std::vector<uint8_t> World::save_state() const {
   devices_.for_each([&](Id, const DeviceLink& link) {
     if (link.servo_running())
@@ -184,69 +312,18 @@ std::vector<uint8_t> World::save_state() const {
   });
   ByteWriter out;
   out.put_bytes(std::string(kHeaderSize, '\0').data(), kHeaderSize);  // filled in at the end
-
   StateShape shape;
   state_shape(shape);
   shape.write(out);
 
-  // The world.
-  out.put(last_.stats);
-  out.put(last_.debt);
-  std::vector<std::pair<uint64_t, double>> warm(warm_start_.begin(), warm_start_.end());
-  std::sort(warm.begin(), warm.end());
-  out.put_vector(warm);
-  const ContactRows& rows = last_.rows;
-  out.put_vector(last_.contacts);
-  out.put_vector(rows.start);
-  out.put_vector(rows.terms);
-  out.put_vector(rows.direction);
-  out.put_vector(rows.bias);
-  out.put_vector(rows.normal_of);
-  out.put_vector(rows.mu);
-  out.put_vector(rows.contact);
-  out.put_vector(rows.key);
-  out.put_vector(last_.lambda);
-  out.put_vector(last_.curvature_impulse);
-  out.put_vector(last_.bodies);
-  out.put_vector(last_.tools);
-  out.put_vector(overlapping_);
-
-  bodies_.for_each([&](Id, const Body& b) {
-    out.put_vector(b.x);
-    out.put_vector(b.v);
-    out.put_vector(b.v_previous);
-    out.put_vector(b.node_forces);
-    out.put(uint8_t(b.has_node_forces));
-    out.put_vector(b.end.x);
-    out.put_vector(b.end.R);
-    out.put(b.end.u);
+  // The warm starts in key order: a map's order is not the same from one world to another.
+  warm_start_list_.assign(warm_start_.begin(), warm_start_.end());
+  std::sort(warm_start_list_.begin(), warm_start_list_.end());
+  StateWriter writer{out};
+  visit_world_state(writer, [&](StateWriter& v, const Body& b) {
     ByteWriter solver;
     solver_->save_body(b.key, solver);
-    out.put_vector(solver.bytes());
-  });
-  tools_.for_each([&](Id, const Tool& t) {
-    out.put(ToolData{t.position, t.previous_position, t.force, t.torque,
-                     t.orientation, t.previous_orientation, t.stiffness, t.contact_count});
-  });
-  lpcs_.for_each([&](Id, const Lpc& c) {
-    out.put(c.velocity);
-    out.put(c.reaction);
-    out.put(uint8_t(c.handle != nullptr));
-    if (!c.handle) return;
-    out.put_vector(c.handle->offsets);
-    out.put(c.handle->position);
-    out.put(c.handle->orientation);
-    out.put(c.handle->tool);
-  });
-  devices_.for_each([&](Id, const DeviceLink& link) {
-    const DeviceLink::FilterState f = link.filter_state();
-    out.put_vector(f.average.samples);
-    out.put(f.average.next);
-    out.put(f.average.count);
-    out.put(f.average.since_resum);
-    out.put(f.average.sum);
-    out.put(uint8_t(f.average.in_contact));
-    out.put(f.previous_force);
+    v("a body's solver state", solver.bytes(), kPlain);
   });
 
   std::vector<uint8_t>& bytes = out.bytes();
@@ -278,205 +355,98 @@ void World::restore_state(const uint8_t* data, size_t size) {
                           std::to_string(size) + (size < header.size ? ": truncated" : ""));
   if (fnv1a(data + kHeaderSize, size - kHeaderSize) != header.checksum)
     fail(Errc::Parse, "the state's checksum does not match its contents: corrupt");
-  ByteReader in(data + kHeaderSize, size - kHeaderSize);
-
-  // The shape.
-  Shape saved;
-  saved.read(in);
-  Shape here;
-  state_shape(here);
-  std::vector<const Body*> bodies;
-  bodies_.for_each([&](Id, const Body& b) { bodies.push_back(&b); });
   devices_.for_each([&](Id, const DeviceLink& link) {
     if (link.servo_running())
       fail(Errc::WrongState, "a device's servo loop is running: stop it (mica_device_stop) before restoring a state");
   });
+
+  // The shape.
+  ByteReader shape_in(data + kHeaderSize, size - kHeaderSize);
+  Shape saved;
+  saved.read(shape_in);
+  Shape here;
+  state_shape(here);
   const std::string difference = shape_difference(saved, here);
   if (!difference.empty()) fail(Errc::InvalidArgument, difference);
+  const size_t fields_at = kHeaderSize + shape_in.position();
 
-  // The world.
-  const WorldStats stats = in.get<WorldStats>("the statistics");
-  const double debt = in.get<double>("the energy debt");
-  std::vector<std::pair<uint64_t, double>> warm;
-  in.get_vector(warm, "the warm-start impulses");
-  std::vector<Contact> contacts;
-  ContactRows rows;
-  std::vector<double> lambda;
-  Vec3List curvature_impulse;
-  std::vector<Id> step_bodies, step_tools;
-  std::vector<std::pair<Id, Id>> overlapping;
-  in.get_vector(contacts, "the contacts");
-  in.get_vector(rows.start, "the contact rows");
-  in.get_vector(rows.terms, "the contact rows");
-  in.get_vector(rows.direction, "the contact rows");
-  in.get_vector(rows.bias, "the contact rows");
-  in.get_vector(rows.normal_of, "the contact rows");
-  in.get_vector(rows.mu, "the contact rows");
-  in.get_vector(rows.contact, "the contact rows");
-  in.get_vector(rows.key, "the contact rows");
-  in.get_vector(lambda, "the contact impulses");
-  in.get_vector(curvature_impulse, "the contact impulses");
-  in.get_vector(step_bodies, "the step's bodies");
-  in.get_vector(step_tools, "the step's tools");
-  in.get_vector(overlapping, "the overlapping bodies");
-  // What the contacts readout dereferences must be in range.
-  const size_t nr = rows.direction.size();
-  require(rows.start.size() == nr + 1 && rows.bias.size() == nr && rows.normal_of.size() == nr && rows.mu.size() == nr &&
-              rows.contact.size() == nr && rows.key.size() == nr && lambda.size() == nr,
-          "the contact rows disagree in length");
-  require(curvature_impulse.size() == contacts.size(), "the contacts disagree in length");
-  for (Id id : step_bodies) require(bodies_.find(id) && bodies_.find(id)->is_dynamic(), "a step body is not in this world");
-  for (Id id : step_tools) require(tools_.find(id) != nullptr, "a step tool is not in this world");
-  for (size_t r = 0; r < nr; ++r)
-    require(rows.contact[r] >= 0 && size_t(rows.contact[r]) < contacts.size() && rows.start[r] <= rows.start[r + 1] &&
-                size_t(rows.start[r + 1]) <= rows.terms.size() && rows.normal_of[r] < int32_t(r),
-            "a contact row is out of range");
-  auto point_ok = [&](const BodyPoint& p) {
-    if (p.count == 0) return true;
-    if (p.count < 0 || p.count > 3 || p.body < 0 || size_t(p.body) >= step_bodies.size()) return false;
-    const int32_t n = bodies_.find(step_bodies[size_t(p.body)])->fem.node_count();
-    for (int k = 0; k < p.count; ++k)
-      if (p.nodes[k] < 0 || p.nodes[k] >= n) return false;
-    return true;
-  };
-  for (const Contact& c : contacts)
-    require(point_ok(c.a) && c.a.count > 0 && point_ok(c.b) && c.tool < int32_t(step_tools.size()),
-            "a contact names a body, node or tool out of range");
-  for (const RowTerm& t : rows.terms)
-    require(t.body >= 0 && size_t(t.body) < step_bodies.size() && t.node >= 0 &&
-                t.node < bodies_.find(step_bodies[size_t(t.body)])->fem.node_count(),
-            "a contact row names a body or node out of range");
-
-  // The bodies.
-  std::vector<BodyData> body_data(bodies.size());
+  // The check pass: every field read and checked, nothing changed; the world's part and the
+  // solver's data kept for the checks that need them whole.
+  StepResults results;
+  std::vector<std::vector<uint8_t>> solver_data;
   std::vector<VelocitySolver::SavedBody> solver_bodies;
-  for (size_t k = 0; k < bodies.size(); ++k) {
-    const Body& b = *bodies[k];
-    BodyData& d = body_data[k];
-    const size_t n = size_t(b.fem.node_count()), e = b.fem.elements.size();
-    in.get_vector(d.x, "a body's positions");
-    in.get_vector(d.v, "a body's velocities");
-    in.get_vector(d.v_previous, "a body's last velocities");
-    in.get_vector(d.node_forces, "a body's node forces");
-    d.has_node_forces = in.get<uint8_t>("a body's node forces");
-    in.get_vector(d.end.x, "a body's end positions");
-    in.get_vector(d.end.R, "a body's rotations");
-    d.end.u = in.get<double>("a body's energies");
-    in.get_vector(d.solver, "a body's solver state");
-    require(d.x.size() == n && d.v.size() == n && d.v_previous.size() == n && d.node_forces.size() == n &&
-                d.end.R.size() == e && (d.end.x.empty() || d.end.x.size() == n),
-            "a body's arrays do not match its node or tet count");
-    require(flat(d.x).allFinite() && flat(d.v).allFinite() && flat(d.v_previous).allFinite() &&
-                flat(d.node_forces).allFinite(),
-            "a body's positions, velocities or forces are not finite");
-    solver_bodies.push_back({b.key, &b.fem, d.solver.data(), d.solver.size()});
-  }
-  std::vector<ToolData> tool_data;
-  tools_.for_each([&](Id, const Tool&) { tool_data.push_back(in.get<ToolData>("a tool's state")); });
-  std::vector<LpcData> lpc_data;
-  lpcs_.for_each([&](Id, const Lpc& c) {
-    LpcData d;
-    d.velocity = in.get<Vec3>("a constraint's state");
-    d.reaction = in.get<Vec3>("a constraint's state");
-    d.has_handle = in.get<uint8_t>("a constraint's state");
-    if (d.has_handle) {
-      d.handle = std::make_unique<Handle>();
-      Handle& h = *d.handle;
-      in.get_vector(h.offsets, "a constraint's handle");
-      h.position = in.get<Vec3>("a constraint's handle");
-      h.orientation = in.get<Eigen::Quaterniond>("a constraint's handle");
-      h.tool = in.get<uint64_t>("a constraint's handle");
-      require(h.offsets.size() == c.nodes.size(), "a constraint's handle does not match its node count");
-      if (h.tool && !tools_.find(h.tool))
-        fail(Errc::InvalidArgument, "the state has a grab following a tool this world does not have (id " +
-                                        std::to_string(h.tool) + ")");
+  std::vector<DeviceLink::FilterState> filters;
+  auto has_tool = [&](Id id) { return tools_.find(id) != nullptr; };
+  auto read_pass = [&](StateReader& r) {
+    const bool apply = r.apply;
+    // What the checks need whole (or what goes in by a call) is read into locals in both passes.
+    auto into_locals = [&](auto&& read) {
+      r.apply = true;
+      read();
+      r.apply = apply;
+    };
+    if (apply) {
+      visit_state(r, last_);
+    } else {
+      into_locals([&] { visit_state(r, results); });
+      check_results(results, [&](Id id) { return bodies_.find(id); }, has_tool);
     }
-    lpc_data.push_back(std::move(d));
-  });
-  std::vector<DeviceLink::FilterState> device_data;
-  devices_.for_each([&](Id, const DeviceLink& link) {
-    DeviceLink::FilterState f;
-    in.get_vector(f.average.samples, "a device's filter");
-    f.average.next = in.get<int32_t>("a device's filter");
-    f.average.count = in.get<int32_t>("a device's filter");
-    f.average.since_resum = in.get<int32_t>("a device's filter");
-    f.average.sum = in.get<Vec3>("a device's filter");
-    f.average.in_contact = in.get<uint8_t>("a device's filter") != 0;
-    f.previous_force = in.get<Vec3>("a device's filter");
-    const int32_t n = link.settings().filter_window;
-    require(f.average.samples.size() == size_t(n) && f.average.next >= 0 && f.average.next < n &&
-                f.average.count >= 0 && f.average.count <= n && f.average.since_resum >= 0,
-            "a device's filter does not match its window");
-    device_data.push_back(std::move(f));
-  });
-  if (in.remaining()) fail(Errc::Parse, "the state has " + std::to_string(in.remaining()) + " bytes past its end: corrupt");
+    r("the warm-start impulses", warm_start_list_, kPlain);
+    r("the overlapping bodies", overlapping_, kPlain);
+    size_t k = 0;
+    bodies_.for_each([&](Id, Body& b) {
+      r.nodes = size_t(b.fem.node_count());
+      r.elements = b.fem.elements.size();
+      visit_state(r, static_cast<BodyState&>(b));
+      if (!apply) solver_data.emplace_back();
+      into_locals([&] { r("a body's solver state", solver_data[k++], kPlain); });
+    });
+    tools_.for_each([&](Id, Tool& t) { visit_state(r, static_cast<ToolState&>(t)); });
+    lpcs_.for_each([&](Id, Lpc& c) {
+      r.lpc_nodes = &c.nodes;
+      visit_state(r, c);
+    });
+    k = 0;
+    devices_.for_each([&](Id, DeviceLink& link) {
+      if (!apply) filters.emplace_back();
+      into_locals([&] { visit_state(r, filters[k]); });
+      check_filter(filters[k++], link.settings().filter_window);
+    });
+    if (r.in.remaining())
+      fail(Errc::Parse, "the state has " + std::to_string(r.in.remaining()) + " bytes past its end: corrupt");
+  };
+  StateReader check{ByteReader(data + fields_at, size - fields_at), false, 0, 0, nullptr, has_tool};
+  read_pass(check);  // reads into locals, or checks and drops
 
   // The solver's part: factors the saved systems (the last step that may throw).
+  size_t k = 0;
+  bodies_.for_each([&](Id, const Body& b) {
+    solver_bodies.push_back({b.key, &b.fem, solver_data[k].data(), solver_data[k].size()});
+    ++k;
+  });
   solver_->restore_bodies(solver_bodies);
 
-  // Nothing throws from here on: values move in.
-  last_.stats = stats;
-  last_.debt = debt;
+  // The apply pass: the same bytes into the fields (nothing throws: every check passed).
+  StateReader apply{ByteReader(data + fields_at, size - fields_at), true, 0, 0, nullptr, has_tool};
+  read_pass(apply);
   warm_start_.clear();
-  for (const auto& [key, impulse] : warm) warm_start_[key] = impulse;
-  last_.contacts.swap(contacts);
-  last_.rows = std::move(rows);
-  last_.lambda.swap(lambda);
-  last_.curvature_impulse.swap(curvature_impulse);
-  last_.bodies.swap(step_bodies);
-  last_.tools.swap(step_tools);
-  overlapping_.swap(overlapping);
-  size_t k = 0;
+  for (const auto& [key, impulse] : warm_start_list_) warm_start_[key] = impulse;
+  k = 0;
+  devices_.for_each([&](Id, DeviceLink& link) { link.set_filter_state(filters[k++]); });
   bodies_.for_each([&](Id, Body& b) {
-    BodyData& d = body_data[k++];
-    b.x = d.x;  // the same size: copied in place (no allocation; a positions view stays valid)
-    b.v = d.v;
-    b.v_previous = d.v_previous;
-    b.node_forces.swap(d.node_forces);
-    b.has_node_forces = d.has_node_forces != 0;
-    std::swap(b.end, d.end);
     b.bvh.refit(b.x);
     // The solvers' factors of the current matrix are redone (the same matrix: the same bits).
     b.matrix_current = false;
     ++b.matrix_version;
   });
-  k = 0;
-  tools_.for_each([&](Id, Tool& t) {
-    const ToolData& d = tool_data[k++];
-    t.position = d.position;
-    t.orientation = d.orientation;
-    t.previous_position = d.previous_position;
-    t.previous_orientation = d.previous_orientation;
-    t.force = d.force;
-    t.torque = d.torque;
-    t.contact_count = d.contact_count;
-    t.stiffness = d.stiffness;
-  });
-  k = 0;
-  lpcs_.for_each([&](Id, Lpc& c) {
-    LpcData& d = lpc_data[k++];
-    c.velocity = d.velocity;
-    c.reaction = d.reaction;
-    c.handle = std::move(d.handle);
-  });
-  k = 0;
-  devices_.for_each([&](Id, DeviceLink& link) { link.set_filter_state(device_data[k++]); });
   publish_force_models();  // the servo path renders the restored step's force model, not the last one run
   if (recorder_) recorder_->write(RecordKind::RestoreState, std::vector<uint8_t>(data, data + size));
 }
 
 uint64_t World::fingerprint() const {
-  uint64_t h = fnv1a(nullptr, 0);
-  bodies_.for_each([&](Id, const Body& b) {
-    h = fnv1a(b.x.data(), b.x.size() * sizeof(Vec3), h);
-    h = fnv1a(b.v.data(), b.v.size() * sizeof(Vec3), h);
-  });
-  tools_.for_each([&](Id, const Tool& t) {
-    h = fnv1a(t.force.data(), sizeof(Vec3), h);
-    h = fnv1a(t.torque.data(), sizeof(Vec3), h);
-  });
-  lpcs_.for_each([&](Id, const Lpc& c) { h = fnv1a(c.reaction.data(), sizeof(Vec3), h); });
-  return h;
+  StateHasher hasher;
+  visit_world_state(hasher, [](StateHasher&, const Body&) {});
+  return hasher.hash;
 }
 
 }  // namespace mica

@@ -272,6 +272,10 @@ class World {
   void undo();
 
   void state_shape(StateShape& out) const;  // state_io.cpp
+  // Visits the list of the state (state_fields.hpp) over the whole world, in the saved order;
+  // body_extra(v, body) adds what the solver keeps for each body.
+  template <class V, class BodyExtra>
+  void visit_world_state(V& v, BodyExtra&& body_extra) const;
   Id insert_lpc(Id body, const std::vector<int32_t>& nodes, const LpcSpec& spec);  // add_lpc, unrecorded
 
   bool needs_loads(const Body& b) const;
@@ -286,6 +290,7 @@ class World {
   // swaps them. The warm start is keyed by row and rewritten at commit.
   StepResults last_, next_;
   std::unordered_map<uint64_t, double> warm_start_; // impulses by row key
+  mutable std::vector<std::pair<uint64_t, double>> warm_start_list_;  // warm_start_ in key order: a saved state's
   StepContext step_;                                // the running step's context, kept for its capacity
   struct SavedPose {  // save_undo(): a device-driven tool's or handle's pose before the step
     Id target;

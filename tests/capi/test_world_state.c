@@ -1,7 +1,10 @@
 /* SPDX-License-Identifier: Apache-2.0 */
-/* A step that fails is undone whole: after it, every readout (positions, velocities, contacts,
- * statistics, tool forces, constraint reactions) and the saved state are bit for bit those of the
- * last good step, for every solver; and the world then steps as a twin that never failed.
+/* The world's state, read out whole (positions, velocities, contacts, statistics, tool forces,
+ * constraint reactions, the saved state), for every solver:
+ * - a step that fails is undone whole: after it, every readout is bit for bit that of the last good
+ *   step, and the world then steps as a twin that never failed;
+ * - a saved state restored into a fresh world reads out as the original and steps as it does (a
+ *   value a step hands the next that the state's list leaves out fails here).
  * A sphere rests pressed into a box fixed at its base (a second box on top in the two-body case);
  * after ten good steps, node forces of 1e308 N on every node make the velocities overflow. */
 #include <stdarg.h>
@@ -196,9 +199,45 @@ static void test_a_failed_step_changes_no_readout(void** state) {
   }
 }
 
+static void test_a_restored_state_reads_and_steps_as_the_original(void** state) {
+  (void)state;
+  for (size_t k = 0; k < sizeof kCases / sizeof kCases[0]; ++k) {
+    const solver_case* c = &kCases[k];
+    print_message("%s\n", c->name);
+    scene original, restored;
+    make_scene(&original, c);
+    make_scene(&restored, c);
+    for (int i = 0; i < 10; ++i) {
+      const double p[3] = {0.03, 0.1 + 0.02 - 0.002 - 0.0002 * i, 0.05}, q[4] = {1, 0, 0, 0};
+      OK(original.w, mica_tool_set_pose(original.w, original.box.tool, p, q));
+      OK(original.w, mica_step(original.w, 0.01));
+    }
+    readout saved = read_world(&original, 1);
+    OK(restored.w, mica_world_restore_state(restored.w, saved.state, saved.state_size));
+    readout back = read_world(&restored, 1);
+    assert_same_readout(&saved, &back);
+    free_readout(&saved);
+    free_readout(&back);
+    for (int i = 0; i < 4; ++i) {
+      const double p[3] = {0.03 + 0.001 * i, 0.1 + 0.02 - 0.004, 0.05}, q[4] = {1, 0, 0, 0};
+      OK(original.w, mica_tool_set_pose(original.w, original.box.tool, p, q));
+      OK(restored.w, mica_tool_set_pose(restored.w, restored.box.tool, p, q));
+      OK(original.w, mica_step(original.w, 0.01));
+      OK(restored.w, mica_step(restored.w, 0.01));
+      readout a = read_world(&original, 0), b = read_world(&restored, 0);
+      assert_same_readout(&a, &b);
+      free_readout(&a);
+      free_readout(&b);
+    }
+    mica_world_destroy(original.w);
+    mica_world_destroy(restored.w);
+  }
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_a_failed_step_changes_no_readout),
+      cmocka_unit_test(test_a_restored_state_reads_and_steps_as_the_original),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
