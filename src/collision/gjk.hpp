@@ -1,6 +1,9 @@
 // SPDX-License-Identifier: Apache-2.0
 // Distance between two convex polytopes given by their support functions (GJK), with the closest
-// points. Polytopes make it exact up to rounding, in a finite number of steps.
+// points. Polytopes make it exact up to rounding, in a finite number of steps. Written here beside
+// libccd because libccd answers whether two shapes intersect and how deep (MPR, GJK + EPA), not how
+// far apart they are: a rounded tool's core and a triangle are separated by its rounding radius when
+// they touch, and the contact needs that distance and its closest points (triangle_contact.cpp).
 #pragma once
 #include <array>
 

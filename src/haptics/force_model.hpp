@@ -35,6 +35,13 @@ struct ForceModel {
   Vec3 evaluate(const Vec3& x, ForceMode mode) const noexcept;
 };
 
+// The model a grasp renders: f0 the force the held tissue puts on the hand (the constraint's
+// reaction) at the handle's position x0, H = -k I with k the secant stiffness the tissue showed
+// along the handle's last move from `last` (the model published before), within [0, the device's
+// nominal stiffness]: stable to render, and zero when the tissue gave way.
+ForceModel grasp_force_model(const ForceModel& last, const Vec3& reaction, const Vec3& handle,
+                             double nominal_stiffness);
+
 // Virtual coupling: the force on the device from a spring (k, N/m) and damper (b, N s/m) joining
 // it to the simulated tool, -k (x_device - x_tool) - b (v_device - v_tool). It pulls the device
 // toward the tool; the opposite force acts on the tool.

@@ -24,7 +24,7 @@ struct Projection {
   void constrain(int32_t node, const Mat3& C, const Vec3& velocity);
 };
 
-// Projector onto span{d} and onto its orthogonal complement, for building C.
+// Projector onto span{d} (I minus it projects onto the orthogonal complement), for building C.
 inline Mat3 line_projector(const Vec3& d) { return d * d.transpose() / d.squaredNorm(); }
 
 }  // namespace mica

@@ -198,26 +198,6 @@ void World::follow_devices() {
   });
 }
 
-ForceModel World::grasp_force_model(const DeviceLink& link, const Lpc& grasp) const {
-  ForceModel model;
-  model.f0 = grasp.reaction;  // the force the held tissue puts on the hand
-  model.x0 = grasp.handle ? grasp.handle->position : link.last_published().x0;
-  model.in_contact = true;
-  model.holds = true;
-  // H = -k I, k the secant stiffness the tissue showed along the handle's last move (dF = -k dx),
-  // within [0, the device's nominal stiffness]: stable to render, and zero when the tissue gave
-  // way; a move below kGraspSecantStep keeps the last estimate (the reaction's own step-to-step
-  // change would swamp it).
-  constexpr double kGraspSecantStep = 1e-5;  // m
-  const ForceModel& last = link.last_published();
-  double k = last.holds ? -last.H(0, 0) : 0;
-  const Vec3 dx = model.x0 - last.x0;
-  if (last.holds && dx.norm() >= kGraspSecantStep)
-    k = std::clamp(-dx.dot(model.f0 - last.f0) / dx.squaredNorm(), 0.0, link.info().nominal_stiffness);
-  model.H = -k * Mat3::Identity();
-  return model;
-}
-
 void World::publish_force_models() {
   devices_.for_each([&](Id, DeviceLink& link) {
     ForceModel model;
@@ -229,7 +209,8 @@ void World::publish_force_models() {
       const double k = t->stiffness.norm(), k_max = link.info().nominal_stiffness;
       model.H = k > k_max ? Mat3(t->stiffness * (k_max / k)) : t->stiffness;
     } else if (const Lpc* c = link.settings().lpc ? lpcs_.find(link.settings().lpc) : nullptr) {
-      model = grasp_force_model(link, *c);
+      model = grasp_force_model(link.last_published(), c->reaction,
+                                c->handle ? c->handle->position : link.last_published().x0, link.info().nominal_stiffness);
     }
     model.step = last_.stats.step_count;
     link.publish(model);
@@ -341,7 +322,8 @@ void World::collide(StepContext& ctx) {
     t.angular_velocity = turn.axis() * (turn.angle() > M_PI ? turn.angle() - 2 * M_PI : turn.angle()) / h;
   });
   // Every body's surface as collision sees it; dynamic bodies' trees follow their nodes.
-  std::vector<SurfaceView> views;
+  std::vector<SurfaceView>& views = ctx.views;
+  views.clear();  // keeps its capacity
   bodies_.for_each([&](Id id, Body& b) {
     const int32_t index = b.step_index;
     double speed = 0;
@@ -421,12 +403,18 @@ void World::solve(const StepContext& ctx) {
 }
 
 void World::compute_forces(const StepContext& ctx) {
+  tool_forces(ctx);
+  curvature_forces(ctx);
+  constraint_reactions(ctx);
+}
+
+void World::tool_forces(const StepContext& ctx) {
+  // The force the tissue puts on a tool is -sum n lambda / h.
   const double h = ctx.h;
   const std::vector<double>& row_diagonal = solver_->row_diagonal();
   const ContactRows& rows = next_.rows;
   const std::vector<double>& lambda = next_.lambda;
   MICA_ASSERT(row_diagonal.size() == rows.size(), "the solver reports the compliance of each row it solved");
-  // Tools: the force the tissue puts on the tool is -sum n lambda / h.
   for (Tool* t : ctx.tools) t->next = {};
   for (size_t r = 0; r < rows.size(); ++r) {
     const Contact& c = next_.contacts[rows.contact[r]];
@@ -443,6 +431,9 @@ void World::compute_forces(const StepContext& ctx) {
         t.stiffness -= rows.direction[r] * rows.direction[r].transpose() / (h * h * row_diagonal[r]);
     }
   }
+}
+
+void World::curvature_forces(const StepContext& ctx) {
   // The curvature terms in A push the triangles' corners by -h^2 F K_c v+ (add_contact_stiffness):
   // a contact force too, which the tool feels the other way round.
   for (Body* b : ctx.dynamic)
@@ -456,14 +447,17 @@ void World::compute_forces(const StepContext& ctx) {
       const Contact& c = next_.contacts[size_t(term.contact)];
       next_.curvature_impulse[size_t(term.contact)] = impulse;
       Tool& t = *ctx.tools[size_t(c.tool)];
-      const Vec3 f = -impulse / h;
+      const Vec3 f = -impulse / ctx.h;
       t.next.force += f;
       t.next.torque += (term.core_point - t.position).cross(f);
     }
-  // Constraints: the impulse r = (I - S)(A v - b - G^T lambda) holds the body; whoever holds
-  // the constraint (the user's hand) feels the opposite force, -r / h. A node held by several
-  // groups gives each group C_g its share C_g (sum_h C_h)^+ r, so that the shares add up to r
-  // (two groups fixing the same node get half each; groups on perpendicular directions, each its own).
+}
+
+void World::constraint_reactions(const StepContext& ctx) {
+  // The impulse r = (I - S)(A v - b - G^T lambda) holds the body; whoever holds the constraint
+  // (the user's hand) feels the opposite force, -r / h. A node held by several groups gives each
+  // group C_g its share C_g (sum_h C_h)^+ r, so that the shares add up to r (two groups fixing the
+  // same node get half each; groups on perpendicular directions, each its own).
   lpcs_.for_each([&](Id, Lpc& c) {
     Body& b = bodies_.get(c.body, "body");
     for (int32_t i : c.nodes) b.constrained_sum[i].setZero();
@@ -483,7 +477,7 @@ void World::compute_forces(const StepContext& ctx) {
       const Vec3 r = Av - b.b[i] - b.contact_impulse[i];
       const Mat3& sum = b.constrained_sum[i];
       const Vec3 share = sum == c.constrained ? Vec3(c.constrained * r) : Vec3(c.constrained * pseudo_inverse(sum) * r);
-      c.next_reaction -= share / h;
+      c.next_reaction -= share / ctx.h;
     }
   });
 }

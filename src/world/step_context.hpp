@@ -5,6 +5,7 @@
 #pragma once
 #include <vector>
 
+#include "collision/contact.hpp"
 #include "collision/tool.hpp"
 #include "solver/velocity_solver.hpp"
 #include "world/body.hpp"
@@ -24,6 +25,7 @@ struct StepContext : SolveContext {
   Plan plan;
   std::vector<Body*> dynamic;    // the bodies that move; Contact::a.body / b.body index this list
   std::vector<Tool*> tools;      // every tool, in collision's order; Contact::tool indexes it
+  std::vector<SurfaceView> views;  // every body's surface as collision sees it
 };
 
 }  // namespace mica

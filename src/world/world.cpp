@@ -14,12 +14,27 @@ void require_finite(const Vec3& v, const std::string& what) {
   if (!v.allFinite()) fail(Errc::InvalidArgument, what + " must be finite");
 }
 
-// Like a tool, a grasp a device moves outlives the device: destroying it first keeps the device
-// from moving a handle that is gone.
+// A rotation as a host gives it: any finite non-zero quaternion (it is normalised).
+void require_rotation(const Eigen::Quaterniond& q, const std::string& what) {
+  if (!q.coeffs().allFinite() || !(q.norm() > 1e-12))
+    fail(Errc::InvalidArgument, what + " must be a finite non-zero quaternion");
+}
+
+void require_nodes_of(const Body& b, const std::vector<int32_t>& nodes) {
+  for (size_t k = 0; k < nodes.size(); ++k)
+    if (nodes[k] < 0 || nodes[k] >= b.fem.node_count())
+      fail(Errc::OutOfRange, b.name + ": node index " + std::to_string(nodes[k]) + " at position " +
+                                 std::to_string(k) + " is outside 0.." + std::to_string(b.fem.node_count() - 1));
+}
+
+// A tool or grasp a device moves outlives the device (destroying it first keeps the device from
+// moving what is gone), and the host does not move it behind the device's back.
 template <class Devices>
-void refuse_if_driven(const Devices& devices, Id lpc) {
+void refuse_if_driven(const Devices& devices, Id target, const char* advice = "destroy the device first") {
   devices.for_each([&](Id, const DeviceLink& link) {
-    if (link.settings().lpc == lpc) fail(Errc::WrongState, "a device drives this grasp: destroy the device first");
+    if (link.settings().lpc == target || link.settings().tool == target)
+      fail(Errc::WrongState, std::string("a device drives this ") +
+                                 (id_kind(target) == IdKind::Tool ? "tool" : "grasp") + ": " + advice);
   });
 }
 }  // namespace
@@ -127,12 +142,8 @@ int64_t World::factorizations(Id id) const { return solver_->factorizations(body
 
 void World::set_node_forces(Id id, const std::vector<int32_t>& nodes, const Vec3List& forces) {
   Body& b = body(id);
-  for (size_t k = 0; k < nodes.size(); ++k) {
-    if (nodes[k] < 0 || nodes[k] >= b.fem.node_count())
-      fail(Errc::OutOfRange, b.name + ": node index " + std::to_string(nodes[k]) + " at position " +
-                                 std::to_string(k) + " is outside 0.." + std::to_string(b.fem.node_count() - 1));
-    require_finite(forces[k], "force " + std::to_string(k));
-  }
+  require_nodes_of(b, nodes);
+  for (size_t k = 0; k < nodes.size(); ++k) require_finite(forces[k], "force " + std::to_string(k));
   for (size_t k = 0; k < nodes.size(); ++k) b.node_forces[nodes[k]] = forces[k];
   b.has_node_forces = false;
   for (const Vec3& f : b.node_forces) b.has_node_forces = b.has_node_forces || !f.isZero(0);
@@ -182,10 +193,7 @@ Id World::add_lpc(Id body_id, const std::vector<int32_t>& nodes, const LpcSpec& 
 Id World::insert_lpc(Id body_id, const std::vector<int32_t>& nodes, const LpcSpec& spec) {
   Body& b = body(body_id);
   if (nodes.empty()) fail(Errc::InvalidArgument, "a constraint needs at least one node");
-  for (size_t k = 0; k < nodes.size(); ++k)
-    if (nodes[k] < 0 || nodes[k] >= b.fem.node_count())
-      fail(Errc::OutOfRange, b.name + ": node index " + std::to_string(nodes[k]) + " at position " +
-                                 std::to_string(k) + " is outside 0.." + std::to_string(b.fem.node_count() - 1));
+  require_nodes_of(b, nodes);
   require_finite(spec.velocity, "the prescribed velocity");
   auto lpc = std::make_unique<Lpc>(Lpc{body_id, nodes, constrained_projector(spec), spec.velocity, nullptr});
   const Id id = lpcs_.insert(std::move(lpc));
@@ -194,8 +202,8 @@ Id World::insert_lpc(Id body_id, const std::vector<int32_t>& nodes, const LpcSpe
 }
 
 void check_tool_pose(const Vec3& position, const Eigen::Quaterniond& orientation) {
-  if (!position.allFinite() || !orientation.coeffs().allFinite() || !(orientation.norm() > 1e-12))
-    fail(Errc::InvalidArgument, "the tool pose must be finite with a non-zero quaternion");
+  require_finite(position, "the tool position");
+  require_rotation(orientation, "the tool orientation");
 }
 
 Id World::add_tool(const Tool& tool) {
@@ -229,8 +237,7 @@ Id World::add_device(std::unique_ptr<Device> device, const DeviceSettings& setti
   check_device_target(settings);
   if (!(settings.scale > 0) || !std::isfinite(settings.scale)) fail(Errc::InvalidArgument, "the workspace scale must be finite and > 0");
   require_finite(settings.offset, "the workspace offset");
-  if (!settings.rotation.coeffs().allFinite() || !(settings.rotation.norm() > 1e-12))
-    fail(Errc::InvalidArgument, "the workspace rotation must be a finite non-zero quaternion");
+  require_rotation(settings.rotation, "the workspace rotation");
   // (The window's samples are allocated: INT32_MAX of them asked for 51 GB.)
   if (settings.filter_window < 1 || settings.filter_window > kMaxFilterWindow)
     fail(Errc::InvalidArgument, "the filter window must be 1.." + std::to_string(kMaxFilterWindow) +
@@ -257,9 +264,7 @@ void World::remove_device(Id id) {
 
 void World::remove_tool(Id id) {
   tool(id);
-  devices_.for_each([&](Id, DeviceLink& link) {
-    if (link.settings().tool == id) fail(Errc::WrongState, "a device drives this tool: destroy the device first");
-  });
+  refuse_if_driven(devices_, id);
   // Grabs that followed this tool stay where the tool left them.
   lpcs_.for_each([&](Id, Lpc& c) {
     if (c.handle && c.handle->tool == id) {
@@ -339,12 +344,9 @@ void World::set_handle_pose(Id id, const Vec3& position, const Eigen::Quaternion
   Lpc& c = lpcs_.get(id, "constraint");
   if (!c.handle) fail(Errc::WrongState, "the constraint has no handle: create it with a grab or set its targets");
   if (c.handle->tool) fail(Errc::WrongState, "the handle follows a tool: move the tool instead");
-  devices_.for_each([&](Id, const DeviceLink& link) {
-    if (link.settings().lpc == id) fail(Errc::WrongState, "a device moves this handle: move the device instead");
-  });
+  refuse_if_driven(devices_, id, "move the device instead");
   require_finite(position, "the handle position");
-  if (!orientation.coeffs().allFinite() || !(orientation.norm() > 1e-12))
-    fail(Errc::InvalidArgument, "the handle orientation must be a finite non-zero quaternion");
+  require_rotation(orientation, "the handle orientation");
   c.handle->position = position;
   c.handle->orientation = orientation.normalized();
   if (recorder_) recorder_->write(RecordKind::SetHandlePose, id, position, orientation);

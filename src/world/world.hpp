@@ -241,7 +241,6 @@ class World {
   void advance(double h);
   void prepare_step(double h);  // fills step_ and next_ for a step of h seconds
   void follow_devices();
-  ForceModel grasp_force_model(const DeviceLink& link, const Lpc& grasp) const;
   void collide(StepContext& ctx);
   bool bounds_overlap(const SurfaceView& a, const SurfaceView& b) const;
   // Bodies placed overlapping (overlaps.cpp).
@@ -263,7 +262,10 @@ class World {
   // Numeric factorizations the solver has made of the step's bodies so far (the stats' per step).
   int64_t factorizations(const StepContext& ctx) const;
   void check_finite(const StepContext& ctx) const;
-  void compute_forces(const StepContext& ctx);
+  void compute_forces(const StepContext& ctx);  // the three below
+  void tool_forces(const StepContext& ctx);
+  void curvature_forces(const StepContext& ctx);
+  void constraint_reactions(const StepContext& ctx);
   void check_forces() const;
   void commit(const StepContext& ctx);
   void publish_force_models();
