@@ -1,7 +1,8 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /* A fine render mesh driven by a coarse simulation mesh: the 10 cm cube of sphere_indent, meshed
- * as 6 x 6 x 6 cells of 5 tets, wears a surface 16 times finer (its surface triangles split into
- * four, twice: scenes/fine_surface.h) while a 2 cm sphere presses 15 mm into its top and holds.
+ * as 6 x 6 x 6 cells of 5 tets, wears a surface 16 times finer (each surface edge cut in four,
+ * each triangle into 16: scenes/fine_surface.h) while a 2 cm sphere presses 15 mm into its top and
+ * holds.
  *
  * The fine mesh is bound once (mica_embedding_create: each vertex to the tet that holds it and
  * four barycentric weights); after each step mica_embedding_update writes its positions and
@@ -81,7 +82,7 @@ int main(int argc, char** argv) {
 
   /* The render mesh, bound once at rest. */
   fine_surface fine;
-  CHECK(fine_surface_of_body(s.world, s.body, 2, &fine));
+  CHECK(fine_surface_of_body(s.world, s.body, 4, &fine));
   const mica_embedding_def ed = mica_embedding_def_default();
   mica_embedding_id mesh;
   CHECK(mica_embedding_create(s.world, s.body, &ed, fine.xyz, fine.vertex_count, fine.triangles, fine.triangle_count,

@@ -53,17 +53,22 @@ SurfaceProjection::SurfaceProjection(const Vec3List& rest, const std::vector<Tet
 }
 
 int32_t SurfaceProjection::nearest_tet(const Vec3& p, double radius, double& distance) const {
-  distance = HUGE_VAL;
-  int32_t nearest = -1;
-  bvh_.query(Aabb{p, p}.inflated(radius), [&](int32_t t) {
-    const Tri& f = surface_[size_t(t)];
-    const double d = (p - closest_on_triangle(p, rest_[f[0]], rest_[f[1]], rest_[f[2]]).point).norm();
-    if (d <= radius && d < distance) {
-      distance = d;
-      nearest = t;
-    }
-  });
-  return nearest < 0 ? -1 : tet_of_[size_t(nearest)];
+  // Most vertices lie close to the surface: a small search first, doubled until it finds a point or
+  // reaches the radius (a point found within the search distance is the nearest of all).
+  for (double reach = radius / 16;; reach = std::min(2 * reach, radius)) {
+    distance = HUGE_VAL;
+    int32_t nearest = -1;
+    bvh_.query(Aabb{p, p}.inflated(reach), [&](int32_t t) {
+      const Tri& f = surface_[size_t(t)];
+      const double d = (p - closest_on_triangle(p, rest_[f[0]], rest_[f[1]], rest_[f[2]]).point).norm();
+      if (d <= reach && d < distance) {
+        distance = d;
+        nearest = t;
+      }
+    });
+    if (nearest >= 0) return tet_of_[size_t(nearest)];
+    if (reach >= radius) return -1;
+  }
 }
 
 }  // namespace mica

@@ -66,7 +66,7 @@ static void test_nidus_under_a_tool(void** state) {
   press_scene s;
   if (press_scene_create(&def, &s) != MICA_OK) fail_msg("%s", s.error);
   fine_surface fine;
-  OK(s.world, fine_surface_of_body(s.world, s.body, 2, &fine));
+  OK(s.world, fine_surface_of_body(s.world, s.body, 4, &fine));
   const int32_t n = fine.vertex_count;
   mica_embedding_def ed = mica_embedding_def_default();
   mica_embedding_id e = MICA_NULL_ID;
