@@ -118,16 +118,7 @@ int main(int argc, char** argv) {
   machine(host, sizeof host);
   printf("# command: build/bench/bench_embedding %s %d %d\n# machine: %s\n", path, (int)divisions, steps, host);
 
-  press_scene_def def = press_scene_def_default();
-  def.cells = 0;
-  def.mesh = path;
-  def.solver = MICA_SOLVER_MICA;
-  def.tolerance = 1e-6;
-  def.size = 0.004;
-  def.depth = 0.003;
-  def.gap = 0.0005;
-  def.load_time = 0.5 * steps * def.dt;
-  def.hold_time = 0.5 * steps * def.dt;
+  const press_scene_def def = press_scene_nidus_touch_def(path, 0.01 * (steps / 2), 0.01 * (steps - steps / 2));
   press_scene s;
   if (press_scene_create(&def, &s) != MICA_OK) {
     fprintf(stderr, "%s\n", s.error);

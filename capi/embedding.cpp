@@ -118,6 +118,9 @@ MICA_API mica_status mica_embedding_update(const mica_world* world, mica_embeddi
     const mica::Embedding& e = embedding(world, id);
     if (out_normals && e.triangle_count() == 0)
       refuse(MICA_ERR_WRONG_STATE, "the embedding was made without triangles: it has no normals (pass out_normals NULL)");
+    const size_t values = 3 * size_t(e.vertex_count());
+    if (out_normals && out_normals < out_xyz + values && out_xyz < out_normals + values)
+      refuse(MICA_ERR_INVALID_ARGUMENT, "out_xyz and out_normals overlap: pass two arrays");
     e.update(body_of(world, e).x, out_xyz, out_normals);
     return MICA_OK;
   });

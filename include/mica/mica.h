@@ -1341,10 +1341,12 @@ MICA_API mica_status mica_embedding_get_kinds(const mica_world* world, mica_embe
  *  @param world the world (not changed).
  *  @param embedding the embedding.
  *  @param out_xyz the caller's array of 3 * vertex_count doubles (m).
- *  @param out_normals the caller's array of 3 * vertex_count doubles, or NULL for no normals.
+ *  @param out_normals the caller's array of 3 * vertex_count doubles, apart from `out_xyz`, or NULL
+ *         for no normals.
  *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` or `out_xyz` is NULL); MICA_ERR_STALE_ID
  *          (`embedding`, or its body was destroyed: the message names the body);
- *          MICA_ERR_WRONG_STATE (`out_normals` given to an embedding made without triangles).
+ *          MICA_ERR_WRONG_STATE (`out_normals` given to an embedding made without triangles);
+ *          MICA_ERR_INVALID_ARGUMENT (`out_normals` overlaps `out_xyz`).
  *          On an error nothing is written. */
 MICA_API mica_status mica_embedding_update(const mica_world* world, mica_embedding_id embedding, double* out_xyz,
                                            double* out_normals);

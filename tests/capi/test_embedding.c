@@ -53,16 +53,7 @@ static double distance(const double* a, const double* b) {
 
 static void test_nidus_under_a_tool(void** state) {
   (void)state;
-  press_scene_def def = press_scene_def_default();
-  def.cells = 0;
-  def.mesh = NIDUS;
-  def.solver = MICA_SOLVER_MICA;
-  def.tolerance = 1e-6;
-  def.size = 0.004;
-  def.depth = 0.003;
-  def.gap = 0.0005;
-  def.load_time = 0.1;
-  def.hold_time = 0.02;
+  const press_scene_def def = press_scene_nidus_touch_def(NIDUS, 0.1, 0.02);
   press_scene s;
   if (press_scene_create(&def, &s) != MICA_OK) fail_msg("%s", s.error);
   fine_surface fine;
@@ -224,6 +215,13 @@ static void test_def_and_arguments(void** state) {
   OK(w, mica_embedding_create(w, body, &def, xyz, 1, NULL, 0, &e));
   assert_int_equal(mica_embedding_update(w, e, NULL, NULL), MICA_ERR_NULL_ARGUMENT);
   assert_int_equal(mica_embedding_update(NULL, e, NULL, NULL), MICA_ERR_NULL_ARGUMENT);
+  const int32_t triangle[3] = {0, 0, 0};
+  mica_embedding_id with_triangles = MICA_NULL_ID;
+  OK(w, mica_embedding_create(w, body, &def, xyz, 1, triangle, 1, &with_triangles));
+  double both[6];
+  assert_int_equal(mica_embedding_update(w, with_triangles, both, both + 2), MICA_ERR_INVALID_ARGUMENT);
+  OK(w, mica_embedding_update(w, with_triangles, both, both + 3));
+  assert_true(both[3] == 0 && both[4] == 0 && both[5] == 0); /* a triangle without area: no normal */
   assert_int_equal(mica_embedding_get_kinds(w, e, NULL, 0, NULL), MICA_ERR_NULL_ARGUMENT);
   mica_world_destroy(w);
 }
