@@ -1273,7 +1273,7 @@ static inline mica_embedding_def mica_embedding_def_default(void) {
  *  found through a grid over the rest tets, with its four barycentric weights; a vertex in no tet
  *  to the tet under its nearest rest surface point if that is within `def->radius` (its weights
  *  extrapolated: it keeps its place relative to that tet), else left unbound. The arrays are
- *  copied. Cost: about a microsecond a vertex (bench/bench_embedding). The world's thread (the one
+ *  copied. Cost: under a microsecond a vertex (bench/bench_embedding). The world's thread (the one
  *  thread using the world at a time).
  *  @param world the world (not changed).
  *  @param body the body.
