@@ -70,10 +70,10 @@ MICA_API mica_status mica_embedding_create(mica_world* world, mica_body_id body,
     auto e = std::make_unique<mica::Embedding>(body, b.fem.rest, b.tets, b.surface, xyz, vertex_count, triangles,
                                                triangle_count, d.radius);
     const bool unbound = e->count(mica::VertexKind::Unbound) > 0;
-    const std::string warning = unbound ? unbound_message(*e, d.radius) : std::string();
-    *out_embedding = world->embeddings.insert(std::move(e));
+    std::string warning = unbound ? "mica_embedding_create: " + unbound_message(*e, d.radius) : std::string();
+    *out_embedding = world->embeddings.insert(std::move(e));  // nothing may fail after this
     if (!unbound) return MICA_OK;
-    world->last_error = "mica_embedding_create: " + warning;
+    world->last_error.swap(warning);
     if (world->log) world->log(MICA_LOG_WARNING, world->last_error.c_str(), world->log_user);
     return MICA_WARN_UNBOUND_VERTICES;
   });
@@ -118,8 +118,9 @@ MICA_API mica_status mica_embedding_update(const mica_world* world, mica_embeddi
     const mica::Embedding& e = embedding(world, id);
     if (out_normals && e.triangle_count() == 0)
       refuse(MICA_ERR_WRONG_STATE, "the embedding was made without triangles: it has no normals (pass out_normals NULL)");
-    const size_t values = 3 * size_t(e.vertex_count());
-    if (out_normals && out_normals < out_xyz + values && out_xyz < out_normals + values)
+    const uintptr_t bytes = 3 * sizeof(double) * uintptr_t(e.vertex_count()), a = uintptr_t(out_xyz),
+                    n = uintptr_t(out_normals);  // as integers: the two may be unrelated arrays
+    if (out_normals && n < a + bytes && a < n + bytes)
       refuse(MICA_ERR_INVALID_ARGUMENT, "out_xyz and out_normals overlap: pass two arrays");
     e.update(body_of(world, e).x, out_xyz, out_normals);
     return MICA_OK;
