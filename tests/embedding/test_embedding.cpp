@@ -2,10 +2,13 @@
 // A render mesh embedded in a body's tets: the grid finds the tet a brute-force scan finds; at rest
 // and under a rigid motion every bound vertex lands where it should (1e-12 m); vertices outside
 // the body are projected within the radius and unbound beyond it, left as they were; the normals
-// are the area-weighted normals of the moved triangles; bad input is refused by name.
+// are the area-weighted normals of the moved triangles; the update allocates nothing; bad input is
+// refused by name.
 #include "embedding/embedding.hpp"
 #include "embedding/tet_locator.hpp"
 #include "embedding/vertex_normals.hpp"
+#define MICA_TEST_COUNT_MALLOC
+#include "haptics/alloc_counter.hpp"
 #include "test_util.hpp"
 
 using namespace mica;
@@ -170,6 +173,16 @@ static void test_normals_are_those_of_the_moved_triangles(void**) {
     assert_true(Vec3(normals[3 * size_t(i)], normals[3 * size_t(i) + 1], normals[3 * size_t(i) + 2]) == Vec3::Zero());
 }
 
+static void test_update_allocates_nothing(void**) {
+  const Box b = box();
+  const Mesh m = render_mesh(b);
+  const Embedding e = embed(b, m);
+  std::vector<double> out = m.xyz, normals(m.xyz.size());
+  mica_test::start_counting_allocations();
+  e.update(b.mesh.nodes, out.data(), normals.data());
+  assert_int_equal(mica_test::stop_counting_allocations(), 0);
+}
+
 static void test_bad_input_is_refused_by_name(void**) {
   const Box b = box();
   Mesh m = render_mesh(b);
@@ -215,6 +228,7 @@ int main(void) {
       cmocka_unit_test(test_rest_places_every_bound_vertex_where_it_was),
       cmocka_unit_test(test_rigid_motion_moves_the_mesh_rigidly),
       cmocka_unit_test(test_normals_are_those_of_the_moved_triangles),
+      cmocka_unit_test(test_update_allocates_nothing),
       cmocka_unit_test(test_bad_input_is_refused_by_name),
       cmocka_unit_test(test_update_refuses_another_node_count),
   };
