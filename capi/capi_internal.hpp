@@ -11,11 +11,14 @@
 
 #include "mica/mica.h"
 #include "mica/mica_device.h"
+#include "embedding/embedding.hpp"
 #include "world/world.hpp"
 
 struct mica_world {
   explicit mica_world(const mica::WorldSettings& s) : world(s) {}
   mica::World world;
+  // Render meshes bound to the world's bodies (capi/embedding.cpp): they read bodies, never change them.
+  mica::SlotMap<mica::Embedding, mica::IdKind::Embedding> embeddings;
   mutable std::string last_error;
   mica_log_fn log = nullptr;
   void* log_user = nullptr;
@@ -77,6 +80,7 @@ constexpr uint32_t first_size(const mica_body_def*) { return MICA_CAPI_END_OF(mi
 constexpr uint32_t first_size(const mica_lpc_def*) { return MICA_CAPI_END_OF(mica_lpc_def, velocity); }
 constexpr uint32_t first_size(const mica_tool_def*) { return MICA_CAPI_END_OF(mica_tool_def, reserved0); }
 constexpr uint32_t first_size(const mica_device_def*) { return MICA_CAPI_END_OF(mica_device_def, hand_damping); }
+constexpr uint32_t first_size(const mica_embedding_def*) { return MICA_CAPI_END_OF(mica_embedding_def, radius); }  // 0.7
 #undef MICA_CAPI_END_OF
 template <class T>
 constexpr uint32_t first_size() {

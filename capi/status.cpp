@@ -53,6 +53,8 @@ MICA_API const char* mica_status_string(mica_status status) {
     case MICA_WARN_DEVICE: return "MICA_WARN_DEVICE: the haptic device reported a warning";
     case MICA_WARN_BODIES_OVERLAP:
       return "MICA_WARN_BODIES_OVERLAP: the body was created deep inside another; the two do not collide until they part";
+    case MICA_WARN_UNBOUND_VERTICES:
+      return "MICA_WARN_UNBOUND_VERTICES: the embedding was made, but some vertices are too far from the body and unbound";
     case MICA_ERR_NULL_ARGUMENT: return "MICA_ERR_NULL_ARGUMENT: a required pointer is NULL";
     case MICA_ERR_INVALID_ARGUMENT: return "MICA_ERR_INVALID_ARGUMENT: a value is outside its domain";
     case MICA_ERR_OUT_OF_RANGE: return "MICA_ERR_OUT_OF_RANGE: an index is outside its array";

@@ -39,6 +39,20 @@ press_scene_def press_scene_def_default(void) {
   return d;
 }
 
+press_scene_def press_scene_nidus_touch_def(const char* mesh, double load_time, double hold_time) {
+  press_scene_def d = press_scene_def_default();
+  d.cells = 0;
+  d.mesh = mesh;
+  d.solver = MICA_SOLVER_MICA;
+  d.tolerance = 1e-6;
+  d.size = 0.004;
+  d.gap = 0.0005;
+  d.depth = 0.003;
+  d.load_time = load_time;
+  d.hold_time = hold_time;
+  return d;
+}
+
 press_scene_def press_scene_sphere_indent_def(void) {
   press_scene_def d = press_scene_def_default();
   d.depth = 0.015;

@@ -88,6 +88,11 @@ press_scene_def press_scene_def_default(void);
  * MICA with the factored sweep at tolerance 1e-6, cap 2000. */
 press_scene_def press_scene_sphere_indent_def(void);
 
+/* The nidus at `mesh` touched by a 4 mm sphere: from 0.5 mm above down to 3 mm deep in `load_time`,
+ * held for `hold_time`; MICA with the factored sweep at tolerance 1e-6 (the scene of
+ * bench/bench_embedding.c and of the embedded-mesh tests). */
+press_scene_def press_scene_nidus_touch_def(const char* mesh, double load_time, double hold_time);
+
 /* Builds the world, body, fixation and tool. On failure returns the status (< 0), leaves
  * nothing allocated and puts the reason into s->error. */
 mica_status press_scene_create(const press_scene_def* def, press_scene* s);

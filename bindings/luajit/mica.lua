@@ -415,6 +415,45 @@ function World:contacts()
   return out, n[0]
 end
 
+-- Since 0.7: embedded meshes (docs/embedding.md, "Rendering"). Binds a render mesh to `body`: xyz
+-- a table {x1, y1, z1, x2, ...} (m, in the frame of the rest positions), triangles a table of
+-- 0-based vertex indices, 3 a triangle (nil: no normals), fields of mica_embedding_def ({ radius =
+-- 0.002 }). Returns the embedding's id, its vertex count and the status (MICA_WARN_UNBOUND_VERTICES
+-- when some vertices are farther than the radius: mica_world_last_error names them).
+function World:embed(body, xyz, triangles, fields)
+  assert(#xyz % 3 == 0 and (triangles == nil or #triangles % 3 == 0), "xyz: 3 values a vertex, triangles: 3 indices each")
+  local def = ffi.new("mica_embedding_def")
+  check(C.mica_embedding_def_init(def, ffi.sizeof(def)), nil)
+  fill(def, fields)
+  local tris = triangles and #triangles > 0 and ffi.new("int32_t[?]", #triangles, triangles) or nil
+  local id = ffi.new("mica_embedding_id[1]")
+  local status = self:check(C.mica_embedding_create(self.ptr, body, def, ffi.new("double[?]", #xyz, xyz), #xyz / 3,
+                                                    tris, tris and #triangles / 3 or 0, id))
+  return id[0], #xyz / 3, status
+end
+
+-- Writes the embedding's positions (m) and, with `out_normals`, its unit normals after the last step
+-- into double arrays of 3 values a vertex that the host made once (ffi.new("double[?]", 3 * n)) and
+-- reuses; an unbound vertex's values are left as they are. Allocates nothing.
+function World:update_embedding(embedding, out_xyz, out_normals)
+  self:check(C.mica_embedding_update(self.ptr, embedding, out_xyz, out_normals))
+end
+
+-- The kind of each vertex (an int32_t array of C.MICA_EMBED_*, 0-based) and the vertex count; and
+-- the counts: vertices, inside, projected, unbound.
+function World:embedding_kinds(embedding)
+  return read_indices(self, function(out, cap, count)
+    return C.mica_embedding_get_kinds(self.ptr, embedding, out, cap, count)
+  end)
+end
+function World:embedding_counts(embedding)
+  local c = ffi.new("int32_t[4]")
+  self:check(C.mica_embedding_get_counts(self.ptr, embedding, c, c + 1, c + 2, c + 3))
+  return c[0], c[1], c[2], c[3]
+end
+
+function World:destroy_embedding(embedding) self:check(C.mica_embedding_destroy(self.ptr, embedding)) end
+
 -- A device from mica_device_def fields: { tool = tool } drives a tool, { lpc = grab } (since 0.6)
 -- moves a grab's handle and renders its reaction, the force on the hand. With `callbacks`, a device
 -- whose callbacks are Lua functions: `callbacks` has read_state(state) and

@@ -1220,6 +1220,138 @@ MICA_API mica_status mica_body_write_vtk(const mica_world* world, mica_body_id b
 MICA_API mica_status mica_world_write_vtk(const mica_world* world, const char* path);
 /** @} */
 
+/** @name Embedded meshes (since 0.7)
+ *  A host's fine render mesh driven by a body's tets: each vertex is bound once to a tet and four
+ *  barycentric weights at the body's rest shape, then placed from that tet's current nodes after
+ *  each step, with area-weighted vertex normals (docs/embedding.md, "Rendering"). An embedding
+ *  belongs to its world: named by an id, freed by mica_embedding_destroy() or with the world. It
+ *  reads its body but changes nothing in the world (it is not recorded, saved or replayed). A body
+ *  destroyed under it is detected: the embedding's calls then return MICA_ERR_STALE_ID.
+ *  @{ */
+
+/** Id of an embedded mesh. */
+typedef uint64_t mica_embedding_id;
+
+#define MICA_EMBED_INSIDE 0    /**< in a tet (or on its boundary): weights in [0, 1] */
+/** outside the body, its nearest surface point within the radius: it follows the tet under that
+ *  point with extrapolated weights (some negative), so it keeps its offset from the surface */
+#define MICA_EMBED_PROJECTED 1
+/** outside the body and farther than the radius from it: mica_embedding_update() leaves its
+ *  entries of out_xyz as they are (never moves it, never writes the origin) */
+#define MICA_EMBED_UNBOUND 2
+
+/** Warning (since 0.7): the embedding was made, but some vertices are farther than its radius from
+ *  the body and are unbound (MICA_EMBED_UNBOUND); the message names how many and the first. */
+#define MICA_WARN_UNBOUND_VERTICES 4
+
+/** How to bind a mesh: fill with mica_embedding_def_default(). */
+typedef struct mica_embedding_def {
+  uint32_t struct_size; /**< sizeof(mica_embedding_def) as the caller compiled it */
+  int32_t reserved0;    /**< zero */
+  /** m, >= 0: a vertex outside the body whose nearest point of the body's rest surface is at most
+   *  this far is projected (MICA_EMBED_PROJECTED), a farther one unbound; default 0.001 */
+  double radius;
+} mica_embedding_def;
+
+/** Fills `def` with defaults, writing only its first `struct_size` bytes. Thread: any.
+ *  @param def the def to fill.
+ *  @param struct_size sizeof(mica_embedding_def) as the caller compiled it.
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`def` is NULL); MICA_ERR_STRUCT_SIZE (`struct_size`
+ *          outside the accepted sizes: nothing is written). */
+MICA_API mica_status mica_embedding_def_init(mica_embedding_def* def, uint32_t struct_size);
+
+/** The default embedding definition (radius 1 mm). Thread: any.
+ *  @return a def with `struct_size` = sizeof(mica_embedding_def) and every field at its default. */
+static inline mica_embedding_def mica_embedding_def_default(void) {
+  mica_embedding_def def;
+  def.struct_size = (uint32_t)sizeof def; /* kept if init refuses: the create call names it */
+  mica_embedding_def_init(&def, (uint32_t)sizeof def);
+  return def;
+}
+
+/** Binds a host's mesh to a body: each vertex to the tet that holds it at the body's rest shape,
+ *  found through a grid over the rest tets, with its four barycentric weights; a vertex in no tet
+ *  to the tet under its nearest rest surface point if that is within `def->radius` (its weights
+ *  extrapolated: it keeps its place relative to that tet), else left unbound. The arrays are
+ *  copied. Cost: under a microsecond a vertex (bench/bench_embedding). The world's thread (the one
+ *  thread using the world at a time).
+ *  @param world the world (not changed).
+ *  @param body the body.
+ *  @param def the definition (mica_embedding_def_default(), then changed).
+ *  @param xyz 3 * `vertex_count` coordinates (m) in the frame of the body's rest positions
+ *         (mica_body_get_rest_positions(), which include mica_body_def.translation), finite.
+ *  @param vertex_count number of vertices, >= 1.
+ *  @param triangles 3 * `triangle_count` 0-based vertex indices, counter-clockwise seen from where
+ *         the normals should point; may be NULL when `triangle_count` is 0 (then no normals).
+ *  @param triangle_count number of triangles, >= 0.
+ *  @param out_embedding receives the embedding's id.
+ *  @return MICA_OK; MICA_WARN_UNBOUND_VERTICES (made, but some vertices are unbound: the message
+ *          names how many and the first; mica_embedding_get_kinds() says which); or
+ *          MICA_ERR_NULL_ARGUMENT (`world`, `def`, `xyz`, `out_embedding`, or `triangles` with a
+ *          count above 0, is NULL); MICA_ERR_STALE_ID (`body`); MICA_ERR_STRUCT_SIZE
+ *          (`def->struct_size`); MICA_ERR_INVALID_ARGUMENT (a count out of its domain, the radius
+ *          negative or not finite, a coordinate not finite: the message names the vertex);
+ *          MICA_ERR_OUT_OF_RANGE (a triangle names a vertex outside 0..vertex_count-1: the message
+ *          names the triangle); MICA_ERR_OUT_OF_MEMORY. */
+MICA_API mica_status mica_embedding_create(mica_world* world, mica_body_id body, const mica_embedding_def* def,
+                                           const double* xyz, int32_t vertex_count, const int32_t* triangles,
+                                           int32_t triangle_count, mica_embedding_id* out_embedding);
+
+/** Destroys an embedding. The world's thread (the one thread using the world at a time).
+ *  @param world the world.
+ *  @param embedding the embedding.
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` is NULL); MICA_ERR_STALE_ID (`embedding` is
+ *          null, of another kind or destroyed). */
+MICA_API mica_status mica_embedding_destroy(mica_world* world, mica_embedding_id embedding);
+
+/** How many vertices an embedding has, and of each kind. The world's thread (the one thread using
+ *  the world at a time).
+ *  @param world the world (not changed).
+ *  @param embedding the embedding.
+ *  @param vertex_count receives the vertex count, or NULL.
+ *  @param inside receives the count of MICA_EMBED_INSIDE vertices, or NULL.
+ *  @param projected receives the count of MICA_EMBED_PROJECTED vertices, or NULL.
+ *  @param unbound receives the count of MICA_EMBED_UNBOUND vertices, or NULL.
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` is NULL); MICA_ERR_STALE_ID (`embedding`). */
+MICA_API mica_status mica_embedding_get_counts(const mica_world* world, mica_embedding_id embedding,
+                                               int32_t* vertex_count, int32_t* inside, int32_t* projected,
+                                               int32_t* unbound);
+
+/** The kind of each vertex (MICA_EMBED_INSIDE, _PROJECTED or _UNBOUND), 1 value per vertex; buffer
+ *  protocol as mica_body_get_positions(). The world's thread (the one thread using the world at a
+ *  time).
+ *  @param world the world (not changed).
+ *  @param embedding the embedding.
+ *  @param out the caller's buffer, or NULL to ask for the count only. @param capacity its size in
+ *         vertices. @param out_count receives the vertex count (may be NULL when `out` is not).
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world`, or both `out` and `out_count`, NULL);
+ *          MICA_ERR_STALE_ID (`embedding`); MICA_ERR_INVALID_ARGUMENT (`capacity` < 0);
+ *          MICA_ERR_BUFFER_TOO_SMALL (`capacity` below the count: nothing copied, `*out_count` = the
+ *          count needed). */
+MICA_API mica_status mica_embedding_get_kinds(const mica_world* world, mica_embedding_id embedding, int32_t* out,
+                                              int32_t capacity, int32_t* out_count);
+
+/** Places the mesh on the body as it is now (call it after each mica_step()): each bound vertex's
+ *  position (m) is its weights times its tet's current node positions, written into `out_xyz`;
+ *  an unbound vertex's three values are left as they are (fill them once, e.g. with the array you
+ *  bound, or hide those vertices). With `out_normals`, then the area-weighted unit normal of each
+ *  vertex over its triangles at `out_xyz` (unbound vertices' values included); a vertex in no
+ *  triangle, or whose triangles have no area, gets (0, 0, 0). Allocates nothing. The world's thread
+ *  (the one thread using the world at a time).
+ *  @param world the world (not changed).
+ *  @param embedding the embedding.
+ *  @param out_xyz the caller's array of 3 * vertex_count doubles (m).
+ *  @param out_normals the caller's array of 3 * vertex_count doubles, apart from `out_xyz`, or NULL
+ *         for no normals.
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` or `out_xyz` is NULL); MICA_ERR_STALE_ID
+ *          (`embedding`, or its body was destroyed: the message names the body);
+ *          MICA_ERR_WRONG_STATE (`out_normals` given to an embedding made without triangles);
+ *          MICA_ERR_INVALID_ARGUMENT (`out_normals` overlaps `out_xyz`).
+ *          On an error nothing is written. */
+MICA_API mica_status mica_embedding_update(const mica_world* world, mica_embedding_id embedding, double* out_xyz,
+                                           double* out_normals);
+/** @} */
+
 #ifdef __cplusplus
 }
 #endif

@@ -23,7 +23,7 @@
 namespace mica {
 
 using Id = uint64_t;
-enum class IdKind : uint8_t { Body = 1, Lpc = 2, Tool = 3, Device = 4 };
+enum class IdKind : uint8_t { Body = 1, Lpc = 2, Tool = 3, Device = 4, Embedding = 5 };
 // The kind an id was made for (its top byte); not a check that the object lives.
 inline IdKind id_kind(Id id) { return IdKind(uint8_t(id >> 56)); }
 

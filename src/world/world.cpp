@@ -360,6 +360,7 @@ std::vector<Id> World::ids(IdKind kind) const {
     case IdKind::Lpc: lpcs_.for_each(add); break;
     case IdKind::Tool: tools_.for_each(add); break;
     case IdKind::Device: devices_.for_each(add); break;
+    case IdKind::Embedding: break;  // held by the C layer's world (capi/embedding.cpp), not here
   }
   return out;
 }

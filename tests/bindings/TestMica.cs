@@ -498,6 +498,56 @@ static class TestMica
         }
     }
 
+    // An embedded mesh (since 0.7): it follows its body into the host's arrays; an unbound vertex is
+    // reported and left as it was; NaN is refused by index; a destroyed embedding is detected.
+    static void EmbeddedMesh()
+    {
+        using (var world = new World(Mica.WorldDef()))
+        {
+            var body = world.CreateBox(new[] { 0.0, 0, 0 }, new[] { 0.1, 0.1, 0.1 }, new[] { 2, 2, 2 }, 5, Mica.BodyDef());
+            var xyz = new[] { 0.05, 0.05, 0.05, 0.02, 0.1, 0.03, 0.08, 0.1, 0.07, 0.03, 0.1, 0.09, 0.05, 0.5, 0.05 };
+            var def = Mica.EmbeddingDef();
+            Expect(def.radius == 0.001, "the default radius");
+            var sheet = body.Embed(xyz, new[] { 1, 3, 2 }, def);
+            Expect(world.LastStatus == MicaNative.MICA_WARN_UNBOUND_VERTICES, "a far vertex is reported");
+            int n, inside, projected, unbound;
+            sheet.GetCounts(out n, out inside, out projected, out unbound);
+            Expect(n == 5 && inside == 4 && projected == 0 && unbound == 1, "counts");
+            Expect(sheet.GetKinds()[4] == MicaNative.MICA_EMBED_UNBOUND, "kinds");
+            var x = body.GetPositions();
+            for (int i = 1; i < x.Length; i += 3) x[i] += 0.01;
+            body.SetPositions(x);
+            var outXyz = new double[15];
+            var normals = new double[15];
+            outXyz[12] = outXyz[13] = outXyz[14] = 7;
+            sheet.Update(outXyz, normals);
+            for (int i = 0; i < 12; ++i)
+                Expect(Math.Abs(outXyz[i] - xyz[i] - (i % 3 == 1 ? 0.01 : 0)) < 1e-12, "a bound vertex follows the body");
+            Expect(outXyz[12] == 7 && outXyz[14] == 7, "an unbound vertex is left as it was");
+            Expect(Math.Abs(normals[4] - 1) < 1e-12, "the top triangle's normal is +y");
+            xyz[7] = double.NaN;
+            try
+            {
+                body.Embed(xyz);
+                Expect(false, "NaN was taken");
+            }
+            catch (MicaException e)
+            {
+                Expect(e.Message.Contains("vertex 2 is not finite"), e.Message);
+            }
+            sheet.Destroy();
+            try
+            {
+                sheet.Update(outXyz);
+                Expect(false, "a destroyed embedding was updated");
+            }
+            catch (MicaException e)
+            {
+                Expect(e.Status == MicaNative.MICA_ERR_STALE_ID, "stale id");
+            }
+        }
+    }
+
     // System.Numerics overloads (MicaNumerics): Vector3 and Quaternion, libmica's (w, x, y, z) mapped.
     static void NumericsOverloads()
     {
@@ -782,6 +832,7 @@ static class TestMica
         Test("a mesh file and raw ids, from another assembly", LoaderAndRawIds);
         Test("tissue regions, materials and fields", RegionsMaterialsAndFields);
         Test("System.Numerics Vector3 and Quaternion overloads", NumericsOverloads);
+        Test("an embedded mesh follows its body", EmbeddedMesh);
         Test("a recorded session replays bit for bit, with the recorded ids", RecordAndReplay);
         Test("a changed fingerprint diverges at its step", ReplayDiverges);
         Console.WriteLine("{0} passed, {1} failed, {2} skipped", passed, failed, skipped);

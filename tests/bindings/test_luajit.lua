@@ -400,6 +400,37 @@ test("loaders, grasp and constraint helpers", function()
   world:close()
 end)
 
+test("an embedded mesh follows its body (since 0.7)", function()
+  local world = mica.world{ gravity = { 0, 0, 0 } }
+  local box = world:create_box({ 0, 0, 0 }, { 0.1, 0.1, 0.1 }, { 2, 2, 2 }, 5)
+  local xyz = { 0.05, 0.05, 0.05, 0.02, 0.1, 0.03, 0.08, 0.1, 0.07, 0.03, 0.1, 0.09, 0.05, 0.5, 0.05 }
+  local sheet, n, status = world:embed(box, xyz, { 1, 3, 2 }, { radius = 0.001 })
+  expect(n == 5 and status == C.MICA_WARN_UNBOUND_VERTICES, "a far vertex is reported unbound")
+  expect(world:last_error():find("vertex 4", 1, true), "the warning names the vertex")
+  local count, inside, projected, unbound = world:embedding_counts(sheet)
+  expect(count == 5 and inside == 4 and projected == 0 and unbound == 1, "counts")
+  local kinds = world:embedding_kinds(sheet)
+  expect(kinds[0] == C.MICA_EMBED_INSIDE and kinds[4] == C.MICA_EMBED_UNBOUND, "kinds")
+  local out, normals = ffi.new("double[?]", 15), ffi.new("double[?]", 15)
+  out[12], out[13], out[14] = 7, 7, 7
+  local x, nodes = world:positions(box)
+  local lifted = {}
+  for i = 0, 3 * nodes - 1 do lifted[i + 1] = x[i] + (i % 3 == 1 and 0.01 or 0) end
+  world:set_positions(box, lifted)
+  world:update_embedding(sheet, out, normals)
+  for i = 0, 11 do
+    expect(math.abs(out[i] - xyz[i + 1] - (i % 3 == 1 and 0.01 or 0)) < 1e-12, "a bound vertex moves with the body")
+  end
+  expect(out[12] == 7 and out[13] == 7 and out[14] == 7, "an unbound vertex is left as it was")
+  expect(math.abs(normals[4] - 1) < 1e-12, "the top triangle's normal is +y")
+  xyz[7] = 0 / 0
+  expect_refused("vertex 2 is not finite", world.embed, world, box, xyz)
+  world:destroy_embedding(sheet)
+  local ok, e = pcall(world.update_embedding, world, sheet, out, nil)
+  expect(not ok and e.status == C.MICA_ERR_STALE_ID, "a destroyed embedding is refused")
+  world:close()
+end)
+
 test("node state, saved state and contacts", function()
   local world = mica.world{ gravity = { 0, -9.81, 0 } }
   local box = world:create_box({ 0, 0, 0 }, { 0.1, 0.1, 0.1 }, { 2, 2, 2 }, 5, { youngs_modulus = 2e4 })

@@ -256,6 +256,41 @@ class Behaviour(unittest.TestCase):
             with self.assertRaisesRegex(ValueError, "teleport position: expected 3 values, got 1"):
                 tool.teleport((0.2,))
 
+    def test_embedding_fills_numpy_arrays(self):
+        """A render mesh on a box: at rest in place, moved with the body into the same arrays (no
+        new ones), an unbound vertex warned about and left where it was, NaN refused by index."""
+        with mica.World(gravity=(0, 0, 0)) as world:
+            box = world.create_box((0, 0, 0), (0.1, 0.1, 0.1), (2, 2, 2), 5)
+            xyz = np.array([[0.05, 0.05, 0.05], [0.02, 0.1, 0.03], [0.08, 0.1, 0.07], [0.03, 0.1, 0.09],
+                            [0.05, 0.5, 0.05]])
+            with self.assertWarns(mica.MicaWarning) as w:
+                sheet = box.embed(xyz, [[1, 3, 2]], radius=0.001)
+            self.assertEqual(w.warning.status, mica.MICA_WARN_UNBOUND_VERTICES)
+            self.assertIn("vertex 4", str(w.warning))
+            self.assertEqual(sheet.counts(), (5, 4, 0, 1))
+            self.assertEqual(list(sheet.kinds()), [0, 0, 0, 0, 2])
+            positions, normals = sheet.update()
+            self.assertIs(positions, sheet.positions)
+            np.testing.assert_allclose(positions, xyz, atol=1e-12)
+            np.testing.assert_allclose(normals[1], (0, 1, 0), atol=1e-12)
+            rest = box.rest_positions()
+            box.set_positions(rest + (0, 0.01, 0))
+            out, out_n = np.zeros((5, 3)), np.zeros((5, 3))
+            self.assertIs(sheet.update(out, out_n)[0], out)
+            np.testing.assert_allclose(out[:4], xyz[:4] + (0, 0.01, 0), atol=1e-12)
+            np.testing.assert_array_equal(out[4], (0, 0, 0))  # unbound: left as it was
+            with self.assertRaisesRegex(ValueError, "out_xyz"):
+                sheet.update(np.zeros((5, 3), dtype=np.float32))
+            bad = xyz.copy()
+            bad[2, 0] = np.nan
+            with self.assertRaises(mica.MicaError) as e:
+                box.embed(bad)
+            self.assertIn("vertex 2 is not finite", e.exception.message)
+            sheet.destroy()
+            with self.assertRaises(mica.MicaError) as e:
+                sheet.update()
+            self.assertEqual(e.exception.status, mica.MICA_ERR_STALE_ID)
+
     def test_a_trajectory_of_the_wrong_length_is_reported(self):
         # The trajectory runs inside a C callback: its error goes to sys.unraisablehook.
         reported = []

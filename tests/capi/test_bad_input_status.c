@@ -14,6 +14,7 @@ static void test_status_strings(void** state) {
       S(MICA_WARN_NOT_CONVERGED),
       S(MICA_WARN_DEVICE),
       S(MICA_WARN_BODIES_OVERLAP),
+      S(MICA_WARN_UNBOUND_VERTICES),
       S(MICA_ERR_NULL_ARGUMENT),
       S(MICA_ERR_INVALID_ARGUMENT),
       S(MICA_ERR_OUT_OF_RANGE),
@@ -33,7 +34,7 @@ static void test_status_strings(void** state) {
   };
 #undef S
   const size_t count = sizeof kCodes / sizeof kCodes[0];
-  const mica_status unknown[6] = {4, -17, 100, -1000, INT32_MAX, INT32_MIN};
+  const mica_status unknown[6] = {5, -17, 100, -1000, INT32_MAX, INT32_MIN};
   for (size_t i = 0; i < count; ++i) {
     const char* text = mica_status_string(kCodes[i].code);
     assert_non_null(text);

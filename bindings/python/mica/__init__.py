@@ -53,7 +53,8 @@ PathLike = Union[str, "os.PathLike[str]"]
 globals().update({k: v for k, v in vars(native).items() if k.startswith("MICA_")})
 
 __all__ = ["MicaError", "MicaWarning", "World", "Replay", "Body", "Tool", "Lpc", "Device", "DeviceBackend",
-           "PositionsView", "version", "world_def", "body_def", "lpc_def", "tool_def", "device_def", "native"]
+           "Embedding", "PositionsView", "version", "world_def", "body_def", "lpc_def", "tool_def", "device_def",
+           "embedding_def", "native"]
 
 
 class MicaError(Exception):
@@ -83,8 +84,9 @@ def _check(status, world_handle=None, function=""):
         raise MicaError(status, message.decode(errors="replace"), function)
     if status > 0:
         message = ""
-        if status == native.MICA_WARN_BODIES_OVERLAP and world_handle is not None:
-            # The library keeps this warning's message (both bodies and the depth) as the world's.
+        if status in (native.MICA_WARN_BODIES_OVERLAP, native.MICA_WARN_UNBOUND_VERTICES) and world_handle is not None:
+            # The library keeps these warnings' messages (the bodies and the depth; the unbound
+            # vertices) as the world's.
             message = (native.mica_world_last_error(world_handle) or b"").decode(errors="replace")
         warnings.warn(MicaWarning(status, message), stacklevel=_caller_level())
     return status
@@ -171,6 +173,13 @@ def device_def(**fields: Any) -> native.mica_device_def:
     """A mica_device_def with the library's defaults, then `fields`."""
     d = native.mica_device_def()
     _check(native.mica_device_def_init(byref(d), sizeof(d)), None, "mica_device_def_init")
+    return _fill(d, fields)
+
+
+def embedding_def(**fields: Any) -> native.mica_embedding_def:
+    """A mica_embedding_def with the library's defaults (radius 1 mm), then `fields`. Since 0.7."""
+    d = native.mica_embedding_def()
+    _check(native.mica_embedding_def_init(byref(d), sizeof(d)), None, "mica_embedding_def_init")
     return _fill(d, fields)
 
 
@@ -738,9 +747,82 @@ class Body(_Object):
         self.world._check(native.mica_body_write_vtk(self.world.handle, self.id, str(path).encode()),
                           "mica_body_write_vtk")
 
+    def embed(self, xyz: ArrayLike, triangles: Optional[ArrayLike] = None,
+              definition: Optional[native.mica_embedding_def] = None, **fields: Any) -> Embedding:
+        """Binds a render mesh to this body (mica_embedding_create, since 0.7): vertices (n, 3) in m
+        in the frame of the rest positions, triangles (k, 3) of vertex indices for the normals
+        (None: no normals); fields of mica_embedding_def (radius=...). Vertices farther than the
+        radius from the body are unbound: a MicaWarning (MICA_WARN_UNBOUND_VERTICES) names them."""
+        d = _fill(definition if definition is not None else embedding_def(), fields)
+        xyz = _rows(xyz, 3, np.float64, "embed xyz")
+        tris = _rows(triangles if triangles is not None else np.empty((0, 3)), 3, np.int32, "embed triangles")
+        out = native.mica_embedding_id()
+        status = native.mica_embedding_create(
+            self.world.handle, self.id, byref(d), xyz.ctypes.data_as(POINTER(c_double)), len(xyz),
+            tris.ctypes.data_as(POINTER(c_int32)) if len(tris) else None, len(tris), byref(out))
+        embedding = Embedding(self.world, out.value, xyz, len(tris) > 0) if status >= 0 else None
+        self.world._check(status, "mica_embedding_create")  # raises for an error, warns for unbound vertices
+        return embedding
+
     def destroy(self) -> None:
         self.world._view_epoch += 1  # positions views of this body lose their buffer
         self.world._check(native.mica_body_destroy(self.world.handle, self.id), "mica_body_destroy")
+
+
+class Embedding(_Object):
+    """A render mesh bound to a body's tets (Body.embed; mica_embedding_*, since 0.7).
+
+    update() places it on the body as it is now: it writes the positions (n, 3) and, when the
+    mesh has triangles, the area-weighted unit normals (n, 3) into float64 numpy arrays, in place:
+    by default its own .positions and .normals (made once, reused by every update: views you
+    may hand to a renderer), or arrays you pass (C-contiguous float64 of shape (n, 3)). An
+    unbound vertex (kinds() == MICA_EMBED_UNBOUND) is never written: .positions starts as the
+    bound vertices, so such a vertex stays where it was given.
+    """
+
+    def __init__(self, world: World, id_: int, xyz: np.ndarray, has_triangles: bool) -> None:
+        super().__init__(world, id_)
+        self.positions = np.array(xyz, dtype=np.float64, order="C")  # updated in place
+        self.normals = np.zeros_like(self.positions) if has_triangles else None
+
+    @property
+    def vertex_count(self) -> int:
+        return len(self.positions)
+
+    def counts(self) -> Tuple[int, int, int, int]:
+        """(vertices, inside, projected, unbound)."""
+        n, i, p, u = c_int32(), c_int32(), c_int32(), c_int32()
+        self.world._check(native.mica_embedding_get_counts(self.world.handle, self.id, byref(n), byref(i), byref(p),
+                                                           byref(u)), "mica_embedding_get_counts")
+        return n.value, i.value, p.value, u.value
+
+    def kinds(self) -> np.ndarray:
+        """The kind of each vertex (n,): MICA_EMBED_INSIDE, _PROJECTED or _UNBOUND."""
+        w = self.world
+        return _read_items(lambda out, cap, cnt: w._check(native.mica_embedding_get_kinds(
+            w.handle, self.id, out, cap, cnt), "mica_embedding_get_kinds"), 1, np.int32).ravel()
+
+    def _target(self, array, name):
+        if not (isinstance(array, np.ndarray) and array.dtype == np.float64 and array.flags.c_contiguous
+                and array.flags.writeable and array.shape == (self.vertex_count, 3)):
+            raise ValueError("%s: expected a writeable C-contiguous float64 array of shape (%d, 3)"
+                             % (name, self.vertex_count))
+        return array.ctypes.data_as(POINTER(c_double))
+
+    def update(self, out_xyz: Optional[np.ndarray] = None,
+               out_normals: Optional[np.ndarray] = None) -> Tuple[np.ndarray, Optional[np.ndarray]]:
+        """Writes the positions (m) and normals after the last step into out_xyz and out_normals
+        (default: .positions and .normals) and returns the two arrays (normals None without
+        triangles). Allocates nothing."""
+        xyz = self.positions if out_xyz is None else out_xyz
+        normals = self.normals if out_normals is None else out_normals
+        self.world._check(native.mica_embedding_update(
+            self.world.handle, self.id, self._target(xyz, "out_xyz"),
+            None if normals is None else self._target(normals, "out_normals")), "mica_embedding_update")
+        return xyz, normals
+
+    def destroy(self) -> None:
+        self.world._check(native.mica_embedding_destroy(self.world.handle, self.id), "mica_embedding_destroy")
 
 
 class Lpc(_Object):

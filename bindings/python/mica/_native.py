@@ -89,6 +89,11 @@ MICA_OBJECT_LPC = 2
 MICA_OBJECT_TOOL = 3
 MICA_OBJECT_DEVICE = 4
 
+MICA_EMBED_INSIDE = 0  # since 0.7: embedded meshes
+MICA_EMBED_PROJECTED = 1
+MICA_EMBED_UNBOUND = 2
+MICA_WARN_UNBOUND_VERTICES = 4
+
 # --- Constants (mica_device.h)
 MICA_DEVICE_CALLBACKS = 0
 MICA_DEVICE_NULL = 1
@@ -108,6 +113,7 @@ mica_body_id = c_uint64
 mica_lpc_id = c_uint64
 mica_tool_id = c_uint64
 mica_device_id = c_uint64
+mica_embedding_id = c_uint64
 mica_world_p = c_void_p  # opaque mica_world*
 mica_replay_p = c_void_p  # opaque mica_replay*
 
@@ -237,6 +243,14 @@ class mica_contact(Structure):
         ("tangent_impulse", c_double * 3),
         ("friction", c_double),
         ("curvature_impulse", c_double * 3),
+    ]
+
+
+class mica_embedding_def(Structure):  # since 0.7
+    _fields_ = [
+        ("struct_size", c_uint32),
+        ("reserved0", c_int32),
+        ("radius", c_double),
     ]
 
 
@@ -408,6 +422,14 @@ PROTOTYPES = {
     "mica_stage_name": (c_char_p, [_i]),
     "mica_body_write_vtk": (mica_status, [mica_world_p, mica_body_id, c_char_p]),
     "mica_world_write_vtk": (mica_status, [mica_world_p, c_char_p]),
+    # since 0.7: embedded meshes
+    "mica_embedding_def_init": (mica_status, [_p(mica_embedding_def), _u]),
+    "mica_embedding_create": (mica_status, [mica_world_p, mica_body_id, _p(mica_embedding_def), _p(_d), _i, _p(_i),
+                                            _i, _p(mica_embedding_id)]),
+    "mica_embedding_destroy": (mica_status, [mica_world_p, mica_embedding_id]),
+    "mica_embedding_get_counts": (mica_status, [mica_world_p, mica_embedding_id, _p(_i), _p(_i), _p(_i), _p(_i)]),
+    "mica_embedding_get_kinds": (mica_status, [mica_world_p, mica_embedding_id, _p(_i), _i, _p(_i)]),
+    "mica_embedding_update": (mica_status, [mica_world_p, mica_embedding_id, _p(_d), _p(_d)]),
     # mica_device.h
     "mica_device_def_init": (mica_status, [_p(mica_device_def), _u]),
     "mica_device_create": (mica_status, [mica_world_p, _p(mica_device_def), _p(mica_device_id)]),

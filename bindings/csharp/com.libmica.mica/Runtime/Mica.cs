@@ -165,6 +165,14 @@ namespace LibMica
             return d;
         }
 
+        /// <summary>The default embedding def (radius 1 mm). Since 0.7.</summary>
+        public static MicaNative.mica_embedding_def EmbeddingDef()
+        {
+            var d = new MicaNative.mica_embedding_def();
+            Check(MicaNative.mica_embedding_def_init(ref d, (uint)sizeof(MicaNative.mica_embedding_def)), null);
+            return d;
+        }
+
         /// <summary>A NUL-terminated UTF-8 string (for path parameters).</summary>
         public static byte[] Utf8z(string s)
         {
@@ -586,6 +594,70 @@ namespace LibMica
         }
 
         public void Destroy() { World.Check(MicaNative.mica_body_destroy(World.Handle, Id)); }
+
+        /// <summary>Binds a render mesh to this body (since 0.7): `xyz` 3 values a vertex (m, the rest
+        /// frame), `triangles` 3 vertex indices each for the normals (null: none). Vertices farther
+        /// than def.radius from the body are unbound: World.LastStatus is then
+        /// MICA_WARN_UNBOUND_VERTICES and the world's last error names them.</summary>
+        public Embedding Embed(double[] xyz, int[] triangles, MicaNative.mica_embedding_def def)
+        {
+            if (xyz == null || xyz.Length % 3 != 0) throw new ArgumentException("xyz needs 3 values a vertex");
+            if (triangles != null && triangles.Length % 3 != 0) throw new ArgumentException("triangles need 3 indices each");
+            ulong id;
+            int triangleCount = triangles == null ? 0 : triangles.Length / 3;
+            World.Check(MicaNative.mica_embedding_create(World.Handle, Id, ref def, xyz, xyz.Length / 3,
+                                                         triangleCount > 0 ? triangles : null, triangleCount, out id));
+            return new Embedding(World, id, xyz.Length / 3, triangleCount > 0);
+        }
+
+        public Embedding Embed(double[] xyz, int[] triangles = null) { return Embed(xyz, triangles, Mica.EmbeddingDef()); }
+    }
+
+    /// <summary>A render mesh bound to a body's tets (Body.Embed, since 0.7): Update() writes its
+    /// positions and normals after each step into the host's arrays.</summary>
+    public sealed class Embedding
+    {
+        public readonly World World;
+        public readonly ulong Id;
+        public readonly int VertexCount;
+        public readonly bool HasTriangles;
+
+        public Embedding(World world, ulong id, int vertexCount, bool hasTriangles)
+        {
+            World = world;
+            Id = id;
+            VertexCount = vertexCount;
+            HasTriangles = hasTriangles;
+        }
+
+        /// <summary>Writes the positions (m) and, with `normals`, the unit normals after the last step
+        /// into arrays of 3 * VertexCount values the host made once and reuses (an unbound vertex's
+        /// values are left as they are). Allocates nothing.</summary>
+        public void Update(double[] xyz, double[] normals = null)
+        {
+            if (xyz == null || xyz.Length != 3 * VertexCount) throw new ArgumentException("xyz needs " + 3 * VertexCount + " values");
+            if (normals != null && normals.Length != 3 * VertexCount)
+                throw new ArgumentException("normals need " + 3 * VertexCount + " values");
+            World.Check(MicaNative.mica_embedding_update(World.Handle, Id, xyz, normals));
+        }
+
+        /// <summary>The kind of each vertex: MICA_EMBED_INSIDE, _PROJECTED or _UNBOUND.</summary>
+        public int[] GetKinds()
+        {
+            int n;
+            World.Check(MicaNative.mica_embedding_get_kinds(World.Handle, Id, null, 0, out n));
+            var kinds = new int[n];
+            World.Check(MicaNative.mica_embedding_get_kinds(World.Handle, Id, kinds, n, out n));
+            return kinds;
+        }
+
+        public void GetCounts(out int vertices, out int inside, out int projected, out int unbound)
+        {
+            World.Check(MicaNative.mica_embedding_get_counts(World.Handle, Id, out vertices, out inside, out projected,
+                                                             out unbound));
+        }
+
+        public void Destroy() { World.Check(MicaNative.mica_embedding_destroy(World.Handle, Id)); }
     }
 
     /// <summary>Positions owned by the world, read in place (see Body.Positions()).</summary>

@@ -93,6 +93,12 @@ namespace LibMica
         public const int MICA_OBJECT_TOOL = 3;
         public const int MICA_OBJECT_DEVICE = 4;
 
+        // Since 0.7: embedded meshes.
+        public const int MICA_EMBED_INSIDE = 0;
+        public const int MICA_EMBED_PROJECTED = 1;
+        public const int MICA_EMBED_UNBOUND = 2;
+        public const int MICA_WARN_UNBOUND_VERTICES = 4;
+
         // --- Constants (mica_device.h)
         public const int MICA_DEVICE_CALLBACKS = 0;
         public const int MICA_DEVICE_NULL = 1;
@@ -259,6 +265,14 @@ namespace LibMica
                 if (stage < 0 || stage >= MICA_STAGE_COUNT) throw new ArgumentOutOfRangeException("stage");
                 fixed (byte* p = stages) return ((mica_stage_stats*)p)[stage];
             }
+        }
+
+        [StructLayout(LayoutKind.Sequential)]
+        public struct mica_embedding_def // since 0.7
+        {
+            public uint struct_size;
+            public int reserved0;
+            public double radius;
         }
 
         // --- Structs (mica_device.h)
@@ -562,6 +576,30 @@ namespace LibMica
 
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
         public static extern int mica_world_write_vtk(WorldHandle world, byte[] path);
+
+        // Since 0.7: embedded meshes. The output arrays are the host's double[] (3 values a vertex).
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern int mica_embedding_def_init(ref mica_embedding_def def, uint struct_size);
+
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern int mica_embedding_create(WorldHandle world, ulong body, ref mica_embedding_def def,
+                                                       double[] xyz, int vertex_count, int[] triangles,
+                                                       int triangle_count, out ulong out_embedding);
+
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern int mica_embedding_destroy(WorldHandle world, ulong embedding);
+
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern int mica_embedding_get_counts(WorldHandle world, ulong embedding, out int vertex_count,
+                                                           out int inside, out int projected, out int unbound);
+
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern int mica_embedding_get_kinds(WorldHandle world, ulong embedding, int[] @out, int capacity,
+                                                          out int out_count);
+
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern int mica_embedding_update(WorldHandle world, ulong embedding, [In, Out] double[] out_xyz,
+                                                       [In, Out] double[] out_normals);
 
         // --- Functions (mica_device.h)
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]

@@ -1,0 +1,236 @@
+// SPDX-License-Identifier: Apache-2.0
+// A render mesh embedded in a body's tets: the grid finds the tet a brute-force scan finds; at rest
+// and under a rigid motion every bound vertex lands where it should (1e-12 m); vertices outside
+// the body are projected within the radius and unbound beyond it, left as they were; the normals
+// are the area-weighted normals of the moved triangles; the update allocates nothing; bad input is
+// refused by name.
+#include "embedding/embedding.hpp"
+#include "embedding/tet_locator.hpp"
+#include "embedding/vertex_normals.hpp"
+#define MICA_TEST_COUNT_MALLOC
+#include "haptics/alloc_counter.hpp"
+#include "test_util.hpp"
+
+using namespace mica;
+
+namespace {
+
+struct Box {
+  TetMesh mesh;
+  std::vector<Tri> surface;
+};
+
+Box box() {
+  Box b;
+  b.mesh = make_box_grid(Vec3(-0.05, 0, -0.04), Vec3(0.05, 0.06, 0.04), {5, 3, 4}, 6);
+  b.surface = extract_surface(b.mesh);
+  return b;
+}
+
+// The render mesh of a test: the body's surface nodes and triangles, random points inside, points
+// just outside the +x face (2 mm) and far outside (5 cm); their counts.
+struct Mesh {
+  std::vector<double> xyz;
+  std::vector<int32_t> triangles;
+  int32_t inside = 0, near = 0, far = 0;
+  int32_t count() const { return int32_t(xyz.size() / 3); }
+  Vec3 vertex(int32_t i) const { return {xyz[3 * size_t(i)], xyz[3 * size_t(i) + 1], xyz[3 * size_t(i) + 2]}; }
+  void add(const Vec3& p) { xyz.insert(xyz.end(), {p.x(), p.y(), p.z()}); }
+};
+
+Mesh render_mesh(const Box& b) {
+  Mesh m;
+  std::vector<int32_t> index(b.mesh.nodes.size(), -1);
+  for (const Tri& f : b.surface)
+    for (int32_t v : f) {
+      if (index[size_t(v)] < 0) {
+        index[size_t(v)] = m.count();
+        m.add(b.mesh.nodes[size_t(v)]);
+      }
+      m.triangles.push_back(index[size_t(v)]);
+    }
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(0.001, 0.999);
+  for (int k = 0; k < 500; ++k) m.add(Vec3(-0.05 + 0.1 * u(rng), 0.06 * u(rng), -0.04 + 0.08 * u(rng)));
+  m.inside = m.count();
+  for (int k = 0; k < 50; ++k) m.add(Vec3(0.052, 0.06 * u(rng), -0.04 + 0.08 * u(rng)));
+  m.near = 50;
+  for (int k = 0; k < 5; ++k) m.add(Vec3(0.1, 0.06 * u(rng), 0));
+  m.far = 5;
+  return m;
+}
+
+Embedding embed(const Box& b, const Mesh& m, double radius = 0.003) {
+  return Embedding(7, b.mesh.nodes, b.mesh.tets, b.surface, m.xyz.data(), m.count(), m.triangles.data(),
+                   int32_t(m.triangles.size() / 3), radius);
+}
+
+// The normals of `triangles` at xyz, summed per vertex the plain way (Vec3, one triangle at a time).
+Vec3List reference_normals(const std::vector<double>& xyz, const std::vector<int32_t>& triangles) {
+  Vec3List n(xyz.size() / 3, Vec3::Zero());
+  auto p = [&](int32_t v) { return Vec3(xyz[3 * size_t(v)], xyz[3 * size_t(v) + 1], xyz[3 * size_t(v) + 2]); };
+  for (size_t t = 0; t < triangles.size(); t += 3) {
+    const Vec3 face = (p(triangles[t + 1]) - p(triangles[t])).cross(p(triangles[t + 2]) - p(triangles[t]));
+    for (int k = 0; k < 3; ++k) n[size_t(triangles[t + size_t(k)])] += face;
+  }
+  for (Vec3& v : n)
+    if (v.norm() > 0) v.normalize();
+  return n;
+}
+
+double angle_degrees(const Vec3& a, const Vec3& b) {
+  return std::atan2(a.cross(b).norm(), a.dot(b)) * 180 / M_PI;
+}
+
+}  // namespace
+
+static void test_grid_finds_the_tet_a_scan_finds(void**) {
+  const Box b = box();
+  const TetLocator locator(b.mesh.nodes, b.mesh.tets);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-0.06, 0.07);
+  int inside = 0;
+  for (int k = 0; k < 2000; ++k) {
+    const Vec3 p(u(rng), u(rng), u(rng));
+    int32_t scan = -1;
+    for (size_t e = 0; e < b.mesh.tets.size() && scan < 0; ++e)
+      if (locator.weights(int32_t(e), p).minCoeff() >= -1e-9) scan = int32_t(e);
+    Weights w;
+    const int32_t found = locator.locate(p, 1e-9, w);
+    assert_int_equal(found >= 0, scan >= 0);
+    if (found < 0) continue;
+    ++inside;
+    assert_true(w.minCoeff() >= -1e-9);
+    assert_near(w.sum(), 1.0, 1e-12);
+    Vec3 q = Vec3::Zero();
+    for (int a = 0; a < 4; ++a) q += w[a] * b.mesh.nodes[size_t(b.mesh.tets[size_t(found)][size_t(a)])];
+    assert_near((q - p).norm(), 0.0, 1e-15);
+  }
+  assert_true(inside > 400);
+}
+
+static void test_rest_places_every_bound_vertex_where_it_was(void**) {
+  const Box b = box();
+  const Mesh m = render_mesh(b);
+  const Embedding e = embed(b, m);
+  const std::vector<int32_t>& kinds = e.kinds();
+  for (int32_t i = 0; i < m.inside; ++i) assert_int_equal(kinds[size_t(i)], int32_t(VertexKind::Inside));
+  for (int32_t i = m.inside; i < m.inside + m.near; ++i) assert_int_equal(kinds[size_t(i)], int32_t(VertexKind::Projected));
+  for (int32_t i = m.inside + m.near; i < m.count(); ++i) assert_int_equal(kinds[size_t(i)], int32_t(VertexKind::Unbound));
+  assert_int_equal(e.count(VertexKind::Inside), m.inside);
+  assert_int_equal(e.count(VertexKind::Projected), m.near);
+  assert_int_equal(e.count(VertexKind::Unbound), m.far);
+
+  std::vector<double> out(m.xyz.size(), 42.0);  // unbound vertices keep this
+  e.update(b.mesh.nodes, out.data(), nullptr);
+  for (int32_t i = 0; i < m.count(); ++i) {
+    const Vec3 p(out[3 * size_t(i)], out[3 * size_t(i) + 1], out[3 * size_t(i) + 2]);
+    if (kinds[size_t(i)] == int32_t(VertexKind::Unbound))
+      assert_true(p == Vec3::Constant(42.0));
+    else if ((p - m.vertex(i)).norm() > 1e-12)
+      fail_msg("vertex %d (kind %d) is %.3g m from where it was", i, kinds[size_t(i)], (p - m.vertex(i)).norm());
+  }
+}
+
+static void test_rigid_motion_moves_the_mesh_rigidly(void**) {
+  const Box b = box();
+  const Mesh m = render_mesh(b);
+  const Embedding e = embed(b, m);
+  const Mat3 R = Eigen::AngleAxisd(0.7, Vec3(1, 2, -0.5).normalized()).toRotationMatrix();
+  const Vec3 t(0.3, -0.2, 0.15);
+  Vec3List x = b.mesh.nodes;
+  for (Vec3& p : x) p = R * p + t;
+  std::vector<double> out = m.xyz, normals(m.xyz.size());
+  std::vector<double> rest_normals(m.xyz.size());
+  vertex_normals(m.xyz.data(), m.count(), m.triangles.data(), int32_t(m.triangles.size() / 3), rest_normals.data());
+  e.update(x, out.data(), normals.data());
+  for (int32_t i = 0; i < m.inside + m.near; ++i) {
+    const Vec3 p(out[3 * size_t(i)], out[3 * size_t(i) + 1], out[3 * size_t(i) + 2]);
+    assert_near((p - (R * m.vertex(i) + t)).norm(), 0.0, 1e-12);
+    const Vec3 n(normals[3 * size_t(i)], normals[3 * size_t(i) + 1], normals[3 * size_t(i) + 2]);
+    const Vec3 n0(rest_normals[3 * size_t(i)], rest_normals[3 * size_t(i) + 1], rest_normals[3 * size_t(i) + 2]);
+    assert_near((n - R * n0).norm(), 0.0, 1e-9);
+  }
+}
+
+static void test_normals_are_those_of_the_moved_triangles(void**) {
+  const Box b = box();
+  const Mesh m = render_mesh(b);
+  const Embedding e = embed(b, m);
+  // A bend: not an affine map, so each tet moves its own way.
+  Vec3List x = b.mesh.nodes;
+  for (Vec3& p : x) p += Vec3(0, 0.3 * p.x() * p.x() + 0.1 * p.z() * p.x(), 0.2 * p.y() * p.x());
+  std::vector<double> out = m.xyz, normals(m.xyz.size());
+  e.update(x, out.data(), normals.data());
+  const Vec3List expected = reference_normals(out, m.triangles);
+  const int32_t surface_vertices = int32_t(m.inside - 500);
+  for (int32_t i = 0; i < surface_vertices; ++i) {
+    const Vec3 n(normals[3 * size_t(i)], normals[3 * size_t(i) + 1], normals[3 * size_t(i) + 2]);
+    assert_near(n.norm(), 1.0, 1e-12);
+    assert_le(angle_degrees(n, expected[size_t(i)]), 1e-6);
+  }
+  for (int32_t i = surface_vertices; i < m.count(); ++i)  // in no triangle
+    assert_true(Vec3(normals[3 * size_t(i)], normals[3 * size_t(i) + 1], normals[3 * size_t(i) + 2]) == Vec3::Zero());
+}
+
+static void test_update_allocates_nothing(void**) {
+  const Box b = box();
+  const Mesh m = render_mesh(b);
+  const Embedding e = embed(b, m);
+  std::vector<double> out = m.xyz, normals(m.xyz.size());
+  mica_test::start_counting_allocations();
+  e.update(b.mesh.nodes, out.data(), normals.data());
+  assert_int_equal(mica_test::stop_counting_allocations(), 0);
+}
+
+static void test_bad_input_is_refused_by_name(void**) {
+  const Box b = box();
+  Mesh m = render_mesh(b);
+  auto refused = [&](Errc code, const char* phrase, double radius) {
+    try {
+      embed(b, m, radius);
+    } catch (const Error& error) {
+      assert_int_equal(int(error.code()), int(code));
+      if (!std::strstr(error.what(), phrase)) fail_msg("'%s' does not say '%s'", error.what(), phrase);
+      return;
+    }
+    fail_msg("not refused: %s", phrase);
+  };
+  m.xyz[3 * 17 + 1] = std::nan("");
+  refused(Errc::InvalidArgument, "vertex 17 is not finite (y = nan)", 0.001);
+  m.xyz[3 * 17 + 1] = 0.01;
+  m.triangles[3 * 4 + 2] = m.count();
+  refused(Errc::OutOfRange, "triangle 4 refers to vertex", 0.001);
+  m.triangles[3 * 4 + 2] = 0;
+  refused(Errc::InvalidArgument, "radius is -1 m", -1);
+  refused(Errc::InvalidArgument, "radius is inf m", HUGE_VAL);
+}
+
+static void test_update_refuses_another_node_count(void**) {
+  const Box b = box();
+  const Mesh m = render_mesh(b);
+  const Embedding e = embed(b, m);
+  Vec3List x = b.mesh.nodes;
+  x.pop_back();
+  std::vector<double> out(m.xyz.size());
+  try {
+    e.update(x, out.data(), nullptr);
+  } catch (const Error& error) {
+    assert_int_equal(int(error.code()), int(Errc::WrongState));
+    return;
+  }
+  fail_msg("a shorter node array was taken");
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_grid_finds_the_tet_a_scan_finds),
+      cmocka_unit_test(test_rest_places_every_bound_vertex_where_it_was),
+      cmocka_unit_test(test_rigid_motion_moves_the_mesh_rigidly),
+      cmocka_unit_test(test_normals_are_those_of_the_moved_triangles),
+      cmocka_unit_test(test_update_allocates_nothing),
+      cmocka_unit_test(test_bad_input_is_refused_by_name),
+      cmocka_unit_test(test_update_refuses_another_node_count),
+  };
+  return cmocka_run_group_tests(tests, nullptr, nullptr);
+}
