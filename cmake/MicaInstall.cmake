@@ -75,6 +75,13 @@ foreach(_dir LIBDIR INCLUDEDIR)
     set(MICA_PC_${_dir} "\${prefix}/${CMAKE_INSTALL_${_dir}}")
   endif()
 endforeach()
+# What a static link needs besides libmica, named only when libmica.a is installed: pkg-config
+# resolves Requires.private for --cflags too, so naming libccd would make every consumer of the
+# shared library install libccd's development files.
+set(MICA_PC_PRIVATE "")
+if(MICA_INSTALL_STATIC)
+  set(MICA_PC_PRIVATE "Requires.private: ccd\nLibs.private: -lcholmod -lsuitesparseconfig -lstdc++ -lm -ldl -lpthread")
+endif()
 set(MICA_PC_PREFIX "@MICA_PC_PREFIX@")  # survives this pass, replaced at install time
 configure_file(${PROJECT_SOURCE_DIR}/pkgconfig/mica.pc.in
                ${PROJECT_BINARY_DIR}/pkgconfig/mica.pc.stage @ONLY)
