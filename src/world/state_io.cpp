@@ -325,7 +325,8 @@ void World::restore_state(const uint8_t* data, size_t size) {
   in.get_vector(overlapping, "the overlapping bodies");
   // What the contacts readout dereferences must be in range.
   const size_t nr = rows.direction.size();
-  require(rows.start.size() == nr + 1 && rows.bias.size() == nr && rows.normal_of.size() == nr && rows.mu.size() == nr &&
+  // Before the first step the rows have no start offsets at all.
+  require((rows.start.size() == nr + 1 || (nr == 0 && rows.start.empty())) && rows.bias.size() == nr && rows.normal_of.size() == nr && rows.mu.size() == nr &&
               rows.contact.size() == nr && rows.key.size() == nr && lambda.size() == nr,
           "the contact rows disagree in length");
   require(curvature_impulse.size() == contacts.size(), "the contacts disagree in length");
