@@ -72,6 +72,9 @@ class DirectSolver : public LinearSolver {
   // with OpenBLAS on bodies of a few thousand nodes (docs/architecture.md).
   // Eigen's wrapper, opened to cholmod_solve2 (its factor is a protected member).
   struct Factor : Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> {
+    // CHOLMOD prints its warnings ("matrix not positive definite") on the host's stdout: quiet,
+    // since factorize() reports the failure as an error.
+    Factor() { cholmod().print = 0; }
     cholmod_factor* factor() const { return m_cholmodFactor; }
     // analyzePattern with this fill-reducing permutation (CHOLMOD_GIVEN; postordered after).
     void analyze_given(const Eigen::SparseMatrix<double>& lower, std::vector<int>& perm);

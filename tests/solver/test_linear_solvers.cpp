@@ -2,7 +2,12 @@
 // The linear solvers of one body's projected system (S A S + I - S) y = S (b - A z), v = y + z:
 // CHOLMOD (DirectSolver) against a dense Cholesky of the same matrix (also as the nodes held still
 // change, which the factor leaves out), and projected PCG
-// (PcgSolver) against CHOLMOD, for solve and solve_homogeneous; PCG stops at its deadline.
+// (PcgSolver) against CHOLMOD, for solve and solve_homogeneous; PCG stops at its deadline. A matrix
+// that is not positive definite is an error, and CHOLMOD prints nothing about it.
+#include <cstdio>
+
+#include <unistd.h>
+
 #include "solver/direct_solver.hpp"  // before cmocka (test_util.hpp)
 #include "solver/pcg.hpp"
 #include "solver/solver_problem.hpp"
@@ -86,6 +91,44 @@ static void test_direct_follows_the_held_nodes(void**) {
   assert_true(nonzeros[2] == nonzeros[0]);  // a sliding node keeps its couplings
 }
 
+// Not positive definite (A negated): Errc::Numerical, and nothing on stdout or stderr (a library
+// does not write to its host's streams; CHOLMOD prints its warnings unless told not to).
+static void test_direct_indefinite_is_silent(void**) {
+  SolverProblem p(0, 2, false);
+  for (Mat3& block : p.A) block = -block;
+  const ProjectedSystem sys{p.fem.pattern, p.A, p.projection};
+  DirectSolver direct;
+  direct.analyze(p.fem.pattern);
+  std::fflush(stdout);
+  std::fflush(stderr);
+  FILE* captured = std::tmpfile();
+  assert_non_null(captured);
+  const int out = dup(1), err = dup(2);
+  dup2(fileno(captured), 1);
+  dup2(fileno(captured), 2);
+  bool numerical = false;
+  try {
+    direct.factorize(sys);
+  } catch (const Error& e) {
+    numerical = e.code() == Errc::Numerical;
+  }
+  std::fflush(stdout);
+  std::fflush(stderr);
+  dup2(out, 1);
+  dup2(err, 2);
+  close(out);
+  close(err);
+  std::fseek(captured, 0, SEEK_END);
+  const long written = std::ftell(captured);
+  std::rewind(captured);
+  char text[256] = {0};
+  const size_t read = std::fread(text, 1, sizeof text - 1, captured);
+  (void)read;  // what was written, for the message
+  std::fclose(captured);
+  if (written != 0) fail_msg("the failed factorization wrote %ld bytes to stdout or stderr: %s", written, text);
+  assert_true(numerical);
+}
+
 static void test_pcg_matches_direct(void**) {
   SolverProblem p(0, 3, false);
   const ProjectedSystem sys{p.fem.pattern, p.A, p.projection};
@@ -122,6 +165,7 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_direct_matches_dense),
       cmocka_unit_test(test_direct_follows_the_held_nodes),
+      cmocka_unit_test(test_direct_indefinite_is_silent),
       cmocka_unit_test(test_pcg_matches_direct),
       cmocka_unit_test(test_pcg_stops_at_its_deadline),
   };
