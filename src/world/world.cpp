@@ -124,6 +124,9 @@ int64_t World::factorizations(Id id) const { return solver_->factorizations(body
 
 void World::set_node_forces(Id id, const std::vector<int32_t>& nodes, const Vec3List& forces) {
   Body& b = body(id);
+  if (nodes.size() != forces.size())  // the C API passes one count for both; a corrupt recording may not
+    fail(Errc::InvalidArgument, b.name + ": " + std::to_string(nodes.size()) + " node indices and " +
+                                    std::to_string(forces.size()) + " forces");
   for (size_t k = 0; k < nodes.size(); ++k) {
     if (nodes[k] < 0 || nodes[k] >= b.fem.node_count())
       fail(Errc::OutOfRange, b.name + ": node index " + std::to_string(nodes[k]) + " at position " +
