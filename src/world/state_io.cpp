@@ -20,6 +20,7 @@
 // Not saved, because they do not change a later step: timings aside from the counters, the per-step
 // work arrays, and a linear body's assembled matrix (reassembled: the same bits).
 #include <algorithm>
+#include <cstddef>
 #include <cstring>
 
 #include "core/byte_stream.hpp"
@@ -299,7 +300,13 @@ void World::restore_state(const uint8_t* data, size_t size) {
   if (!difference.empty()) fail(Errc::InvalidArgument, difference);
 
   // The world.
-  const WorldStats stats = in.get<WorldStats>("the statistics");
+  // The statistics' flags are bools: checked as bytes first (a bool holding 2 is undefined behaviour).
+  uint8_t raw[sizeof(WorldStats)];
+  in.get_bytes(raw, sizeof raw, "the statistics");
+  require(raw[offsetof(WorldStats, converged)] <= 1 && raw[offsetof(WorldStats, out_of_time)] <= 1,
+          "the statistics' flags are not 0 or 1");
+  WorldStats stats;
+  std::memcpy(static_cast<void*>(&stats), raw, sizeof raw);
   const decltype(debt_) debt = in.get<decltype(debt_)>("the energy debt");
   std::vector<std::pair<uint64_t, double>> warm;
   in.get_vector(warm, "the warm-start impulses");
