@@ -9,8 +9,8 @@
 // Oracles (a failure aborts: libFuzzer saves the input):
 //  - no sanitizer report; the status is a documented one, not MICA_ERR_INTERNAL, with a message;
 //  - a failed restore leaves the world exactly as it was: its saved state is the same bytes;
-//  - after a restore that succeeded, the world reads (contacts, positions, forces, reactions),
-//    steps (any documented status) and saves.
+//  - after a restore that succeeded, the world reads (contacts, positions, forces, reactions,
+//    statistics), steps (any documented status) and saves.
 //
 // Built with fuzz_files.cpp. Seeds: fuzz/corpus/state, written by the build without libFuzzer
 // (tests/: fuzz_state_replay --write-seeds fuzz/corpus/state), which also runs them with fixed
@@ -54,6 +54,9 @@ void read_world(const mica_fuzz::Scene& s) {
   mica_fuzz::require_ok(w, mica_tool_get_force(w, s.sphere, f, nullptr, nullptr), "mica_tool_get_force");
   mica_fuzz::require_ok(w, mica_lpc_get_reaction(w, s.grab, f), "mica_lpc_get_reaction");
   mica_fuzz::require_ok(w, mica_device_poll(w, s.device, nullptr, f), "mica_device_poll");
+  mica_world_stats stats{};
+  stats.struct_size = sizeof stats;
+  mica_fuzz::require_ok(w, mica_world_get_stats(w, &stats), "mica_world_get_stats");
 }
 
 }  // namespace
