@@ -85,6 +85,36 @@ void press(const Scene& s, int steps) {
   }
 }
 
+void read_world(mica_world* w) {
+  std::uint64_t ids[64];
+  for (int32_t kind : {MICA_OBJECT_BODY, MICA_OBJECT_TOOL, MICA_OBJECT_LPC, MICA_OBJECT_DEVICE}) {
+    int32_t count = 0;
+    require_ok(w, mica_world_get_ids(w, kind, ids, 64, &count), "mica_world_get_ids");
+    for (int32_t k = 0; k < count; ++k) {
+      double f[3];
+      int32_t nodes = 0;
+      if (kind == MICA_OBJECT_BODY) {
+        require_ok(w, mica_body_get_counts(w, ids[k], &nodes, nullptr, nullptr), "mica_body_get_counts");
+        std::vector<double> x(3 * size_t(nodes));
+        require_ok(w, mica_body_get_positions(w, ids[k], x.data(), nodes, &nodes), "mica_body_get_positions");
+        check_status(w, mica_body_get_velocities(w, ids[k], x.data(), nodes, &nodes), "mica_body_get_velocities");
+      }
+      if (kind == MICA_OBJECT_TOOL) require_ok(w, mica_tool_get_force(w, ids[k], f, nullptr, nullptr), "mica_tool_get_force");
+      if (kind == MICA_OBJECT_LPC) require_ok(w, mica_lpc_get_reaction(w, ids[k], f), "mica_lpc_get_reaction");
+      if (kind == MICA_OBJECT_DEVICE) check_status(w, mica_device_poll(w, ids[k], nullptr, f), "mica_device_poll");
+    }
+  }
+  int32_t count = 0;
+  const mica_status s = mica_world_get_contacts(w, nullptr, 0, &count);
+  if (s != MICA_ERR_BUFFER_TOO_SMALL) require_ok(w, s, "mica_world_get_contacts");
+  std::vector<mica_contact> contacts(size_t(count) + 1);
+  contacts[0].struct_size = sizeof(mica_contact);
+  require_ok(w, mica_world_get_contacts(w, contacts.data(), count + 1, &count), "mica_world_get_contacts");
+  mica_world_stats stats{};
+  stats.struct_size = sizeof stats;
+  require_ok(w, mica_world_get_stats(w, &stats), "mica_world_get_stats");
+}
+
 bool write_file(const std::string& path, const Bytes& bytes) {
   std::FILE* f = std::fopen(path.c_str(), "wb");
   if (!f) return false;

@@ -52,6 +52,11 @@ Scene build_scene(mica_world* w);
 // lifted; the device polled four times before each.
 void press(const Scene& s, int steps);
 
+// Reads what a host reads of a world it did not build (mica_replay does): each object by its
+// ids, the contacts, the statistics. Every call must succeed, but a body's velocities (a static
+// body has none) and a device's poll (it may fail) must only return documented statuses.
+void read_world(mica_world* w);
+
 bool write_file(const std::string& path, const Bytes& bytes);
 bool read_file(const std::string& path, Bytes& bytes);
 

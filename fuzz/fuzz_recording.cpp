@@ -101,33 +101,6 @@ const std::string& scratch_file() {
   return path;
 }
 
-// Everything a program reading a replayed world reads (mica_replay does).
-void read_world(mica_world* w) {
-  std::uint64_t ids[64];
-  for (int32_t kind : {MICA_OBJECT_BODY, MICA_OBJECT_TOOL, MICA_OBJECT_LPC, MICA_OBJECT_DEVICE}) {
-    int32_t count = 0;
-    mica_fuzz::require_ok(w, mica_world_get_ids(w, kind, ids, 64, &count), "mica_world_get_ids");
-    for (int32_t k = 0; k < count; ++k) {
-      double f[3];
-      int32_t nodes = 0;
-      if (kind == MICA_OBJECT_BODY) {
-        mica_fuzz::require_ok(w, mica_body_get_counts(w, ids[k], &nodes, nullptr, nullptr), "mica_body_get_counts");
-        std::vector<double> x(3 * size_t(nodes));
-        mica_fuzz::require_ok(w, mica_body_get_positions(w, ids[k], x.data(), nodes, &nodes), "mica_body_get_positions");
-      }
-      if (kind == MICA_OBJECT_TOOL)
-        mica_fuzz::require_ok(w, mica_tool_get_force(w, ids[k], f, nullptr, nullptr), "mica_tool_get_force");
-      if (kind == MICA_OBJECT_LPC) mica_fuzz::require_ok(w, mica_lpc_get_reaction(w, ids[k], f), "mica_lpc_get_reaction");
-    }
-  }
-  int32_t contacts = 0;
-  const mica_status s = mica_world_get_contacts(w, nullptr, 0, &contacts);
-  if (s != MICA_ERR_BUFFER_TOO_SMALL) mica_fuzz::require_ok(w, s, "mica_world_get_contacts");
-  mica_world_stats stats{};
-  stats.struct_size = sizeof stats;
-  mica_fuzz::require_ok(w, mica_world_get_stats(w, &stats), "mica_world_get_stats");
-}
-
 }  // namespace
 
 namespace mica_fuzz::file_target {
@@ -160,7 +133,7 @@ bool run(const std::uint8_t* data, size_t size) {
     }
     if (status == MICA_ERR_PARSE || (status >= 0 && !stepped)) break;  // a corrupt entry, or the end
   }
-  read_world(w);
+  mica_fuzz::read_world(w);
   mica_replay_close(replay);
   return status >= 0;
 }

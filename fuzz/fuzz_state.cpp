@@ -39,26 +39,6 @@ Bytes save(mica_world* w) {
   return state;
 }
 
-// Everything a host reads after a restore.
-void read_world(const mica_fuzz::Scene& s) {
-  mica_world* w = s.world;
-  int32_t count = 0;
-  const mica_status contacts = mica_world_get_contacts(w, nullptr, 0, &count);
-  if (contacts != MICA_OK && contacts != MICA_ERR_BUFFER_TOO_SMALL) mica_fuzz::check_status(w, contacts, "contacts");
-  std::vector<mica_contact> out(size_t(count) + 1);
-  out[0].struct_size = sizeof(mica_contact);
-  mica_fuzz::require_ok(w, mica_world_get_contacts(w, out.data(), count + 1, &count), "mica_world_get_contacts");
-  double x[8 * 3], f[3];
-  mica_fuzz::require_ok(w, mica_body_get_positions(w, s.body, x, 8, &count), "mica_body_get_positions");
-  mica_fuzz::require_ok(w, mica_body_get_velocities(w, s.body, x, 8, &count), "mica_body_get_velocities");
-  mica_fuzz::require_ok(w, mica_tool_get_force(w, s.sphere, f, nullptr, nullptr), "mica_tool_get_force");
-  mica_fuzz::require_ok(w, mica_lpc_get_reaction(w, s.grab, f), "mica_lpc_get_reaction");
-  mica_fuzz::require_ok(w, mica_device_poll(w, s.device, nullptr, f), "mica_device_poll");
-  mica_world_stats stats{};
-  stats.struct_size = sizeof stats;
-  mica_fuzz::require_ok(w, mica_world_get_stats(w, &stats), "mica_world_get_stats");
-}
-
 }  // namespace
 
 namespace mica_fuzz::file_target {
@@ -81,7 +61,7 @@ bool run(const std::uint8_t* data, size_t size) {
     if (save(s.world) != before)
       mica_fuzz::bug(std::string("a failed restore changed the world: ") + mica_world_last_error(s.world));
   } else {
-    read_world(s);
+    mica_fuzz::read_world(s.world);
     mica_fuzz::check_status(s.world, mica_step(s.world, 0.01), "mica_step after a restore");
     save(s.world);
   }
