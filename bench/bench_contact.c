@@ -48,6 +48,7 @@
 #include <mica/mica.h>
 
 #include "bench_common.h"
+#include "cli.h"
 #include "press_scene.h"
 
 static int trace = 0;             /* --trace: one line per step */
@@ -190,32 +191,49 @@ static int in_list(const char* list, double v) {
   return 0;
 }
 
-static void usage(FILE* out) {
-  fprintf(out,
-          "usage: bench_contact [--quick | --full] [--gauss-seidel] [--no-nidus] [--csv FILE] [--tol T]\n"
-          "                     [--cells LIST] [--dt LIST] [--shape NAME] [--trace] [--run-limit S] [--nidus-only] [--solver NAME]\n"
-          "  a tool pressed 10 mm into a 10 cm cube at constant speed over 1 s and held 1 s; per run:\n"
-          "  the end force, the longest run of alternating step-to-step changes in the hold, the largest\n"
-          "  relative change after 0.5 s of hold, the largest relative drop while loading, ms per step\n"
-          "  (default) cells 8 x dt 1, 5, 10, 20 ms, cells 12 at dt 10, 20 ms, + the nidus (~10 min)\n"
-          "  --full          cells 8, 12, 16 x dt 1, 5, 10, 20 ms, + the nidus (hours)\n"
-          "  --quick         cells 12, dt 10 ms (no nidus)\n"
-          "  --gauss-seidel  also MICA with the paper's Gauss-Seidel sweep (slow)\n"
-          "  --no-nidus      skip the nidus case\n"
-          "  --csv FILE      also write the rows to FILE\n"
-          "  --tol T         MICA tolerance (default 1e-8; cap 20000)\n"
-          "  --cells LIST    only these cells per side (comma list, e.g. 8,16), from 8, 12, 16\n"
-          "  --dt LIST       only these time steps in ms (comma list), from 1, 5, 10, 20\n"
-          "                  (with --cells or --dt, the grid is every combination of the two lists)\n"
-          "  --shape NAME    only this tool: sphere, capsule, box or hull\n"
-          "  --trace         print every step (depth, force, change, contacts, iterations)\n"
-          "  --run-limit S   give up a run after S s of wall time (default 120): a TIMEOUT row\n"
-          "  --nidus-only    only the nidus case\n"
-          "  --solver NAME   only this solver: exact, MICA-F or MICA-GS (with --gauss-seidel)\n"
-          "  every tool (sphere, capsule, box, hull), exact (DIRECT) and MICA factored\n");
+static const char kUsage[] =
+    "usage: bench_contact [--quick | --full] [--gauss-seidel] [--no-nidus] [--csv FILE] [--tol T]\n"
+    "                     [--cells LIST] [--dt LIST] [--shape NAME] [--trace] [--run-limit S] [--nidus-only] [--solver NAME]\n"
+    "  a tool pressed 10 mm into a 10 cm cube at constant speed over 1 s and held 1 s; per run:\n"
+    "  the end force, the longest run of alternating step-to-step changes in the hold, the largest\n"
+    "  relative change after 0.5 s of hold, the largest relative drop while loading, ms per step\n"
+    "  (default) cells 8 x dt 1, 5, 10, 20 ms, cells 12 at dt 10, 20 ms, + the nidus (~10 min)\n"
+    "  --full          cells 8, 12, 16 x dt 1, 5, 10, 20 ms, + the nidus (hours)\n"
+    "  --quick         cells 12, dt 10 ms (no nidus)\n"
+    "  --gauss-seidel  also MICA with the paper's Gauss-Seidel sweep (slow)\n"
+    "  --no-nidus      skip the nidus case\n"
+    "  --csv FILE      also write the rows to FILE (its folder is made if missing)\n"
+    "  --tol T         MICA tolerance (default 1e-8; cap 20000)\n"
+    "  --cells LIST    only these cells per side (comma list, e.g. 8,16), from 8, 12, 16\n"
+    "  --dt LIST       only these time steps in ms (comma list), from 1, 5, 10, 20\n"
+    "                  (with --cells or --dt, the grid is every combination of the two lists)\n"
+    "  --shape NAME    only this tool: sphere, capsule, box or hull\n"
+    "  --trace         print every step (depth, force, change, contacts, iterations)\n"
+    "  --run-limit S   give up a run after S s of wall time (default 120): a TIMEOUT row\n"
+    "  --nidus-only    only the nidus case\n"
+    "  --solver NAME   only this solver: exact, MICA-F or MICA-GS (with --gauss-seidel)\n"
+    "  every tool (sphere, capsule, box, hull), exact (DIRECT) and MICA factored\n"
+    "  --help          this text\n";
+
+/* Whether each item of the comma-separated `list` is a number (cli_double says which is not). */
+static int check_list(const char* program, const char* what, const char* list) {
+  char item[64];
+  for (const char* p = list;; ++p) {
+    const size_t n = strcspn(p, ",");
+    snprintf(item, sizeof item, "%.*s", (int)n, p);
+    double unused;
+    if (!cli_double(program, what, item, 0, 1e6, &unused)) return 0;
+    p += n;
+    if (!*p) return 1;
+  }
 }
 
 int main(int argc, char** argv) {
+  static const char* const options[] = {"--quick",     "--full",      "--gauss-seidel", "--no-nidus",   "--csv FILE",
+                                        "--tol T",     "--cells LIST", "--dt LIST",     "--shape NAME", "--trace",
+                                        "--run-limit S", "--nidus-only", "--solver NAME", NULL};
+  const int cli = cli_check(argc, argv, kUsage, options);
+  if (cli >= 0) return cli;
   int quick = 0, full = 0, gs = 0, nidus = 1, nidus_only = 0;
   const char* csv_path = NULL;
   const char* only_cells = NULL; /* comma lists: keep only these cells / dt (ms) */
@@ -223,33 +241,32 @@ int main(int argc, char** argv) {
   const char* only_shape = NULL; /* one tool */
   const char* only_solver = NULL; /* one solver */
   double tol = 1e-8;
-  for (int i = 1; i < argc; ++i) {
+  int ok = 1;
+  for (int i = 1; i < argc && ok; ++i) { /* cli_check saw that each option with a value has one */
     if (strcmp(argv[i], "--quick") == 0) quick = 1;
     else if (strcmp(argv[i], "--full") == 0) full = 1;
     else if (strcmp(argv[i], "--gauss-seidel") == 0) gs = 1;
     else if (strcmp(argv[i], "--no-nidus") == 0) nidus = 0;
-    else if (strcmp(argv[i], "--csv") == 0 && i + 1 < argc) csv_path = argv[++i];
-    else if (strcmp(argv[i], "--tol") == 0 && i + 1 < argc) tol = atof(argv[++i]);
-    else if (strcmp(argv[i], "--cells") == 0 && i + 1 < argc) only_cells = argv[++i];
-    else if (strcmp(argv[i], "--dt") == 0 && i + 1 < argc) only_dt = argv[++i];
-    else if (strcmp(argv[i], "--shape") == 0 && i + 1 < argc) only_shape = argv[++i];
+    else if (strcmp(argv[i], "--csv") == 0) csv_path = argv[++i];
+    else if (strcmp(argv[i], "--tol") == 0) ok = cli_double(argv[0], "--tol", argv[++i], 1e-15, 1, &tol);
+    else if (strcmp(argv[i], "--cells") == 0) ok = check_list(argv[0], "--cells", only_cells = argv[++i]);
+    else if (strcmp(argv[i], "--dt") == 0) ok = check_list(argv[0], "--dt", only_dt = argv[++i]);
+    else if (strcmp(argv[i], "--shape") == 0) only_shape = argv[++i];
     else if (strcmp(argv[i], "--trace") == 0) trace = 1;
-    else if (strcmp(argv[i], "--run-limit") == 0 && i + 1 < argc) run_limit_s = atof(argv[++i]);
+    else if (strcmp(argv[i], "--run-limit") == 0) ok = cli_double(argv[0], "--run-limit", argv[++i], 0.1, 86400, &run_limit_s);
     else if (strcmp(argv[i], "--nidus-only") == 0) nidus_only = 1;
-    else if (strcmp(argv[i], "--solver") == 0 && i + 1 < argc) only_solver = argv[++i];
-    else if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
-      usage(stdout);
-      return 0;
-    } else {
-      fprintf(stderr, "%s: unknown option, or an option without its value: %s\n\n", argv[0], argv[i]);
-      usage(stderr);
-      return 2;
+    else if (strcmp(argv[i], "--solver") == 0) only_solver = argv[++i];
+    else {
+      fprintf(stderr, "%s: %s: this program takes options only (--help lists them)\n", argv[0], argv[i]);
+      ok = 0;
     }
   }
-  if ((quick && full) || !(tol > 0)) {
-    usage(stderr);
-    return 2;
+  if (ok && quick && full) {
+    fprintf(stderr, "%s: --quick and --full exclude each other\n", argv[0]);
+    ok = 0;
   }
+  if (!ok) return 2;
+  if (csv_path && !cli_make_parent(argv[0], csv_path)) return 1;
   if (quick && !nidus_only) nidus = 0;
   if (nidus_only) nidus = 1;
 

@@ -83,11 +83,8 @@ int main(int argc, char** argv) {
   BodySettings bs;
   bs.material = {1e4, 0.4, 1000};
   bs.rayleigh_alpha = 2;
-  const int cube = path.rfind("cube:", 0) == 0 ? std::atoi(path.c_str() + 5) : 0;
-  if (path.rfind("cube:", 0) == 0 && (cube < 1 || cube > 60)) {
-    std::fprintf(stderr, "bench_factor: %s: cube:N takes N from 1 to 60\n", path.c_str());
-    return 2;
-  }
+  int cube = 0;
+  if (path.rfind("cube:", 0) == 0 && !cli_int(argv[0], "cube:N", path.c_str() + 5, 1, 60, &cube)) return 2;
   const TetMesh mesh = cube ? make_box_grid(Vec3(0, 0, 0), Vec3(0.1, 0.1, 0.1), {cube, cube, cube}, 6) : load_mesh(path);
   const Id id = world.add_body(mesh, bs, Vec3::Zero(), Vec3::Zero());
   world.step(0.01);  // assembles A

@@ -411,32 +411,36 @@ static const char kUsage[] =
 int main(int argc, char** argv) {
   const int cli = cli_check(argc, argv, kUsage, kOptions);
   if (cli >= 0) return cli;
-  if (argc > 1 && strcmp(argv[1], "--defaults") == 0)
-    return defaults(argc > 2 ? argv[2] : "data/nidus/nidus.msh", argc > 3 ? atoi(argv[3]) : 110);
+  if (argc > 1 && strcmp(argv[1], "--defaults") == 0) {
+    int steps = 110;
+    if (argc > 3 && !cli_int(argv[0], "steps", argv[3], 1, 1000000, &steps)) return 2;
+    return defaults(argc > 2 ? argv[2] : "data/nidus/nidus.msh", steps);
+  }
   if (argc > 1 && strcmp(argv[1], "--scaling") == 0) {
     if (argc < 3) {
       fprintf(stderr, "usage: bench_nidus --scaling <out.csv> [max-tets] [factored|gauss-seidel]\n");
       return 2;
     }
+    int max_tets = 110000;
+    if (argc > 3 && !cli_int(argv[0], "max-tets", argv[3], 1, 100000000, &max_tets)) return 2;
     const int32_t sweep = argc > 4 && strcmp(argv[4], "gauss-seidel") == 0 ? MICA_SWEEP_GAUSS_SEIDEL : MICA_SWEEP_FACTORED;
-    return scaling(argv[2], argc > 3 ? atoi(argv[3]) : 110000, sweep);
+    if (!cli_make_parent(argv[0], argv[2])) return 1;
+    return scaling(argv[2], max_tets, sweep);
   }
   const char* path = argc > 1 ? argv[1] : "data/nidus/nidus.msh";
-  const double tol = argc > 2 ? atof(argv[2]) : 1e-6;
-  const int steps = argc > 3 ? atoi(argv[3]) : 200;
-  const int warmup = argc > 4 ? atoi(argv[4]) : 40;
-  const double E = argc > 5 ? atof(argv[5]) : 1e4;
-  const double dt = argc > 6 ? atof(argv[6]) : 0.01;
-  const int gs_steps = argc > 7 ? atoi(argv[7]) : 30;
+  double tol = 1e-6, E = 1e4, dt = 0.01;
   /* Every 6 steps: a nidus factorization and its copy take about 22 ms on the second core, more
    * than four 5 ms steps (with 4 the adopting steps wait for it). */
-  const int refactor = argc > 8 ? atoi(argv[8]) : 6;
-  const int linear = argc > 9 && strcmp(argv[9], "linear") == 0;
-  if (!(tol > 0) || steps < 1 || warmup < 2 || !(E > 0) || !(dt > 0) || gs_steps < 0 || refactor < 0) {
-    fprintf(stderr, "usage: bench_nidus [mesh] [tolerance] [steps] [warm-up >= 2] [E] [dt] [gauss-seidel steps] "
-                    "[refactor interval] [linear]\n");
+  int steps = 200, warmup = 40, gs_steps = 30, refactor = 6;
+  if ((argc > 2 && !cli_double(argv[0], "tolerance", argv[2], 1e-15, 1, &tol)) ||
+      (argc > 3 && !cli_int(argv[0], "steps", argv[3], 1, 1000000, &steps)) ||
+      (argc > 4 && !cli_int(argv[0], "warm-up", argv[4], 2, 1000000, &warmup)) ||
+      (argc > 5 && !cli_double(argv[0], "E", argv[5], 1, 1e12, &E)) ||
+      (argc > 6 && !cli_double(argv[0], "dt", argv[6], 1e-6, 1, &dt)) ||
+      (argc > 7 && !cli_int(argv[0], "gauss-seidel steps", argv[7], 0, 1000000, &gs_steps)) ||
+      (argc > 8 && !cli_int(argv[0], "refactor interval", argv[8], 0, 1000000, &refactor)))
     return 2;
-  }
+  const int linear = argc > 9 && strcmp(argv[9], "linear") == 0;
   printf("# command: OMP_THREAD_LIMIT=1 OPENBLAS_NUM_THREADS=1 build/bench/bench_nidus %s %g %d %d %g %g %d %d%s\n", path,
          tol, steps, warmup, E, dt, gs_steps, refactor, linear ? " linear" : "");
   /* The MICA sweeps on the same scene, one after the other in this process: the factored one

@@ -133,13 +133,12 @@ int main(int argc, char** argv) {
   const int cli = cli_check(argc, argv, kUsage, NULL);
   if (cli >= 0) return cli;
   const std::string csv_path = argc > 1 ? argv[1] : "out/scaling_threads.csv";
-  const int max_tets = argc > 2 ? std::atoi(argv[2]) : 110000;
-  const int32_t threads = argc > 3 ? std::atoi(argv[3]) : 2;
-  const int large_steps = argc > 4 ? std::atoi(argv[4]) : 4;
-  if (max_tets < 1 || threads < 2 || large_steps < 1) {
-    std::fprintf(stderr, "usage: bench_scaling [out.csv] [max-tets] [threads >= 2] [timed-steps-above-40k]\n");
+  int max_tets = 110000, threads = 2, large_steps = 4;
+  if ((argc > 2 && !cli_int(argv[0], "max-tets", argv[2], 1, 100000000, &max_tets)) ||
+      (argc > 3 && !cli_int(argv[0], "threads", argv[3], 2, 1024, &threads)) ||
+      (argc > 4 && !cli_int(argv[0], "timed-steps-above-40k", argv[4], 1, 1000000, &large_steps)))
     return 2;
-  }
+  if (!cli_make_parent(argv[0], csv_path.c_str())) return 1;
   FILE* csv = std::fopen(csv_path.c_str(), "w");
   if (!csv) {
     std::fprintf(stderr, "cannot write %s\n", csv_path.c_str());

@@ -74,13 +74,16 @@ static const char kUsage[] =
 int main(int argc, char** argv) {
   const int cli = cli_check(argc, argv, kUsage, NULL);
   if (cli >= 0) return cli;
-  const double seconds = argc > 1 ? atof(argv[1]) : 10.0;
+  double seconds = 10.0;
+  if (argc > 1 && !cli_double(argv[0], "seconds", argv[1], 0.1, 86400, &seconds)) return 2;
   const char* scene_arg = argc > 2 ? argv[2] : "12";
   /* "idle": the default cube built but never stepped: the machine's own floor for the servo loop. */
   const int idle = strcmp(scene_arg, "idle") == 0;
   const int use_mesh = !idle && strspn(scene_arg, "0123456789") != strlen(scene_arg);
-  const int32_t cells = use_mesh ? 0 : idle ? 12 : atoi(scene_arg);
-  const int32_t refactor = argc > 3 ? atoi(argv[3]) : 4;
+  int cells = use_mesh ? 0 : 12, refactor = 4;
+  if ((!use_mesh && !idle && !cli_int(argv[0], "cells-per-side", scene_arg, 2, 64, &cells)) ||
+      (argc > 3 && !cli_int(argv[0], "refactor interval", argv[3], 0, 1000000, &refactor)))
+    return 2;
   mica_world* world = NULL;
   mica_device_def dd = mica_device_def_default();
   dd.backend = MICA_DEVICE_SIMULATED;

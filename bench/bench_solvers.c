@@ -67,7 +67,8 @@ static const char kUsage[] =
 int main(int argc, char** argv) {
   const int cli = cli_check(argc, argv, kUsage, NULL);
   if (cli >= 0) return cli;
-  const int32_t cells = argc > 1 ? atoi(argv[1]) : 8;
+  int cells = 8;
+  if (argc > 1 && !cli_int(argv[0], "cells-per-side", argv[1], 2, 64, &cells)) return 2;
   struct {
     const char* name;
     int32_t solver;

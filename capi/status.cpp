@@ -25,6 +25,7 @@ mica_status to_status(mica::Errc code) {
     case mica::Errc::Device: return MICA_ERR_DEVICE;
     case mica::Errc::Internal: return MICA_ERR_INTERNAL;
     case mica::Errc::Diverged: return MICA_ERR_DIVERGED;
+    case mica::Errc::Truncated: return MICA_ERR_TRUNCATED;
   }
   return MICA_ERR_INTERNAL;
 }
@@ -72,6 +73,7 @@ MICA_API const char* mica_status_string(mica_status status) {
     case MICA_ERR_OUT_OF_MEMORY: return "MICA_ERR_OUT_OF_MEMORY: allocation failed";
     case MICA_ERR_INTERNAL: return "MICA_ERR_INTERNAL: internal error";
     case MICA_ERR_DIVERGED: return "MICA_ERR_DIVERGED: the replay did not reproduce its recording";
+    case MICA_ERR_TRUNCATED: return "MICA_ERR_TRUNCATED: the recording was cut short (no end entry)";
     default: return "unknown mica_status";
   }
 }

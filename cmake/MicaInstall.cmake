@@ -1,8 +1,9 @@
 # SPDX-License-Identifier: Apache-2.0
-# Install rules: libmica (shared, and static when built), the public headers, a CMake
-# package (find_package(mica) -> mica::mica, mica::mica_static), mica.pc, and the licence
-# (LICENSE, NOTICE), README and CHANGELOG under share/doc/libmica.
-# Included by the top-level CMakeLists once the targets mica and (optionally) mica_static exist.
+# Install rules: libmica (shared, and static when built), the program mica_replay, the public
+# headers, a CMake package (find_package(mica) -> mica::mica, mica::mica_static), mica.pc, and the
+# licence (LICENSE, NOTICE), README and CHANGELOG under share/doc/libmica.
+# Included by the top-level CMakeLists once the targets mica, mica_replay and (optionally)
+# mica_static exist.
 # The docs HTML (component docs) is installed from cmake/MicaDocs.cmake, next to its target.
 include(CMakePackageConfigHelpers)
 
@@ -32,6 +33,10 @@ install(TARGETS ${MICA_INSTALL_TARGETS} EXPORT micaTargets
   RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR}
   LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
   ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
+
+# mica_replay (examples_c/mica_replay.c) replays a recording; it finds the libmica installed beside it.
+set_target_properties(mica_replay PROPERTIES INSTALL_RPATH "$ORIGIN/../${CMAKE_INSTALL_LIBDIR}")
+install(TARGETS mica_replay RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
 
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/include/mica/
   DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/mica
@@ -75,6 +80,13 @@ foreach(_dir LIBDIR INCLUDEDIR)
     set(MICA_PC_${_dir} "\${prefix}/${CMAKE_INSTALL_${_dir}}")
   endif()
 endforeach()
+# What a static link needs besides libmica, named only when libmica.a is installed: pkg-config
+# resolves Requires.private for --cflags too, so naming libccd would make every consumer of the
+# shared library install libccd's development files.
+set(MICA_PC_PRIVATE "")
+if(MICA_INSTALL_STATIC)
+  set(MICA_PC_PRIVATE "Requires.private: ccd\nLibs.private: -lcholmod -lsuitesparseconfig -lstdc++ -lm -ldl -lpthread")
+endif()
 set(MICA_PC_PREFIX "@MICA_PC_PREFIX@")  # survives this pass, replaced at install time
 configure_file(${PROJECT_SOURCE_DIR}/pkgconfig/mica.pc.in
                ${PROJECT_BINARY_DIR}/pkgconfig/mica.pc.stage @ONLY)

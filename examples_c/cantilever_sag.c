@@ -31,7 +31,7 @@ static const char kUsage[] =
     "A 1 m x 0.1 m x 0.1 m block (E = 3e7 Pa), clamped at x = 0, sags under gravity in the default\n"
     "world; prints the tip deflection against the Euler-Bernoulli estimate w = q L^4 / (8 E I) and\n"
     "writes cantilever.csv and VTK frames (cantilever_*.vtk) into the output folder.\n"
-    "  output-folder  where the files go (default .)\n"
+    "  output-folder  where the files go (made if missing; default .)\n"
     "  steps          5 ms steps (default 200)\n"
     "  --help         this text\n";
 
@@ -39,7 +39,9 @@ int main(int argc, char** argv) {
   const int cli = cli_check(argc, argv, kUsage, NULL);
   if (cli >= 0) return cli;
   const char* out_dir = argc > 1 ? argv[1] : ".";
-  const int steps = argc > 2 ? atoi(argv[2]) : 200;
+  int steps = 200;
+  if (argc > 2 && !cli_int(argv[0], "steps", argv[2], 1, 1000000, &steps)) return 2;
+  if (!cli_make_folder(argv[0], out_dir)) return 1;
   const double L = 1.0, H = 0.1, E = 3e7, nu = 0.3, rho = 1000.0, g = 9.81, dt = 0.005;
   mica_world* world = NULL;
 

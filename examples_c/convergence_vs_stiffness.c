@@ -113,7 +113,7 @@ static const char kUsage[] =
     "MICA iterations per step (the paper's Gauss-Seidel sweep, tolerance 1e-8) for E = 1e3 ... 1e7 Pa:\n"
     "a 2 cm sphere pressing at 1 cm/s into a 10 cm cube fixed at its bottom (Figure 2 of Arikatla et\n"
     "al. 2016). Writes convergence_vs_stiffness.csv into the output folder.\n"
-    "  output-folder   where the CSV goes (default .)\n"
+    "  output-folder   where the CSV goes (made if missing; default .)\n"
     "  steps           10 ms steps per modulus (default 30)\n"
     "  cells-per-side  the cube's mesh (default 12)\n"
     "  iteration-cap   MICA's max_iterations (default 100000)\n"
@@ -123,13 +123,12 @@ int main(int argc, char** argv) {
   const int cli = cli_check(argc, argv, kUsage, NULL);
   if (cli >= 0) return cli;
   const char* out_dir = argc > 1 ? argv[1] : ".";
-  const int steps = argc > 2 ? atoi(argv[2]) : 30;
-  const int cells_per_side = argc > 3 ? atoi(argv[3]) : 12;
-  const int cap = argc > 4 ? atoi(argv[4]) : 100000;
-  if (steps < 1 || cells_per_side < 2 || cap < 1) {
-    fprintf(stderr, "usage: convergence_vs_stiffness [output-folder] [steps] [cells-per-side] [iteration-cap]\n");
-    return 1;
-  }
+  int steps = 30, cells_per_side = 12, cap = 100000;
+  if ((argc > 2 && !cli_int(argv[0], "steps", argv[2], 1, 1000000, &steps)) ||
+      (argc > 3 && !cli_int(argv[0], "cells-per-side", argv[3], 2, 100, &cells_per_side)) ||
+      (argc > 4 && !cli_int(argv[0], "iteration-cap", argv[4], 1, INT32_MAX, &cap)))
+    return 2;
+  if (!cli_make_folder(argv[0], out_dir)) return 1;
   const double moduli[] = {1e3, 1e4, 1e5, 1e6, 1e7};
   const int n_moduli = (int)(sizeof moduli / sizeof moduli[0]);
 

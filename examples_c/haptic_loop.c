@@ -5,7 +5,7 @@
  * a soft block for a second and lets go. Prints the rates and forces and writes
  * haptic_loop.csv (servo samples: time, raw and filtered force) for the paper's Figure 1 b/c.
  *
- * usage: haptic_loop [output-folder] [seconds] [--record file]
+ * usage: haptic_loop [output-folder] [seconds] [--record FILE]
  */
 #include <math.h>
 #include <pthread.h>
@@ -76,30 +76,33 @@ static void* servo_thread(void* arg) {
   } while (0)
 
 static const char kUsage[] =
-    "usage: haptic_loop [output-folder] [seconds] [--record file]\n"
+    "usage: haptic_loop [output-folder] [seconds] [--record FILE]\n"
     "A 60 Hz simulation thread and a 1 kHz servo thread: the Geomagic Touch when OpenHaptics' libHD\n"
     "is found (MICA_HD_LIBRARY), else a simulated stylus pressing into a soft block. Prints the rates\n"
     "and forces and writes haptic_loop.csv (time, raw and rendered force) into the output folder.\n"
-    "  output-folder  where the CSV goes (default .)\n"
+    "  output-folder  where the CSV goes (made if missing; default .)\n"
     "  seconds        how long the loop runs (default 2)\n"
-    "  --record file  record the session (mica_world_record_start); mica_replay replays it\n"
+    "  --record FILE  record the session (mica_world_record_start; its folder is made if missing);\n"
+    "                 mica_replay replays it\n"
     "  --help         this text\n";
 
 int main(int argc, char** argv) {
-  static const char* const options[] = {"--record", NULL};
+  static const char* const options[] = {"--record FILE", NULL};
   const int cli = cli_check(argc, argv, kUsage, options);
   if (cli >= 0) return cli;
   const char* positional[2] = {".", "2"};
   const char* record = NULL;
   for (int i = 1, n = 0; i < argc; ++i) {
-    if (strcmp(argv[i], "--record") == 0 && i + 1 < argc)
-      record = argv[++i];
+    if (strcmp(argv[i], "--record") == 0)
+      record = argv[++i]; /* cli_check saw the value */
     else if (n < 2)
       positional[n++] = argv[i];
   }
   const char* out_dir = positional[0];
   static loop L;
-  L.seconds = atof(positional[1]);
+  if (!cli_double(argv[0], "seconds", positional[1], 0.01, 86400, &L.seconds)) return 2;
+  /* The folders first: the session is not run to find out at its end that they are missing. */
+  if (!cli_make_folder(argv[0], out_dir) || (record && !cli_make_parent(argv[0], record))) return 1;
   mica_world* world = NULL;
   mica_world_def wd = mica_world_def_default();
   wd.gravity[1] = 0;

@@ -6,7 +6,8 @@
  *                      constraint's reaction, every step (long format: one row per object)
  *   replay_NNNNNN.vtk  every body (positions, von Mises stress, regions) every N steps (--vtk-every)
  * Exit status: 0 when every step reproduced the recording, 3 when the replay diverged (the message
- * names the step), 1 for another error.
+ * names the step), 4 when the recording was cut short (its steps are replayed, then the message
+ * says after how many it ends), 1 for another error, 2 for bad arguments. Installed with libmica.
  *
  * usage: mica_replay recording [output-folder] [--vtk-every N]
  */
@@ -26,10 +27,16 @@ static const char kUsage[] =
     "(each tool's force and each constraint's reaction per step, N) and, with --vtk-every N, the\n"
     "bodies every N steps as replay_NNNNNN.vtk (ParaView).\n"
     "  recording      the file written by mica_world_record_start\n"
-    "  output-folder  where the files go (default .)\n"
+    "  output-folder  where the files go (made if missing; default .)\n"
     "  --vtk-every N  write the bodies every N steps (default 0: never)\n"
     "  --help         this text\n"
-    "Exit status 0: every step reproduced; 3: the replay diverged; 1: another error.\n";
+    "Exit status 0: every step reproduced; 3: the replay diverged; 4: the recording was cut short\n"
+    "(it ends before the entry that stopping a recording writes); 1: another error; 2: bad arguments.\n";
+
+/* The exit status for a replay that stopped with `status`. */
+static int exit_status_of(mica_status status) {
+  return status == MICA_ERR_DIVERGED ? 3 : status == MICA_ERR_TRUNCATED ? 4 : 1;
+}
 
 /* Writes each object's force of one kind: tools' forces or constraints' reactions. */
 static int write_forces(mica_world* w, FILE* csv, int64_t step, int32_t kind) {
@@ -48,25 +55,28 @@ static int write_forces(mica_world* w, FILE* csv, int64_t step, int32_t kind) {
 }
 
 int main(int argc, char** argv) {
-  static const char* const options[] = {"--vtk-every", NULL};
+  static const char* const options[] = {"--vtk-every N", NULL};
   const int cli = cli_check(argc, argv, kUsage, options);
   if (cli >= 0) return cli;
   const char* positional[2] = {NULL, "."};
   int n_positional = 0, vtk_every = 0;
   for (int i = 1; i < argc; ++i) {
-    if (strcmp(argv[i], "--vtk-every") == 0 && i + 1 < argc)
-      vtk_every = atoi(argv[++i]);
-    else if (n_positional < 2)
+    if (strcmp(argv[i], "--vtk-every") == 0) {
+      if (!cli_int(argv[0], "--vtk-every", argv[++i], 0, INT32_MAX, &vtk_every)) return 2;
+    } else if (n_positional < 2) {
       positional[n_positional++] = argv[i];
+    }
   }
   if (n_positional < 1) {
     fputs(kUsage, stderr);
     return 2;
   }
+  if (!cli_make_folder(argv[0], positional[1])) return 1;
   mica_replay* replay = NULL;
-  if (mica_replay_open(positional[0], &replay) != MICA_OK) {
+  const mica_status opened = mica_replay_open(positional[0], &replay);
+  if (opened != MICA_OK) {
     fprintf(stderr, "mica_replay: %s\n", mica_world_last_error(NULL));
-    return 1;
+    return exit_status_of(opened);
   }
   mica_world* w = mica_replay_world(replay);
   char path[4096];
@@ -86,9 +96,14 @@ int main(int argc, char** argv) {
   double ms = 0;
   while (stepped) {
     const mica_status s = mica_replay_step(replay, &stepped);
+    if (s == MICA_ERR_TRUNCATED) {
+      fprintf(stderr, "mica_replay: %s\n", mica_world_last_error(w));
+      exit_status = exit_status_of(s);
+      break;
+    }
     if (s < 0 && s != MICA_ERR_NUMERICAL) { /* a recorded step that failed fails again: not an error */
       fprintf(stderr, "mica_replay: step %" PRId64 ": %s\n  %s\n", step + 1, mica_status_string(s), mica_world_last_error(w));
-      exit_status = s == MICA_ERR_DIVERGED ? 3 : 1;
+      exit_status = exit_status_of(s);
       break;
     }
     if (!stepped) break;
@@ -116,6 +131,8 @@ int main(int argc, char** argv) {
   fclose(forces_csv);
   mica_replay_close(replay);
   printf("mica_replay: %" PRId64 " steps replayed in %.1f ms of stepping, %s\n", step, ms,
-         exit_status == 0 ? "each as recorded, bit for bit" : "stopped (see above)");
+         exit_status == 0   ? "each as recorded, bit for bit"
+         : exit_status == 4 ? "each as recorded; then the recording ends, cut short (see above)"
+                            : "stopped (see above)");
   return exit_status;
 }

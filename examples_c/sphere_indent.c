@@ -50,19 +50,17 @@ static const char kUsage[] =
     "(Figure 1 of Arikatla et al. 2016). Prints time, depth, tool force, contacts and iterations;\n"
     "writes sphere_indent.csv and VTK frames (sphere_indent_*.vtk) into the output folder. Exits 1\n"
     "if the force is not finite, pulls, does not grow while loading or stays after release.\n"
-    "  output-folder  where the files go (default .)\n"
-    "  steps          10 ms steps of the whole press (default 300)\n"
+    "  output-folder  where the files go (made if missing; default .)\n"
+    "  steps          10 ms steps of the whole press, at least 12 (default 300)\n"
     "  --help         this text\n";
 
 int main(int argc, char** argv) {
   const int cli = cli_check(argc, argv, kUsage, NULL);
   if (cli >= 0) return cli;
   const char* out_dir = argc > 1 ? argv[1] : ".";
-  const int steps = argc > 2 ? atoi(argv[2]) : 300;
-  if (steps < 12) {
-    fprintf(stderr, "usage: sphere_indent [output-folder] [steps >= 12]\n");
-    return 1;
-  }
+  int steps = 300;
+  if (argc > 2 && !cli_int(argv[0], "steps", argv[2], 12, 1000000, &steps)) return 2;
+  if (!cli_make_folder(argv[0], out_dir)) return 1;
   /* The scene, built by scenes/press_scene.c (shared with the benchmarks and the bindings'
    * reference): the cube [-L/2, L/2] x [0, L] x [-L/2, L/2], L = 10 cm, fixed at its bottom face
    * y = 0, and the sphere centred above (0, L, 0), its lowest point start_gap above the top face.

@@ -70,7 +70,7 @@ static const char kUsage[] =
     "world at 100 Hz, prints each hand's rendered force, writes two_hands.csv (time, each hand's\n"
     "rendered force, the step's grasp and tool forces) and checks the block's force balance and the\n"
     "direction and size of each hand's force; exit status 1 when a check fails.\n"
-    "  output-folder  where the CSV goes (default .)\n"
+    "  output-folder  where the CSV goes (made if missing; default .)\n"
     "  seconds        how long the hands act (default 3, at least 1.5; they stop moving at 1 s)\n"
     "  --help         this text\n";
 
@@ -137,8 +137,9 @@ int main(int argc, char** argv) {
   const int cli = cli_check(argc, argv, kUsage, NULL);
   if (cli >= 0) return cli;
   const char* out_dir = argc > 1 ? argv[1] : ".";
-  double seconds = argc > 2 ? atof(argv[2]) : 3;
-  if (!(seconds >= 1.5)) seconds = 1.5; /* the hands reach their targets at 1 s, then settle */
+  double seconds = 3; /* at least 1.5: the hands reach their targets at 1 s, then settle */
+  if (argc > 2 && !cli_double(argv[0], "seconds", argv[2], 1.5, 86400, &seconds)) return 2;
+  if (!cli_make_folder(argv[0], out_dir)) return 1;
   mica_world* world = NULL;
   mica_world_def wd = mica_world_def_default(); /* MICA, factored sweep, relative tolerance 1e-8 */
   if (mica_world_create(&wd, &world) != MICA_OK) {

@@ -1,13 +1,15 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: Apache-2.0
-# Fuzzes the mesh loaders and the C API with libFuzzer (clang, ASan + UBSan) for a bounded time:
+# Fuzzes the mesh loaders, the C API and the file formats a user receives from others (saved
+# states, recordings) with libFuzzer (clang, ASan + UBSan) for a bounded time:
 #   bash scripts/fuzz.sh                      # each target FUZZ_SECONDS (default 60) seconds,
 #                                             # fuzz_api FUZZ_API_SECONDS (default the same)
 #   FUZZ_SECONDS=300 bash scripts/fuzz.sh     # longer
 #   FUZZ_TARGETS="fuzz_gmsh" bash scripts/fuzz.sh
 #   FUZZ_SECONDS=0 bash scripts/fuzz.sh       # no fuzzing: only run the seeds and learned corpus
 # Targets (fuzz/): fuzz_gmsh, fuzz_tetgen, fuzz_mesh_build, fuzz_api (sequences of C API calls
-# on twin worlds; fuzz/README.md). Seeds come from fuzz/corpus/<kind>/
+# on twin worlds; fuzz/README.md), fuzz_state (mica_world_restore_state), fuzz_recording
+# (mica_replay_open and _step). Seeds come from fuzz/corpus/<kind>/
 # (read only); what the fuzzer learns goes to <build>/corpus/<target>/ and is kept between runs.
 # A crashing input is saved as fuzz/crashes/<target>-crash-<sha1> (or -leak-, -timeout-, -oom-),
 # printed in base64, and makes the script exit 1 after the other targets have run.
@@ -17,14 +19,14 @@
 #
 # Installs nothing. Needs the Debian 12 packages clang-14, libclang-rt-14-dev and
 # libeigen3-dev (llvm-14 too for symbolized stack traces); fuzz_api also libsuitesparse-dev and
-# libccd-dev (the main build's).
+# libccd-dev (the main build's), and so do fuzz_state and fuzz_recording.
 # Environment: FUZZ_SECONDS, FUZZ_API_SECONDS, FUZZ_TARGETS, FUZZ_BUILD_DIR (default build-fuzz/), FUZZ_CXX (the
 # clang++ to use), FUZZ_JOBS (build parallelism, default nproc), FUZZ_CRASH_DIR (default
 # fuzz/crashes/).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 seconds=${FUZZ_SECONDS:-60}
-targets=${FUZZ_TARGETS:-fuzz_gmsh fuzz_tetgen fuzz_mesh_build fuzz_api}
+targets=${FUZZ_TARGETS:-fuzz_gmsh fuzz_tetgen fuzz_mesh_build fuzz_api fuzz_state fuzz_recording}
 api_seconds=${FUZZ_API_SECONDS:-$seconds}
 build=${FUZZ_BUILD_DIR:-$root/build-fuzz}
 crashes=${FUZZ_CRASH_DIR:-$root/fuzz/crashes}
@@ -76,6 +78,8 @@ for target in $targets; do
     fuzz_tetgen) seeds=("$root/fuzz/corpus/tetgen"); dict=tetgen ;;
     fuzz_mesh_build) seeds=("$root/fuzz/corpus/gmsh" "$root/fuzz/corpus/tetgen"); dict=mesh_build ;;
     fuzz_api) seeds=("$root/fuzz/corpus/api"); dict= ;;
+    fuzz_state) seeds=("$root/fuzz/corpus/state"); dict= ;;
+    fuzz_recording) seeds=("$root/fuzz/corpus/recording"); dict= ;;
     *) echo "fuzz.sh: unknown target '$target'" >&2; exit 2 ;;
   esac
   if [[ ! -x "$build/$target" ]]; then
@@ -91,7 +95,12 @@ for target in $targets; do
   [[ -n $dict ]] && options+=(-dict="$root/fuzz/dict/$dict.dict")
   # fuzz_api: a program's steps may take seconds under ASan on a loaded machine (it stops after 2 s
   # of them): a longer timeout, so that a slow valid scene is not reported as a hang.
-  [[ $target == fuzz_api ]] && options+=(-max_len=4096 -timeout=30) || options+=(-max_len=65536 -timeout=10)
+  # The file targets: their seeds are a few KB, each run makes a world and steps it.
+  case "$target" in
+    fuzz_api) options+=(-max_len=4096 -timeout=30) ;;
+    fuzz_state | fuzz_recording) options+=(-max_len=16384 -timeout=30) ;;
+    *) options+=(-max_len=65536 -timeout=10) ;;
+  esac
   work="$build/corpus/$target"
   mkdir -p "$work"
   before=$(find "$crashes" -maxdepth 1 -type f -name "$target-*" | sort)

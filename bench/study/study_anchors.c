@@ -256,7 +256,7 @@ static const char kUsage[] =
     "Mesh convergence toward the analytic anchors: Hertz (a sphere indenting a deep block) and\n"
     "Euler-Bernoulli (a cantilever under its own weight), linear bodies, MICA_SOLVER_DIRECT. Writes\n"
     "<out-dir>/anchors.csv and <out-dir>/hertz_curve.csv.\n"
-    "  out-dir  where the CSV files go\n"
+    "  out-dir  where the CSV files go (made if missing)\n"
     "  quick    the coarser meshes only (a smoke test)\n"
     "  --help   this text\n";
 
@@ -269,14 +269,17 @@ int main(int argc, char** argv) {
   }
   const int quick = argc > 2 && strcmp(argv[2], "quick") == 0;
   if (argc > 5 && strcmp(argv[2], "hertz") == 0) { /* experiments: hertz <cells> <kappa> <W> */
-    g_kappa = atof(argv[4]);
-    g_W = atof(argv[5]);
+    int cells = 0;
+    if (!cli_int(argv[0], "cells", argv[3], 1, 64, &cells) || !cli_double(argv[0], "kappa", argv[4], 0.01, 20, &g_kappa) ||
+        !cli_double(argv[0], "W", argv[5], 1e-4, 1, &g_W))
+      return 2;
     g_trace = 1;
-    const level_result r = hertz_level(atoi(argv[3]), stdout);
+    const level_result r = hertz_level(cells, stdout);
     printf("h0 %.4g: %d nodes %d tets F %.6g Hertz %.6g ratio %.4f, %.0f ms\n", r.h, r.nodes, r.tets, r.value,
            r.theory, r.value / r.theory, r.ms);
     return 0;
   }
+  if (!cli_make_folder(argv[0], argv[1])) return 1;
   char path[1024], machine[256];
   study_machine(machine, sizeof machine);
   snprintf(path, sizeof path, "%s/anchors.csv", argv[1]);

@@ -117,7 +117,7 @@ static const char kUsage[] =
     "The rendered force's moving-average window against its delay and smoothness, the simulated stylus\n"
     "polled in lockstep with the simulation. Writes <out-dir>/filter.csv and\n"
     "<out-dir>/filter_samples.csv.\n"
-    "  out-dir  where the CSV files go\n"
+    "  out-dir  where the CSV files go (made if missing)\n"
     "  --help   this text\n";
 
 int main(int argc, char** argv) {
@@ -127,6 +127,7 @@ int main(int argc, char** argv) {
     fprintf(stderr, "usage: study_filter <out-dir>\n");
     return 2;
   }
+  if (!cli_make_folder(argv[0], argv[1])) return 1;
   char path[1024], machine[256];
   study_machine(machine, sizeof machine);
   snprintf(path, sizeof path, "%s/filter.csv", argv[1]);

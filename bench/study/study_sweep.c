@@ -553,7 +553,7 @@ static const char kUsage[] =
     "What accuracy costs in time: every solver knob of the C API swept on one haptic scene, each\n"
     "configuration timed and compared with the exact solver. Writes <out-dir>/sweep.csv and\n"
     "<out-dir>/stiffness_steps.csv (docs/accuracy-vs-time.md).\n"
-    "  out-dir  where the CSV files go\n"
+    "  out-dir  where the CSV files go (made if missing)\n"
     "  quick    a few configurations (a smoke test)\n"
     "  --help   this text\n";
 
@@ -566,6 +566,7 @@ int main(int argc, char** argv) {
   }
   const int quick = argc > 2 && strcmp(argv[2], "quick") == 0;
   make_plan(quick);
+  if (!cli_make_folder(argv[0], argv[1])) return 1;
   char path[1024], machine[256];
   study_machine(machine, sizeof machine);
   snprintf(path, sizeof path, "%s/sweep.csv", argv[1]);

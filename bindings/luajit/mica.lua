@@ -515,7 +515,8 @@ end
 -- The next recorded step (with the calls before it), checked against the recording: returns
 -- true and the step's status (a warning such as MICA_WARN_NOT_CONVERGED is returned, as by
 -- World:step), or false at the end of the recording. Raises a mica.Error: MICA_ERR_DIVERGED
--- when the step does not reproduce the recording (the message names the step).
+-- when the step does not reproduce the recording (the message names the step),
+-- MICA_ERR_TRUNCATED when the recording was cut short (after its whole steps).
 function Replay:step()
   assert(self.ptr ~= nil, "the replay is closed")
   local stepped = ffi.new("int32_t[1]")

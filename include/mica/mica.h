@@ -100,6 +100,7 @@ typedef int32_t mica_status;
 #define MICA_ERR_OUT_OF_MEMORY (-15)   /**< an allocation failed */
 #define MICA_ERR_INTERNAL (-16)        /**< a bug in libmica: please report it with the message */
 #define MICA_ERR_DIVERGED (-17)        /**< since 0.6: a replay did not reproduce its recording (mica_replay_step) */
+#define MICA_ERR_TRUNCATED (-18)       /**< since 0.7: a recording ends before its end entry: it was cut short (mica_replay_step) */
 
 /** Static text naming a status ("MICA_ERR_STALE_ID: ..."). Thread: any.
  *  @param status any ::mica_status (unknown values get a generic text).
@@ -1070,8 +1071,14 @@ MICA_API mica_status mica_world_get_ids(const mica_world* world, int32_t kind, u
  *  or to attach to a bug report. What a device did between steps (the servo path's forces) is not recorded: the
  *  steps do not depend on it. A world with a time budget (mica_world_def.time_budget_ms) may not
  *  replay bit for bit: its steps depend on the clock. A recording is for this libmica on this kind
- *  of machine (native byte order), like a saved state. The tool `mica_replay` (examples_c) replays
- *  one and writes CSV and VTK.
+ *  of machine (native byte order), like a saved state. The tool `mica_replay` (installed with the
+ *  library) replays one and writes CSV and VTK.
+ *
+ *  A recording ends with an end entry (since 0.7: format 2), written when the recording is stopped
+ *  (mica_world_record_stop, or the world destroyed): a file without it was cut short (a host that
+ *  died, a copy cut off), and its replay says so after its last whole step (MICA_ERR_TRUNCATED).
+ *  A recording of 0.6 (format 1) has no end entry: it is replayed to the end of its file, and a
+ *  cut one cannot be told from a whole one.
  *  @{ */
 
 /** Starts recording the world into a file (created or truncated). A recording starts from a new
@@ -1085,13 +1092,14 @@ MICA_API mica_status mica_world_get_ids(const mica_world* world, int32_t kind, u
  *          (the file cannot be opened or written: the message names it). */
 MICA_API mica_status mica_world_record_start(mica_world* world, const char* path);
 
-/** Stops recording, flushes and closes the file (destroying the world also closes it). A write
- *  that failed during the recording (a full disk) did not fail the call that made it: it is
- *  reported here. The world's thread.
+/** Stops recording: writes the end entry (the replay's proof that the recording is whole),
+ *  flushes and closes the file (destroying the world does the same). A write that failed during
+ *  the recording (a full disk) did not fail the call that made it: it is reported here. The
+ *  world's thread.
  *  @param world the world.
  *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` is NULL); MICA_ERR_WRONG_STATE (not
  *          recording); MICA_ERR_IO (a write failed: the recording ends at the last whole entry
- *          before it, and the message says why). */
+ *          before it, without the end entry, and the message says why). */
 MICA_API mica_status mica_world_record_stop(mica_world* world);
 
 /** A recording being replayed into a world of its own. */
@@ -1103,7 +1111,8 @@ typedef struct mica_replay mica_replay;
  *  @param out_replay receives the replay, or NULL on failure.
  *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`path` or `out_replay` is NULL); MICA_ERR_IO (the
  *          file cannot be read); MICA_ERR_PARSE (not a recording, of another format or machine
- *          kind); MICA_ERR_INVALID_ARGUMENT (recorded settings this libmica refuses);
+ *          kind); MICA_ERR_TRUNCATED (cut short inside its header); MICA_ERR_INVALID_ARGUMENT
+ *          (recorded settings this libmica refuses);
  *          MICA_ERR_OUT_OF_MEMORY. The message: mica_world_last_error(NULL). */
 MICA_API mica_status mica_replay_open(const char* path, mica_replay** out_replay);
 
@@ -1123,13 +1132,16 @@ MICA_API mica_world* mica_replay_world(const mica_replay* replay);
  *  fingerprint of them. The replay's thread.
  *  @param replay the replay.
  *  @param out_stepped receives 1 when a step was replayed, 0 at the end of the recording (the
- *         calls recorded after its last step have been made). May be NULL.
+ *         calls recorded after its last step have been made) or when it was cut short. May be NULL.
  *  @return the step's status as mica_step() returned it when recorded (MICA_OK,
- *          MICA_WARN_NOT_CONVERGED, or the error of a step that failed then and now); or
- *          MICA_ERR_NULL_ARGUMENT (`replay` is NULL); MICA_ERR_DIVERGED (a recorded call failed, a
- *          creation got another id, or the step's results differ: the message says which and at
- *          which step); MICA_ERR_PARSE (a corrupt entry; a recording cut off inside an entry ends at
- *          the entry before). Messages: mica_world_last_error(mica_replay_world(replay)). */
+ *          MICA_WARN_NOT_CONVERGED, or the error of a step that failed then and now); MICA_OK with
+ *          `*out_stepped` 0 at the end entry; or MICA_ERR_NULL_ARGUMENT (`replay` is NULL);
+ *          MICA_ERR_DIVERGED (a recorded call failed, a creation got another id, or the step's
+ *          results differ: the message says which and at which step); MICA_ERR_TRUNCATED (the file
+ *          ends, inside an entry or between two, before the end entry: the message says after how
+ *          many steps; the steps before were replayed and checked); MICA_ERR_PARSE (a corrupt
+ *          entry, or bytes after the end entry). Messages:
+ *          mica_world_last_error(mica_replay_world(replay)). */
 MICA_API mica_status mica_replay_step(mica_replay* replay, int32_t* out_stepped);
 /** @} */
 

@@ -20,7 +20,8 @@ enum class Errc {
   Unsupported,      // the feature is not available in this build or on this scene
   Device,           // a haptic device failed
   Internal,         // a bug in libmica
-  Diverged          // a replay did not reproduce its recording
+  Diverged,         // a replay did not reproduce its recording
+  Truncated         // a recording ends before its end entry: it was cut short
 };
 
 class Error : public std::runtime_error {

@@ -21,9 +21,7 @@ Recorder::Recorder(const std::string& path, const WorldSettings& settings) : pat
   }
 }
 
-Recorder::~Recorder() {
-  if (file_) std::fclose(file_);
-}
+Recorder::~Recorder() { close(); }
 
 void Recorder::append(RecordKind kind, const std::vector<uint8_t>& payload) {
   if (!file_ || !error_.empty()) return;
@@ -33,11 +31,19 @@ void Recorder::append(RecordKind kind, const std::vector<uint8_t>& payload) {
                   // A step ends an entry group: flushed, so a crash of the host keeps every step before it.
                   (kind != RecordKind::Step || std::fflush(file_) == 0);
   if (!ok) error_ = "writing '" + path_ + "' failed: " + std::strerror(errno);
+  if (kind == RecordKind::Step) ++steps_;
+}
+
+bool Recorder::close() noexcept {
+  if (!file_) return true;
+  write(RecordKind::End, steps_);  // skipped after a failed write: the file then reads as cut short
+  const bool closed = std::fclose(file_) == 0;
+  file_ = nullptr;
+  return closed;
 }
 
 void Recorder::stop() {
-  if (file_ && std::fclose(file_) != 0 && error_.empty()) error_ = "closing '" + path_ + "' failed: " + std::strerror(errno);
-  file_ = nullptr;
+  if (!close() && error_.empty()) error_ = "closing '" + path_ + "' failed: " + std::strerror(errno);
   if (!error_.empty()) fail(Errc::Io, "the recording is incomplete: " + error_);
 }
 

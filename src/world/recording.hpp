@@ -4,8 +4,9 @@
 // then entries in call order, each a kind, its payload's size and the payload. Creations carry the
 // id they returned (a replay checks it gets the same one); a step carries its time step, the poses
 // its devices' tools took at its start, whether it failed, and a fingerprint of its results (the
-// replay checks its own step against it). Write and read of each type sit side by side below, so
-// that the two cannot drift apart.
+// replay checks its own step against it). Stopping the recording writes an end entry with the
+// number of steps (format 2; format 1, libmica 0.6's, has none): a file without it was cut short.
+// Write and read of each type sit side by side below, so that the two cannot drift apart.
 #pragma once
 #include <cstdio>
 #include <string>
@@ -19,13 +20,14 @@ namespace mica {
 enum class RecordKind : uint32_t {
   SetGravity = 1, AddBody, RemoveBody, SetNodeForces, SetPositions, SetVelocities, SetMaterials,
   AddLpc, RemoveLpc, SetLpcVelocity, SetLpcTargets, Grab, SetHandlePose,
-  AddTool, RemoveTool, SetToolPose, AddDevice, RemoveDevice, RestoreState, Step,
-  TeleportTool  // since 0.7
+  AddTool, RemoveTool, SetToolPose, AddDevice, RemoveDevice, RestoreState, Step, End,
+  TeleportTool
 };
 constexpr uint32_t kLastRecordKind = uint32_t(RecordKind::TeleportTool);
 
 constexpr char kRecordingMagic[8] = {'M', 'I', 'C', 'A', 'R', 'E', 'C', '1'};
-constexpr uint32_t kRecordingVersion = 1;
+constexpr uint32_t kRecordingVersion = 2;            // 2: the end entry, tool teleports
+constexpr uint32_t kRecordingVersionWithoutEnd = 1;  // libmica 0.6's, still replayed
 // Byte order and the size of a double: a recording is replayed where such values read back alike.
 constexpr uint32_t kRecordingLayout = 0x01020304u ^ uint32_t(sizeof(double) << 24);
 
@@ -37,11 +39,12 @@ struct RecordEntryHeader {
 };
 
 // Writes the entries to a file. A write that fails is kept as the recording's error and ends the
-// recording (the world's calls go on succeeding); stop() reports it.
+// recording (the world's calls go on succeeding; no end entry follows); stop() reports it.
 class Recorder {
  public:
   // Opens (truncates) `path` and writes the header; throws Error(Io) naming the path.
   Recorder(const std::string& path, const WorldSettings& settings);
+  // Ends the recording as stop() does, reporting nothing.
   ~Recorder();
   Recorder(const Recorder&) = delete;
   Recorder& operator=(const Recorder&) = delete;
@@ -58,14 +61,16 @@ class Recorder {
       if (error_.empty()) error_ = "out of memory while recording";
     }
   }
-  // Flushes and closes; throws Error(Io) when a write failed since the start.
+  // Writes the end entry, flushes and closes; throws Error(Io) when a write failed since the start.
   void stop();
 
  private:
   void append(RecordKind kind, const std::vector<uint8_t>& payload);
+  bool close() noexcept;  // writes the end entry and closes the file; false when fclose failed
   std::string path_;
   std::FILE* file_ = nullptr;
   std::string error_;  // the first write error
+  int64_t steps_ = 0;  // step entries written
 };
 
 // --- How each value is written (put) and read (take). -------------------------------------------

@@ -29,19 +29,27 @@ std::string hex(uint64_t v) {
 }  // namespace
 
 Replay::Replay(std::vector<uint8_t> bytes, std::string name) : bytes_(std::move(bytes)), name_(std::move(name)) {
-  ByteReader in(bytes_.data(), bytes_.size(), "the recording");
-  char magic[sizeof kRecordingMagic];
-  in.get_bytes(magic, sizeof magic, "its header");
-  if (std::memcmp(magic, kRecordingMagic, sizeof magic) != 0)
+  if (bytes_.size() < sizeof kRecordingMagic || std::memcmp(bytes_.data(), kRecordingMagic, sizeof kRecordingMagic) != 0)
     fail(Errc::Parse, name_ + " is not a libmica recording (no MICAREC1 header)");
-  const uint32_t version = in.get<uint32_t>("its header"), layout = in.get<uint32_t>("its header");
-  if (version != kRecordingVersion || layout != kRecordingLayout)
-    fail(Errc::Parse, name_ + " is of format " + std::to_string(version) + " (layout " + std::to_string(layout) +
-                          "); this libmica replays format " + std::to_string(kRecordingVersion) +
-                          " recorded on a machine like this one");
-  take(in, settings_);
+  ByteReader in(bytes_.data() + sizeof kRecordingMagic, bytes_.size() - sizeof kRecordingMagic, "the recording");
+  const auto header = [&](auto& value) {
+    if (in.remaining() < sizeof value) cut_short("inside its header");
+    take(in, value);
+  };
+  uint32_t layout = 0;
+  header(version_);
+  header(layout);
+  if ((version_ != kRecordingVersion && version_ != kRecordingVersionWithoutEnd) || layout != kRecordingLayout)
+    fail(Errc::Parse, name_ + " is of format " + std::to_string(version_) + " (layout " + std::to_string(layout) +
+                          "); this libmica replays formats " + std::to_string(kRecordingVersionWithoutEnd) + " to " +
+                          std::to_string(kRecordingVersion) + " recorded on a machine like this one");
+  try {
+    take(in, settings_);
+  } catch (const Error&) {
+    cut_short("inside its header");  // reading plain values fails only where the bytes end
+  }
   validate(settings_);
-  at_ = in.position();
+  at_ = sizeof kRecordingMagic + in.position();
 }
 
 Replay Replay::open(const std::string& path) {
@@ -56,18 +64,32 @@ void Replay::diverged(const std::string& what) const {
   fail(Errc::Diverged, name_ + ", step " + std::to_string(steps_) + ": " + what);
 }
 
+void Replay::cut_short(const std::string& where) const {
+  fail(Errc::Truncated, name_ + " was cut short after " + std::to_string(steps_) + " steps: it ends at byte " +
+                            std::to_string(bytes_.size()) + ", " + where +
+                            ", without the end entry that stopping a recording writes");
+}
+
 bool Replay::next_step(World& world) {
-  while (bytes_.size() - at_ >= sizeof(RecordEntryHeader)) {
-    RecordEntryHeader head;
-    std::memcpy(&head, bytes_.data() + at_, sizeof head);
-    // A host that died mid-entry leaves a partial last entry: its replay ends at the last whole one.
-    if (head.size > bytes_.size() - at_ - sizeof head) break;
+  while (!ended_) {
+    const size_t left = bytes_.size() - at_;
+    RecordEntryHeader head{};
+    if (left >= sizeof head) std::memcpy(&head, bytes_.data() + at_, sizeof head);
+    if (left < sizeof head || head.size > left - sizeof head) {
+      // The file ends inside an entry (a host that died mid-entry) or, when left is 0, between two.
+      if (version_ == kRecordingVersionWithoutEnd) return false;  // 0.6's end: the file's
+      cut_short(left == 0 ? "after a whole entry" : "inside an entry");
+    }
     if (head.kind == 0 || head.kind > kLastRecordKind)
       fail(Errc::Parse, name_ + " is corrupt: an entry of unknown kind " + std::to_string(head.kind) + " at byte " +
                             std::to_string(at_));
     ByteReader in(bytes_.data() + at_ + sizeof head, size_t(head.size), "an entry of the recording");
     at_ += sizeof head + size_t(head.size);
     const auto kind = RecordKind(head.kind);
+    if (kind == RecordKind::End) {
+      end(in);
+      return false;
+    }
     if (kind != RecordKind::Step) {
       try {
         apply(world, kind, in);
@@ -95,6 +117,19 @@ bool Replay::next_step(World& world) {
     return true;
   }
   return false;
+}
+
+void Replay::end(ByteReader& in) {
+  int64_t steps = 0;
+  take(in, steps);
+  if (in.remaining() || steps != steps_)
+    fail(Errc::Parse, name_ + " is corrupt: its end entry " +
+                          (in.remaining() ? "is " + std::to_string(in.remaining()) + " bytes too long"
+                                          : "counts " + std::to_string(steps) + " steps, " + std::to_string(steps_) +
+                                                " were replayed"));
+  if (at_ != bytes_.size())
+    fail(Errc::Parse, name_ + " is corrupt: " + std::to_string(bytes_.size() - at_) + " bytes follow its end entry");
+  ended_ = true;
 }
 
 void Replay::apply(World& world, RecordKind kind, ByteReader& in) {
@@ -163,7 +198,8 @@ void Replay::apply(World& world, RecordKind kind, ByteReader& in) {
       world.restore_state(state.data(), state.size());
       break;
     }
-    case RecordKind::Step: break;  // next_step's
+    case RecordKind::Step:
+    case RecordKind::End: break;  // next_step's
   }
   if (in.remaining())
     fail(Errc::Parse, name_ + " is corrupt: an entry of kind " + std::to_string(uint32_t(kind)) + " has " +

@@ -20,6 +20,7 @@
 // Not saved, because they do not change a later step: timings aside from the counters, the per-step
 // work arrays, and a linear body's assembled matrix (reassembled: the same bits).
 #include <algorithm>
+#include <cstddef>
 #include <cstring>
 #include <functional>
 #include <type_traits>
@@ -190,6 +191,14 @@ struct StateReader {
     }
     if (apply) field = std::move(value);  // a vector of the same size is copied in place (a positions view stays valid)
   }
+  // The statistics' flags are bools: checked as bytes first (a bool holding 2 is undefined behaviour).
+  void operator()(const char* what, WorldStats& field, uint32_t) {
+    uint8_t raw[sizeof(WorldStats)];
+    in.get_bytes(raw, sizeof raw, what);
+    require(raw[offsetof(WorldStats, converged)] <= 1 && raw[offsetof(WorldStats, out_of_time)] <= 1,
+            "the statistics' flags are not 0 or 1");
+    if (apply) std::memcpy(static_cast<void*>(&field), raw, sizeof raw);
+  }
   void operator()(const char* what, bool& field, uint32_t) {
     const bool value = in.get<uint8_t>(what) != 0;
     if (apply) field = value;
@@ -232,7 +241,8 @@ void check_results(const StepResults& r, const std::function<const Body*(Id)>& f
                    const std::function<bool(Id)>& has_tool) {
   const ContactRows& rows = r.rows;
   const size_t nr = rows.direction.size();
-  require(rows.start.size() == nr + 1 && rows.bias.size() == nr && rows.normal_of.size() == nr && rows.mu.size() == nr &&
+  // Before the first step the rows have no start offsets at all.
+  require((rows.start.size() == nr + 1 || (nr == 0 && rows.start.empty())) && rows.bias.size() == nr && rows.normal_of.size() == nr && rows.mu.size() == nr &&
               rows.contact.size() == nr && rows.key.size() == nr && r.lambda.size() == nr,
           "the contact rows disagree in length");
   require(r.curvature_impulse.size() == r.contacts.size(), "the contacts disagree in length");

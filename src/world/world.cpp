@@ -142,6 +142,9 @@ int64_t World::factorizations(Id id) const { return solver_->factorizations(body
 
 void World::set_node_forces(Id id, const std::vector<int32_t>& nodes, const Vec3List& forces) {
   Body& b = body(id);
+  if (nodes.size() != forces.size())  // the C API passes one count for both; a corrupt recording may not
+    fail(Errc::InvalidArgument, b.name + ": " + std::to_string(nodes.size()) + " node indices and " +
+                                    std::to_string(forces.size()) + " forces");
   require_nodes_of(b, nodes);
   for (size_t k = 0; k < nodes.size(); ++k) require_finite(forces[k], "force " + std::to_string(k));
   for (size_t k = 0; k < nodes.size(); ++k) b.node_forces[nodes[k]] = forces[k];

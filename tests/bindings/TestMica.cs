@@ -746,9 +746,9 @@ static class TestMica
         try
         {
             RecordSession(path, new List<double[]>(), new List<double[]>());
-            // The file ends with the last step's fingerprint.
+            // The file ends with the last step's fingerprint, then the end entry (24 bytes).
             var bytes = File.ReadAllBytes(path);
-            bytes[bytes.Length - 1] ^= 1;
+            bytes[bytes.Length - 25] ^= 1;
             File.WriteAllBytes(path, bytes);
             using (var replay = new Replay(path))
             {

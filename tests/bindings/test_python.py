@@ -562,11 +562,11 @@ class Recording(unittest.TestCase):
         with tempfile.TemporaryDirectory() as tmp:
             path = os.path.join(tmp, "session.micarec")
             self.record(path)
-            # The file ends with the last step's fingerprint.
+            # The file ends with the last step's fingerprint, then the end entry (24 bytes).
             with open(path, "r+b") as f:
-                f.seek(-1, os.SEEK_END)
+                f.seek(-25, os.SEEK_END)
                 last = f.read(1)[0]
-                f.seek(-1, os.SEEK_END)
+                f.seek(-25, os.SEEK_END)
                 f.write(bytes([last ^ 1]))
             with mica.Replay(path) as replay:
                 steps = 0

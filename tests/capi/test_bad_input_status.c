@@ -31,10 +31,12 @@ static void test_status_strings(void** state) {
       S(MICA_ERR_DEVICE),
       S(MICA_ERR_OUT_OF_MEMORY),
       S(MICA_ERR_INTERNAL),
+      S(MICA_ERR_DIVERGED),
+      S(MICA_ERR_TRUNCATED),
   };
 #undef S
   const size_t count = sizeof kCodes / sizeof kCodes[0];
-  const mica_status unknown[6] = {5, -17, 100, -1000, INT32_MAX, INT32_MIN};
+  const mica_status unknown[6] = {5, -99, 100, -1000, INT32_MAX, INT32_MIN};
   for (size_t i = 0; i < count; ++i) {
     const char* text = mica_status_string(kCodes[i].code);
     assert_non_null(text);

@@ -1,12 +1,14 @@
 /* SPDX-License-Identifier: Apache-2.0 */
-/* Recording a session and replaying it (issue 15), through the C API:
+/* Recording a session and replaying it, through the C API:
  *  - a 5 s haptic session (a simulated hand on its own 1 kHz servo thread driving a sphere into a
  *    soft block, a grab dragged by the host, node forces, the grab released) replays into a fresh
  *    world with every step's positions and tool force bit for bit;
  *  - a session with a saved state restored halfway (the device polled by the test) replays alike,
  *    and so does one where the device drives a grasp;
- *  - a changed fingerprint is reported as MICA_ERR_DIVERGED at its step, a recording cut inside an
- *    entry replays up to the entry before, and bad files and calls get their statuses. */
+ *  - a changed fingerprint is reported as MICA_ERR_DIVERGED at its step; a recording cut short
+ *    (without the entry mica_world_record_stop ends it with) replays its whole steps, then
+ *    MICA_ERR_TRUNCATED says after how many; one of 0.6 (no end entry) ends with its file;
+ *  - bad files and calls get their statuses. */
 #define _POSIX_C_SOURCE 200809L
 #include <setjmp.h>
 #include <stdarg.h>
@@ -261,17 +263,51 @@ static void record_small(const char* path) {
   mica_world_destroy(w);
 }
 
-static int32_t replay_count(const char* path, mica_status* last) {
+/* Replays `path` to its end or its first error; returns the steps replayed (the failing one
+ * included), the last status in `*last` and, when `message` is not NULL, the replay's message. */
+static int32_t replay_count(const char* path, mica_status* last, char* message, size_t capacity) {
   mica_replay* r = NULL;
   OK(NULL, mica_replay_open(path, &r));
   int32_t steps = 0, stepped = 1;
-  while (stepped) {
+  *last = MICA_OK;
+  while (stepped && *last >= 0) {
     *last = mica_replay_step(r, &stepped);
-    if (*last < 0) break;
     steps += stepped;
   }
+  if (message) snprintf(message, capacity, "%s", mica_world_last_error(mica_replay_world(r)));
   mica_replay_close(r);
   return steps;
+}
+
+/* The entry mica_world_record_stop ends a recording with: a 16-byte entry header and the step count. */
+static const long kEndEntryBytes = 24;
+
+/* Copies the first `bytes` of `from` into `to` (head -c). */
+static void copy_head(const char* from, const char* to, long bytes) {
+  FILE* in = fopen(from, "rb");
+  FILE* out = fopen(to, "wb");
+  assert_non_null(in);
+  assert_non_null(out);
+  for (long k = 0; k < bytes; ++k) {
+    const int c = fgetc(in);
+    assert_true(c != EOF);
+    fputc(c, out);
+  }
+  fclose(in);
+  fclose(out);
+}
+
+/* Replays `path`, which must replay `steps` steps and then be reported cut short after them. */
+static void expect_cut_short(const char* path, int32_t steps) {
+  mica_status status = MICA_OK;
+  char message[512], expected[64];
+  const int32_t replayed = replay_count(path, &status, message, sizeof message);
+  snprintf(expected, sizeof expected, "cut short after %d steps", steps);
+  if (status != MICA_ERR_TRUNCATED || replayed != steps || !strstr(message, expected)) {
+    print_error("%s: %d steps replayed, then %s (%s); expected %d steps, then MICA_ERR_TRUNCATED (%s)\n", path,
+                replayed, mica_status_string(status), message, steps, expected);
+    fail();
+  }
 }
 
 static void test_divergence_and_truncation_are_reported(void** state) {
@@ -279,35 +315,80 @@ static void test_divergence_and_truncation_are_reported(void** state) {
   const char* path = "test_recording_small.micarec";
   record_small(path);
   mica_status last = MICA_OK;
-  assert_int_equal(replay_count(path, &last), 30);
+  assert_int_equal(replay_count(path, &last, NULL, 0), 30);
   assert_int_equal(last, MICA_OK);
 
-  /* The last 8 bytes are the last step's fingerprint: changed, that step diverges. */
+  /* The 8 bytes before the end entry are the last step's fingerprint: changed, that step diverges. */
   const long size = file_size(path);
   FILE* f = fopen(path, "r+b");
-  fseek(f, size - 1, SEEK_SET);
+  fseek(f, size - kEndEntryBytes - 1, SEEK_SET);
   const int byte = fgetc(f);
-  fseek(f, size - 1, SEEK_SET);
+  fseek(f, size - kEndEntryBytes - 1, SEEK_SET);
   fputc(byte ^ 1, f);
   fclose(f);
-  mica_replay* r = NULL;
-  OK(NULL, mica_replay_open(path, &r));
-  int32_t stepped = 1, steps = 0;
-  mica_status status = MICA_OK;
-  while (stepped && status >= 0) {
-    status = mica_replay_step(r, &stepped);
-    steps += stepped;
-  }
-  assert_int_equal(status, MICA_ERR_DIVERGED);
-  assert_int_equal(steps, 30);
-  assert_non_null(strstr(mica_world_last_error(mica_replay_world(r)), "step 30"));
-  mica_replay_close(r);
+  char message[512];
+  assert_int_equal(replay_count(path, &last, message, sizeof message), 30);
+  assert_int_equal(last, MICA_ERR_DIVERGED);
+  assert_non_null(strstr(message, "step 30"));
+  remove(path);
+}
 
-  /* Cut inside the last entry (a host that died while writing it): 29 steps, then the end. */
-  assert_int_equal(truncate(path, size - 4), 0);
-  assert_int_equal(replay_count(path, &last), 29);
+/* A recording that ends before mica_world_record_stop's end entry (a host that died, a file cut
+ * with head -c) replays its whole steps, then says it was cut short and after how many steps. */
+static void test_cut_recording_is_reported(void** state) {
+  (void)state;
+  const char* path = "test_recording_whole.micarec";
+  const char* cut = "test_recording_cut.micarec";
+  record_small(path);
+  const long size = file_size(path);
+  copy_head(path, cut, size - 4); /* inside the end entry */
+  expect_cut_short(cut, 30);
+  copy_head(path, cut, size - kEndEntryBytes); /* right after the last step */
+  expect_cut_short(cut, 30);
+  copy_head(path, cut, size - kEndEntryBytes - 4); /* inside the last step */
+  expect_cut_short(cut, 29);
+  copy_head(path, cut, 1200); /* inside the body's mesh, before any step */
+  expect_cut_short(cut, 0);
+
+  /* 600 bytes fewer: a few steps fewer, as many as are whole in what is left. */
+  copy_head(path, cut, size - kEndEntryBytes - 600);
+  mica_status last = MICA_OK;
+  const int32_t steps = replay_count(cut, &last, NULL, 0);
+  assert_true(steps >= 20 && steps < 30);
+  expect_cut_short(cut, steps);
+
+  /* Bytes after the end entry are not part of a recording. */
+  copy_head(path, cut, size);
+  FILE* f = fopen(cut, "ab");
+  fputs("junk", f);
+  fclose(f);
+  assert_int_equal(replay_count(cut, &last, NULL, 0), 30);
+  assert_int_equal(last, MICA_ERR_PARSE);
+
+  /* A recording of libmica 0.6 (format 1) has no end entry: its replay ends where the file ends,
+   * cut short or not, as 0.6 replayed it. Made from today's format, which differs only by the end
+   * entry. */
+  copy_head(path, cut, size - kEndEntryBytes);
+  f = fopen(cut, "r+b");
+  const uint32_t version = 1;
+  fseek(f, 8, SEEK_SET); /* after the magic "MICAREC1" */
+  fwrite(&version, sizeof version, 1, f);
+  fclose(f);
+  assert_int_equal(replay_count(cut, &last, NULL, 0), 30);
+  assert_int_equal(last, MICA_OK);
+  assert_int_equal(truncate(cut, size - kEndEntryBytes - 4), 0); /* cut inside the last step */
+  assert_int_equal(replay_count(cut, &last, NULL, 0), 29);
+  assert_int_equal(last, MICA_OK);
+
+  /* Destroying the world ends its recording as mica_world_record_stop does. */
+  box_scene s;
+  mica_world* w = new_recorded_world(path, &s);
+  for (int32_t k = 0; k < 3; ++k) OK(w, mica_step(w, kDt));
+  mica_world_destroy(w);
+  assert_int_equal(replay_count(path, &last, NULL, 0), 3);
   assert_int_equal(last, MICA_OK);
   remove(path);
+  remove(cut);
 }
 
 static void test_bad_calls_and_files(void** state) {
@@ -373,6 +454,7 @@ int main(void) {
       cmocka_unit_test(test_restored_state_replays_bit_for_bit),
       cmocka_unit_test(test_grasp_device_session_replays_bit_for_bit),
       cmocka_unit_test(test_divergence_and_truncation_are_reported),
+      cmocka_unit_test(test_cut_recording_is_reported),
       cmocka_unit_test(test_bad_calls_and_files),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

@@ -1,8 +1,9 @@
 /* SPDX-License-Identifier: Apache-2.0 */
-/* Node state, saved states and the contacts readout through the C API (issue 15):
+/* Node state, saved states and the contacts readout through the C API:
  *  - set positions and velocities read back exactly; a body put back at rest stays at rest;
  *  - save, step 50, restore, step 50 again: the same positions and tool forces, bit for bit
- *    (default solver and MICA_SOLVER_DIRECT; also restored into a fresh world built alike);
+ *    (default solver and MICA_SOLVER_DIRECT; also restored into a fresh world built alike); the
+ *    same from a state saved before the first step;
  *    a state of another world shape, or a truncated one, is refused and the world is unchanged;
  *  - the contact impulses of a step add up to the tool force (sphere and box, with and without
  *    friction). */
@@ -164,6 +165,23 @@ static void test_replay_default_solver(void** st) {
 static void test_replay_direct_solver(void** st) {
   (void)st;
   check_replay(MICA_SOLVER_DIRECT, 0);
+}
+
+/* A state saved before the first step (a checkpoint of the scene as built) restores, and the run
+ * from it repeats bit for bit. */
+static void test_state_before_first_step(void** st) {
+  (void)st;
+  scene s = make_scene(MICA_SOLVER_MICA, 3, 1, 0);
+  size_t bytes = 0;
+  void* state = save(&s, &bytes);
+  record first = run(&s, 0, 20);
+  OK(s.world, mica_world_restore_state(s.world, state, bytes));
+  record again = run(&s, 0, 20);
+  assert_same_run(&s, &first, &again, 20);
+  free(state);
+  free_record(&first);
+  free_record(&again);
+  mica_world_destroy(s.world);
 }
 
 /* A state is refused, with the world unchanged, by a world of another shape and when truncated. */
@@ -484,6 +502,7 @@ int main(void) {
       cmocka_unit_test(test_rest_stays_still),
       cmocka_unit_test(test_replay_default_solver),
       cmocka_unit_test(test_replay_direct_solver),
+      cmocka_unit_test(test_state_before_first_step),
       cmocka_unit_test(test_restore_refusals),
       cmocka_unit_test(test_device_filter_restores),
       cmocka_unit_test(test_contacts_sum_to_tool_force),

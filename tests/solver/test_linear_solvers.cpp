@@ -2,7 +2,8 @@
 // The linear solvers of one body's projected system (S A S + I - S) y = S (b - A z), v = y + z:
 // CHOLMOD (DirectSolver) against a dense Cholesky of the same matrix (also as the nodes held still
 // change, which the factor leaves out), and projected PCG
-// (PcgSolver) against CHOLMOD, for solve and solve_homogeneous; PCG stops at its deadline.
+// (PcgSolver) against CHOLMOD, for solve and solve_homogeneous; PCG stops at its deadline. A matrix
+// that is not positive definite is an error naming CHOLMOD's reason, and CHOLMOD prints nothing.
 #include <unistd.h>
 
 #include <cstdio>
@@ -92,6 +93,8 @@ static void test_direct_follows_the_held_nodes(void**) {
   assert_true(nonzeros[2] == nonzeros[0]);  // a sliding node keeps its couplings
 }
 
+// Not positive definite (A negated): Errc::Numerical, and nothing on stdout or stderr (a library
+// does not write to its host's streams; CHOLMOD prints its warnings unless told not to).
 static void test_pcg_matches_direct(void**) {
   SolverProblem p(0, 3, false);
   const ProjectedSystem sys{p.fem.pattern, p.A, p.projection};

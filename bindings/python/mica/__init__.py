@@ -551,8 +551,9 @@ class Replay:
     def step(self) -> bool:
         """Makes the recorded calls up to the next step, then that step, and checks its results
         against the recording. Returns True when a step was replayed, False at the end of the
-        recording. Raises MicaError (MICA_ERR_DIVERGED, MICA_ERR_PARSE, or the error the step
-        had when recorded); a step that did not converge when recorded warns, as World.step()."""
+        recording. Raises MicaError (MICA_ERR_DIVERGED, MICA_ERR_TRUNCATED for a recording cut
+        short, MICA_ERR_PARSE, or the error the step had when recorded); a step that did not
+        converge when recorded warns, as World.step()."""
         handle = self.handle
         self.world._view_epoch += 1
         stepped = c_int32()

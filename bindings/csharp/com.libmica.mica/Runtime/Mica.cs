@@ -440,7 +440,8 @@ namespace LibMica
         /// of the recording; World.LastStatus has the step's status (a warning such as
         /// MICA_WARN_NOT_CONVERGED if it had one when recorded). Throws MicaException:
         /// MICA_ERR_DIVERGED when the step does not reproduce the recording (the message names
-        /// the step), MICA_ERR_PARSE for a corrupt entry.</summary>
+        /// the step), MICA_ERR_TRUNCATED when the recording was cut short (after its whole
+        /// steps), MICA_ERR_PARSE for a corrupt entry.</summary>
         public bool Step()
         {
             int stepped;

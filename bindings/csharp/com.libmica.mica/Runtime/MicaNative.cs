@@ -41,6 +41,7 @@ namespace LibMica
         public const int MICA_ERR_OUT_OF_MEMORY = -15;
         public const int MICA_ERR_INTERNAL = -16;
         public const int MICA_ERR_DIVERGED = -17;
+        public const int MICA_ERR_TRUNCATED = -18;
 
         public const ulong MICA_NULL_ID = 0;
 
