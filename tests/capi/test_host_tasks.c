@@ -3,8 +3,7 @@
  * pthread one here, as an engine's would be) moves its bodies and tool bit for bit as the same
  * world on its own workers, whatever the host's worker count, whether the host helps inside
  * finish_task or runs every range inside enqueue_task; the callbacks are called as mica.h says;
- * a def with half a job system, or a worker count without one, is refused naming the field; a def
- * from a header without the fields steps on the world's own workers. */
+ * a def from a header without the fields steps on the world's own workers. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -263,36 +262,10 @@ static void test_one_worker_never_calls_the_host(void** state) {
   assert_int_equal(js.finished, 0);
 }
 
-static void expect_refused(const mica_world_def* def, const char* field) {
-  mica_world* w = NULL;
-  assert_int_equal(mica_world_create(def, &w), MICA_ERR_INVALID_ARGUMENT);
-  assert_null(w);
-  if (!strstr(mica_world_last_error(NULL), field))
-    fail_msg("the refusal does not name %s: %s", field, mica_world_last_error(NULL));
-}
-
-static void test_half_a_job_system_is_refused(void** state) {
+/* The defaults: no job system (tests/capi/test_bad_input_world.c refuses half of one). */
+static void test_defaults_have_no_job_system(void** state) {
   (void)state;
-  job_system js;
-  mica_world_def def = mica_world_def_default();
-  use_job_system(&def, &js, 2);
-  def.finish_task = NULL;
-  expect_refused(&def, "def->finish_task");
-  use_job_system(&def, &js, 2);
-  def.enqueue_task = NULL;
-  expect_refused(&def, "def->enqueue_task");
-  use_job_system(&def, &js, 0);
-  expect_refused(&def, "def->task_worker_count");
-  use_job_system(&def, &js, -3);
-  expect_refused(&def, "def->task_worker_count");
-  use_job_system(&def, &js, 2);
-  def.threads = 4;
-  expect_refused(&def, "def->threads");
-  def = mica_world_def_default();
-  def.task_worker_count = 2;
-  expect_refused(&def, "def->task_worker_count");
-  /* The defaults: no job system. */
-  def = mica_world_def_default();
+  const mica_world_def def = mica_world_def_default();
   assert_null(def.enqueue_task);
   assert_null(def.finish_task);
   assert_null(def.task_user);
@@ -323,7 +296,7 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_host_steps_match_own_workers),
       cmocka_unit_test(test_one_worker_never_calls_the_host),
-      cmocka_unit_test(test_half_a_job_system_is_refused),
+      cmocka_unit_test(test_defaults_have_no_job_system),
       cmocka_unit_test(test_older_def_uses_own_workers),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
