@@ -196,6 +196,17 @@ static void assert_same_bits(const run* a, const run* b, const char* what) {
 
 static run reference, hosted; /* large: not on the stack */
 
+/* `def` on a job system of `workers` threads (help, inline_: as job_system_start) with
+ * task_worker_count `count`, compared with `reference`. */
+static void press_on_host(mica_world_def def, job_system* js, int workers, int help, int inline_, int32_t count,
+                          const char* what) {
+  job_system_start(js, workers, help, inline_);
+  use_job_system(&def, js, count);
+  press(&def, &hosted);
+  job_system_stop(js);
+  assert_same_bits(&reference, &hosted, what);
+}
+
 /* threads = 2 on the world's workers against the host's job system, for each MICA sweep (the
  * factored one's loops: rotations and assembly; Gauss-Seidel adds the colour-ordered sweep). */
 static void test_host_steps_match_own_workers(void** state) {
@@ -212,11 +223,7 @@ static void test_host_steps_match_own_workers(void** state) {
     def.threads = 1;
     /* One worker and the stepping thread, as threads = 2. */
     job_system js;
-    job_system_start(&js, 1, 0, 0);
-    use_job_system(&def, &js, 2);
-    press(&def, &hosted);
-    job_system_stop(&js);
-    assert_same_bits(&reference, &hosted, "1 host worker, task_worker_count 2");
+    press_on_host(def, &js, 1, 0, 0, 2, "1 host worker, task_worker_count 2");
     /* The callbacks were called, each task waited for, every range on the worker. */
     assert_true(js.enqueued > STEPS);
     assert_int_equal(js.finished, js.enqueued);
@@ -226,21 +233,13 @@ static void test_host_steps_match_own_workers(void** state) {
 
     /* Three workers, four threads in all, the caller helping in finish_task: the same bits
      * (the work is cut the same whatever the thread count). */
-    job_system_start(&js, 3, 1, 0);
-    use_job_system(&def, &js, 4);
-    press(&def, &hosted);
-    job_system_stop(&js);
-    assert_same_bits(&reference, &hosted, "3 host workers helped by finish_task, task_worker_count 4");
+    press_on_host(def, &js, 3, 1, 0, 4, "3 host workers helped by finish_task, task_worker_count 4");
     assert_int_equal(js.finished, js.enqueued);
     assert_int_equal(js.largest_item_count, 3);
     assert_int_equal(js.bad_calls, 0);
 
     /* A host that runs the task inside enqueue_task and returns NULL: finish_task is not called. */
-    job_system_start(&js, 0, 0, 1);
-    use_job_system(&def, &js, 2);
-    press(&def, &hosted);
-    job_system_stop(&js);
-    assert_same_bits(&reference, &hosted, "the task run inside enqueue_task");
+    press_on_host(def, &js, 0, 0, 1, 2, "the task run inside enqueue_task");
     assert_true(js.enqueued > STEPS);
     assert_int_equal(js.finished, 0);
   }
@@ -253,11 +252,7 @@ static void test_one_worker_never_calls_the_host(void** state) {
   def.tolerance = 1e-6;
   press(&def, &reference);
   job_system js;
-  job_system_start(&js, 1, 0, 0);
-  use_job_system(&def, &js, 1);
-  press(&def, &hosted);
-  job_system_stop(&js);
-  assert_same_bits(&reference, &hosted, "task_worker_count 1");
+  press_on_host(def, &js, 1, 0, 0, 1, "task_worker_count 1");
   assert_int_equal(js.enqueued, 0);
   assert_int_equal(js.finished, 0);
 }
