@@ -241,15 +241,15 @@ typedef struct mica_world_def {
   /* Since 0.7: the host's job system (docs/embedding.md, "Running on the host's job system"). */
   /** The workers of the host's job system that may run a step's loops at once, the thread in
    *  mica_step included: with enqueue_task set, it takes the place of `threads` (leave that at 1),
-   *  >= 1 (1: the serial code, the callbacks are never called). Default 0, and 0 without
-   *  enqueue_task. */
+   *  >= 1 (1: the serial code, the callbacks are never called). Default 0, the only value
+   *  accepted without enqueue_task. */
   int32_t task_worker_count;
   int32_t reserved4;       /**< zero */
   /** Optional, with finish_task (both or neither): the step's parallel loops (rotations, element
    *  assembly, the colour-ordered sweep) run on the host's workers instead of workers the world
    *  makes; with the same results, bit for bit, as `threads` = task_worker_count. Each loop is
-   *  one task of at most task_worker_count - 1 items; an item is a helper, not a share of the
-   *  work: any range joins the loop the thread in mica_step is running, taking its pieces in
+   *  one task of at most task_worker_count - 1 items; an item stands for a worker, not a share of
+   *  the work: any range joins the loop the thread in mica_step is running, taking its pieces in
    *  order until none is left (a range that starts late finds nothing to do), so the ranges may
    *  run in any order or on any thread without a deadlock. A loop waits in finish_task; a step
    *  has a few loops per body and solver iteration, so the host's enqueue and finish should cost

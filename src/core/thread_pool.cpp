@@ -104,14 +104,14 @@ void ThreadPool::run_erased(void (*fn)(void*), void* ctx) {
   spin_while([&] { return active_.load(std::memory_order_seq_cst) != 0; });
 }
 
-// One task of up to size_ - 1 items, each a helper: any range runs the loop body once, taking
+// One task of up to size_ - 1 items, each standing for a worker: any range runs the loop body once, taking
 // chunks in order with the caller until none is left (a range that starts late finds none). A
 // range only waits for chunks that a running thread has claimed, so the host may run the ranges
 // in any order, on any thread, the caller's included (inside enqueue or finish), without a
 // deadlock; and which thread ran a chunk does not change its result.
 void ThreadPool::run_on_host() {
-  const int32_t helpers = std::min(size_, chunks_) - 1;
-  void* const handle = host_.enqueue(&ThreadPool::host_range, helpers, 1, this, host_.user);
+  const int32_t workers = std::min(size_, chunks_) - 1;
+  void* const handle = host_.enqueue(&ThreadPool::host_range, workers, 1, this, host_.user);
   [&]() noexcept { fn_(ctx_); }();
   if (handle) host_.finish(handle, host_.user);  // null: the host ran every range in enqueue
   wait_completed(chunks_);  // done already; orders the ranges' writes before the caller's reads
