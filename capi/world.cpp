@@ -37,6 +37,30 @@ mica_world_def world_defaults() {
   return d;
 }
 
+// Since 0.7: the host's job system in place of the world's own workers.
+void host_tasks(const mica_world_def& d, mica::WorldSettings& s) {
+  if (!d.enqueue_task != !d.finish_task)
+    refuse(MICA_ERR_INVALID_ARGUMENT, d.enqueue_task ? "def->finish_task is NULL but def->enqueue_task is set: give both or neither"
+                                                     : "def->enqueue_task is NULL but def->finish_task is set: give both or neither");
+  const std::string count = std::to_string(d.task_worker_count);
+  if (!d.enqueue_task) {
+    if (d.task_worker_count != 0)
+      refuse(MICA_ERR_INVALID_ARGUMENT, "def->task_worker_count is " + count + " but def->enqueue_task is NULL: leave it at 0, "
+                                        "or give the host's job system");
+    return;
+  }
+  if (d.task_worker_count < 1 || d.task_worker_count > mica::kMaxThreads)
+    refuse(MICA_ERR_INVALID_ARGUMENT, "def->task_worker_count is " + count + ": with def->enqueue_task set it must be the host's "
+                                      "worker count, in 1.." + std::to_string(mica::kMaxThreads));
+  if (d.threads != 1)
+    refuse(MICA_ERR_INVALID_ARGUMENT, "def->threads is " + std::to_string(d.threads) + ": with def->enqueue_task set the step's "
+                                      "threads are def->task_worker_count (leave threads at 1)");
+  s.threads = d.task_worker_count;
+  s.tasks.enqueue = d.enqueue_task;
+  s.tasks.finish = d.finish_task;
+  s.tasks.user = d.task_user;
+}
+
 // The C values into the core's settings; the core validates the numbers (mica::validate).
 mica::WorldSettings translate(const mica_world_def& d) {
   mica::WorldSettings s;
@@ -63,6 +87,7 @@ mica::WorldSettings translate(const mica_world_def& d) {
   s.relaxation = d.relaxation;
   s.time_budget_ms = d.time_budget_ms;
   s.threads = d.threads;
+  host_tasks(d, s);
   s.relinearise_tolerance = d.relinearise_tolerance;
   s.relinearise_max = d.relinearise_max;
   s.refactor_interval = d.refactor_interval;

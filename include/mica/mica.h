@@ -153,6 +153,26 @@ typedef void (*mica_log_fn)(int32_t level, const char* message, void* user);
  *  background (docs/solvers.md). The default. */
 #define MICA_SWEEP_FACTORED 1
 
+/** A task of the host's job system (since 0.7): libmica's function that runs the items
+ *  [start_index, end_index) of a task, given with the task's `task_context`. Called by a worker
+ *  of the host's job system (or by the thread that stepped, inside ::mica_enqueue_task_fn or
+ *  ::mica_finish_task_fn). */
+typedef void (*mica_task_fn)(int32_t start_index, int32_t end_index, void* task_context);
+/** Hands a task to the host's job system (since 0.7): the host must call `task` on ranges that
+ *  together cover the items [0, item_count) once each, each range at least `min_range` items long
+ *  (but the last), on its workers, in any order, concurrently or not, then return a handle for
+ *  ::mica_finish_task_fn. Or it may run every range before returning and return NULL (then
+ *  finish_task is not called for it). Called on the thread in mica_step, and only there, one
+ *  task of a world at a time (its finish_task comes before the next enqueue_task). `user` is
+ *  mica_world_def.task_user. Must not throw or call into the world. */
+typedef void* (*mica_enqueue_task_fn)(mica_task_fn task, int32_t item_count, int32_t min_range,
+                                      void* task_context, void* user);
+/** Waits for a task (since 0.7): returns once every range of the task `handle` names (the
+ *  non-NULL return of ::mica_enqueue_task_fn) has returned, their writes visible to the caller.
+ *  It may run ranges (the task's or others) on the calling thread meanwhile. Called on the thread
+ *  in mica_step, once per non-NULL handle. Must not throw or call into the world. */
+typedef void (*mica_finish_task_fn)(void* handle, void* user);
+
 /** How to create a world: fill with mica_world_def_default(), then change fields. */
 typedef struct mica_world_def {
   uint32_t struct_size;    /**< sizeof(mica_world_def) as the caller compiled it */
@@ -192,7 +212,8 @@ typedef struct mica_world_def {
   /** Threads for the step (rotations, element assembly, a colour-ordered Gauss-Seidel sweep):
    *  1 (default) runs the serial code and the paper's sweep order; 0 every CPU the process may
    *  run on; n > 1 starts n - 1 workers owned by the world (they sleep between steps). See
-   *  docs/performance.md before raising it: a haptic host also needs a core for the servo loop. */
+   *  docs/performance.md before raising it: a haptic host also needs a core for the servo loop.
+   *  A host with its own job system sets task_worker_count and enqueue_task instead (since 0.7). */
   int32_t threads;
   /** Co-rotational bodies: a step linearised at its start's rotations can gain energy when
    *  elements turn far within it. When a step gained more than this fraction of the bodies'
@@ -218,6 +239,28 @@ typedef struct mica_world_def {
    *  is kept until the step ends and then reused as the next one's storage: one factor's
    *  memory more.) */
   int32_t refactor_interval;
+  /* Since 0.7: the host's job system (docs/embedding.md, "Running on the host's job system"). */
+  /** The workers of the host's job system that may run a step's loops at once, the thread in
+   *  mica_step included: with enqueue_task set, it takes the place of `threads` (leave that at 1),
+   *  >= 1 (1: the serial code, the callbacks are never called). Default 0, the only value
+   *  accepted without enqueue_task. */
+  int32_t task_worker_count;
+  int32_t reserved4;       /**< zero */
+  /** Optional, with finish_task (both or neither): the step's parallel loops (rotations, element
+   *  assembly, the colour-ordered sweep) run on the host's workers instead of workers the world
+   *  makes; with the same results, bit for bit, as `threads` = task_worker_count. Each loop is
+   *  one task of at most task_worker_count - 1 items; an item stands for a worker, not a share of
+   *  the work: any range joins the loop the thread in mica_step is running, taking its pieces in
+   *  order until none is left (a range that starts late finds nothing to do), so the ranges may
+   *  run in any order or on any thread without a deadlock. A loop waits in finish_task; a step
+   *  has a few loops per body and solver iteration, so the host's enqueue and finish should cost
+   *  microseconds. The world then starts no thread for a step, except the factor refresh's
+   *  (`refactor_interval` > 0: a factorization outlasts several steps, which a host's job
+   *  system expects of none of its tasks, so it stays on the body's own "mica-factor" thread;
+   *  default 0: no such thread). Default NULL. */
+  mica_enqueue_task_fn enqueue_task;
+  mica_finish_task_fn finish_task; /**< waits for a task enqueue_task returned; default NULL */
+  void* task_user;                 /**< passed to enqueue_task and finish_task */
 } mica_world_def;
 
 /** Fills `def` with defaults, writing only its first `struct_size` bytes, and records

@@ -34,7 +34,8 @@ void spin_while(P waiting) {
 
 }  // namespace
 
-ThreadPool::ThreadPool(int32_t threads) : size_(threads < 1 ? 1 : threads) {
+ThreadPool::ThreadPool(int32_t threads, const HostTasks& host) : size_(threads < 1 ? 1 : threads), host_(host) {
+  if (host_.enqueue) return;  // the host's workers join each loop
   workers_.reserve(size_t(size_ - 1));
   for (int32_t t = 1; t < size_; ++t) workers_.emplace_back([this] { worker(); });
 }
@@ -81,9 +82,13 @@ void ThreadPool::run_erased(void (*fn)(void*), void* ctx) {
     [&]() noexcept { fn(ctx); }();
     return;
   }
-  // Open the loop (it publishes fn_, ctx_ and the counters), then wake whoever sleeps.
   fn_ = fn;
   ctx_ = ctx;
+  if (host_.enqueue) {
+    run_on_host();
+    return;
+  }
+  // Open the loop (it publishes fn_, ctx_ and the counters), then wake whoever sleeps.
   {
     std::lock_guard<std::mutex> lock(mutex_);
     const uint64_t g = generation_.load(std::memory_order_relaxed) + 1;
@@ -97,6 +102,24 @@ void ThreadPool::run_erased(void (*fn)(void*), void* ctx) {
   // those that came in time to leave.
   open_.store(0, std::memory_order_seq_cst);
   spin_while([&] { return active_.load(std::memory_order_seq_cst) != 0; });
+}
+
+// One task of up to size_ - 1 items, each standing for a worker: any range runs the loop body once, taking
+// chunks in order with the caller until none is left (a range that starts late finds none). A
+// range only waits for chunks that a running thread has claimed, so the host may run the ranges
+// in any order, on any thread, the caller's included (inside enqueue or finish), without a
+// deadlock; and which thread ran a chunk does not change its result.
+void ThreadPool::run_on_host() {
+  const int32_t workers = std::min(size_, chunks_) - 1;
+  void* const handle = host_.enqueue(&ThreadPool::host_range, workers, 1, this, host_.user);
+  [&]() noexcept { fn_(ctx_); }();
+  if (handle) host_.finish(handle, host_.user);  // null: the host ran every range in enqueue
+  wait_completed(chunks_);  // done already; orders the ranges' writes before the caller's reads
+}
+
+void ThreadPool::host_range(int32_t, int32_t, void* pool) {
+  ThreadPool& p = *static_cast<ThreadPool*>(pool);
+  [&]() noexcept { p.fn_(p.ctx_); }();
 }
 
 void ThreadPool::worker() {

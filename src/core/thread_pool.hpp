@@ -19,6 +19,10 @@
 // which chunk: chunks of one phase write disjoint data, and per-chunk sums are added in chunk
 // order afterwards; as chunks are cut independently of the thread count, neither does it
 // depend on the number of threads.
+//
+// A host with its own job system (a game engine's) lends its workers instead (HostTasks): the
+// pool then starts no thread, and each loop is handed to the host as one task whose ranges join
+// the loop as workers would. The chunks, and so the results, are the same bits either way.
 #pragma once
 #include <algorithm>
 #include <atomic>
@@ -31,10 +35,20 @@
 
 namespace mica {
 
+// A host's job system: mica_world_def's enqueue_task, finish_task and task_user (mica.h says
+// what each must do). Set, a pool starts no thread of its own.
+struct HostTasks {
+  using Task = void (*)(int32_t start, int32_t end, void* context);
+  void* (*enqueue)(Task task, int32_t item_count, int32_t min_range, void* context, void* user) = nullptr;
+  void (*finish)(void* handle, void* user) = nullptr;
+  void* user = nullptr;
+};
+
 class ThreadPool {
  public:
-  // threads >= 1 in all, the caller included (threads - 1 workers are started).
-  explicit ThreadPool(int32_t threads);
+  // threads >= 1 in all, the caller included: threads - 1 workers are started, or, with a
+  // host's job system, its workers join each loop (at most threads - 1 of them).
+  explicit ThreadPool(int32_t threads, const HostTasks& host = {});
   ~ThreadPool();
   ThreadPool(const ThreadPool&) = delete;
   ThreadPool& operator=(const ThreadPool&) = delete;
@@ -93,10 +107,13 @@ class ThreadPool {
 
   bool prepare(const int32_t* start, int32_t phases, int32_t grain);
   void run_erased(void (*fn)(void*), void* ctx);
+  void run_on_host();
+  static void host_range(int32_t start, int32_t end, void* pool);
   void wait_completed(int32_t chunks) const;
   void worker();
 
   int32_t size_;
+  HostTasks host_;                       // enqueue set: the host's workers, none of our own
   std::vector<std::thread> workers_;
   std::mutex mutex_;
   std::condition_variable wake_;

@@ -59,6 +59,8 @@ void validate(const WorldSettings& s) {
           "the body friction coefficient must be finite and >= 0");
   require(s.threads >= 0 && s.threads <= kMaxThreads, "threads must be in 0.." + std::to_string(kMaxThreads) +
                                                           " (0: every CPU), got " + std::to_string(s.threads));
+  require(!s.tasks.enqueue == !s.tasks.finish, "a host's job system needs both enqueue and finish");
+  require(!s.tasks.enqueue || s.threads >= 1, "threads must be >= 1 on a host's job system (its worker count)");
   require(s.relinearise_tolerance >= 0 && std::isfinite(s.relinearise_tolerance),
           "relinearise_tolerance must be finite and >= 0");
 }
@@ -66,7 +68,7 @@ void validate(const WorldSettings& s) {
 World::World(const WorldSettings& settings) : settings_(settings) {
   validate(settings);
   const int32_t threads = ThreadPool::resolve(settings.threads);
-  if (threads > 1) pool_ = std::make_unique<ThreadPool>(threads);
+  if (threads > 1) pool_ = std::make_unique<ThreadPool>(threads, settings.tasks);
   solver_ = make_velocity_solver(settings.solver, settings.mica_sweep, settings);
 }
 

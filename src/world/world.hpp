@@ -54,6 +54,7 @@ struct WorldSettings : SolverSettings {
   // a colour's nodes in parallel. The colour order changes MICA's iterates (not its fixed point)
   // against the paper's natural order; results do not depend on the count once it is above 1.
   int32_t threads = 1;
+  HostTasks tasks;  // set: the host's job system lends the threads - 1 workers (else the world makes them)
   // Co-rotational bodies: the step is linearised with the element rotations of its start, which
   // can add energy when elements turn far within one step. After each solve the energy the step
   // gained beyond the work done on the bodies is checked (summed over the steps since the energy

@@ -291,6 +291,29 @@ class Behaviour(unittest.TestCase):
                 sheet.update()
             self.assertEqual(e.exception.status, mica.MICA_ERR_STALE_ID)
 
+    def test_host_job_system_as_raw_callbacks(self):
+        """enqueue_task and finish_task as ctypes callbacks: the same bits as threads = 2."""
+        calls = []
+
+        def enqueue(task, item_count, min_range, context, user):
+            calls.append(item_count)
+            task(0, item_count, context)  # every range here, then NULL: no finish_task
+            return None
+
+        def run(**fields):
+            with mica.World(gravity=(0, -9.81, 0), **fields) as world:
+                body = world.create_box((0, 0, 0), (0.1, 0.1, 0.1), (3, 3, 3), youngs_modulus=2e4)
+                body.add_lpc(body.select_nodes_by_plane((0, 0, 0), (0, 1, 0)))
+                for _ in range(3):
+                    world.step(0.01)
+                return body.get_positions()
+
+        own = run(threads=2)
+        hosted = run(task_worker_count=2, enqueue_task=native.mica_enqueue_task_fn(enqueue),
+                     finish_task=native.mica_finish_task_fn(lambda handle, user: None))
+        np.testing.assert_array_equal(hosted, own)
+        self.assertTrue(calls and set(calls) == {1}, calls)
+
     def test_a_trajectory_of_the_wrong_length_is_reported(self):
         # The trajectory runs inside a C callback: its error goes to sys.unraisablehook.
         reported = []

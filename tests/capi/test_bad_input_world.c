@@ -113,6 +113,39 @@ static const int32_t kBadSweepKind[] = {2, -1, INT32_MAX};
 static void mica_sweep(mica_world_def* d, int i) { d->mica_sweep = kBadSweepKind[i]; }
 static const int32_t kBadSolver[] = {99, -1, MICA_SOLVER_MICA + 1, INT32_MIN};
 static void solver(mica_world_def* d, int i) { d->solver = kBadSolver[i]; }
+/* A host's job system (never called: every def below is refused). */
+static void* enqueue_nothing(mica_task_fn task, int32_t items, int32_t min_range, void* context, void* user) {
+  (void)task, (void)items, (void)min_range, (void)context, (void)user;
+  return NULL;
+}
+static void finish_nothing(void* handle, void* user) { (void)handle, (void)user; }
+static void job_system(mica_world_def* d, int32_t worker_count) {
+  d->enqueue_task = enqueue_nothing;
+  d->finish_task = finish_nothing;
+  d->task_worker_count = worker_count;
+}
+static void enqueue_only(mica_world_def* d, int i) {
+  (void)i;
+  job_system(d, 2);
+  d->finish_task = NULL;
+}
+static void finish_only(mica_world_def* d, int i) {
+  (void)i;
+  job_system(d, 2);
+  d->enqueue_task = NULL;
+}
+static const int32_t kBadWorkerCount[] = {0, -1, 1025, INT32_MIN};
+static void task_worker_count(mica_world_def* d, int i) {
+  if (i < (int)COUNT_OF(kBadWorkerCount))
+    job_system(d, kBadWorkerCount[i]);
+  else
+    d->task_worker_count = 2; /* without a job system */
+}
+static const int32_t kThreadsBesideJobs[] = {0, 2, 4};
+static void threads_beside_jobs(mica_world_def* d, int i) {
+  job_system(d, 2);
+  d->threads = kThreadsBesideJobs[i];
+}
 static const uint32_t kOtherVersion[] = {(MICA_VERSION_MAJOR + 1) * 10000u + MICA_VERSION_MINOR * 100u,
                                          (MICA_VERSION_MAJOR + 1) * 10000u, 990000u, UINT32_MAX};
 static void header_version(mica_world_def* d, int i) { d->header_version = kOtherVersion[i]; }
@@ -168,6 +201,14 @@ static const bad_case kDefCases[] = {
      {.world_def = mica_sweep}, NO_WORLD},
     {"mica_world_create: solver", create_spoiled, MICA_ERR_INVALID_ARGUMENT, "solver", COUNT_OF(kBadSolver),
      {.world_def = solver}, NO_WORLD},
+    {"mica_world_create: enqueue_task without finish_task", create_spoiled, MICA_ERR_INVALID_ARGUMENT,
+     "def->finish_task is NULL", 1, {.world_def = enqueue_only}, NO_WORLD},
+    {"mica_world_create: finish_task without enqueue_task", create_spoiled, MICA_ERR_INVALID_ARGUMENT,
+     "def->enqueue_task is NULL", 1, {.world_def = finish_only}, NO_WORLD},
+    {"mica_world_create: task_worker_count", create_spoiled, MICA_ERR_INVALID_ARGUMENT, "def->task_worker_count",
+     COUNT_OF(kBadWorkerCount) + 1, {.world_def = task_worker_count}, NO_WORLD},
+    {"mica_world_create: threads beside a job system", create_spoiled, MICA_ERR_INVALID_ARGUMENT, "def->threads",
+     COUNT_OF(kThreadsBesideJobs), {.world_def = threads_beside_jobs}, NO_WORLD},
     {"mica_world_create: struct_size", create_with_bad_size, MICA_ERR_STRUCT_SIZE, "struct_size", 3,
      .no_world = NO_WORLD},
     {"mica_world_def_init: struct_size", def_init_with_bad_size, MICA_ERR_STRUCT_SIZE, NULL, 3, .with.arg = WORLD_DEF,

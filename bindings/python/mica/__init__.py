@@ -302,7 +302,8 @@ class World:
                  log: Optional[Callable[[int, str], None]] = None, **fields: Any) -> None:
         d = definition if definition is not None else world_def()
         _fill(d, fields)
-        self._keepalive = []  # callbacks the library may call while the world exists
+        # Callbacks the library may call while the world exists (log, enqueue_task, finish_task).
+        self._keepalive = [v for v in fields.values() if isinstance(v, ctypes._CFuncPtr)]
         if log is not None:
             def on_log(level, message, user):
                 log(level, message.decode(errors="replace"))

@@ -121,6 +121,9 @@ mica_replay_p = c_void_p  # opaque mica_replay*
 # --- Callback types (the C calling convention of the platform)
 mica_log_fn = CFUNCTYPE(None, c_int32, c_char_p, c_void_p)
 mica_trajectory_fn = CFUNCTYPE(None, c_double, POINTER(c_double), c_void_p)
+mica_task_fn = CFUNCTYPE(None, c_int32, c_int32, c_void_p)
+mica_enqueue_task_fn = CFUNCTYPE(c_void_p, mica_task_fn, c_int32, c_int32, c_void_p, c_void_p)
+mica_finish_task_fn = CFUNCTYPE(None, c_void_p, c_void_p)
 
 
 # --- Structs (mica.h)
@@ -152,6 +155,11 @@ class mica_world_def(Structure):
         ("relinearise_tolerance", c_double),
         ("relinearise_max", c_int32),
         ("refactor_interval", c_int32),
+        ("task_worker_count", c_int32),
+        ("reserved4", c_int32),
+        ("enqueue_task", mica_enqueue_task_fn),
+        ("finish_task", mica_finish_task_fn),
+        ("task_user", c_void_p),
     ]
 
 

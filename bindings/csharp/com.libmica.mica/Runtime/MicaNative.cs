@@ -122,6 +122,16 @@ namespace LibMica
         public delegate void mica_trajectory_fn(double t, double* position, IntPtr user);
 
         [UnmanagedFunctionPointer(CallingConvention.Cdecl)]
+        public delegate void mica_task_fn(int start_index, int end_index, IntPtr task_context);
+
+        // `task` is libmica's mica_task_fn (Marshal.GetDelegateForFunctionPointer to call it).
+        [UnmanagedFunctionPointer(CallingConvention.Cdecl)]
+        public delegate IntPtr mica_enqueue_task_fn(IntPtr task, int item_count, int min_range, IntPtr task_context, IntPtr user);
+
+        [UnmanagedFunctionPointer(CallingConvention.Cdecl)]
+        public delegate void mica_finish_task_fn(IntPtr handle, IntPtr user);
+
+        [UnmanagedFunctionPointer(CallingConvention.Cdecl)]
         public delegate int mica_device_open_fn(IntPtr user);
 
         [UnmanagedFunctionPointer(CallingConvention.Cdecl)]
@@ -166,6 +176,11 @@ namespace LibMica
             public double relinearise_tolerance;
             public int relinearise_max;
             public int refactor_interval;
+            public int task_worker_count;
+            public int reserved4;
+            public IntPtr enqueue_task;
+            public IntPtr finish_task;
+            public IntPtr task_user;
         }
 
         [StructLayout(LayoutKind.Sequential)]
