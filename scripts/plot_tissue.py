@@ -109,7 +109,7 @@ def draw_body(ax, cax, nodes, tets, von_mises, centre, radius, surface_y, cut, e
     if cut:
         ball = ball[ball.mean(axis=1)[:, 1] > -1e3 * centre[2]]
     ball_normal = unit(np.cross(ball[:, 1] - ball[:, 0], ball[:, 2] - ball[:, 0]))
-    ball_colours = np.tile([0.45, 0.55, 0.75, 0.2 if cut else 0.5], (len(ball), 1))
+    ball_colours = np.tile([0.45, 0.55, 0.75, 0.2 if cut else 0.3], (len(ball), 1))
     ball_colours[:, :3] *= (0.5 + 0.5 * np.abs(ball_normal @ light))[:, None]
 
     # Edges in the faces' own colours hide the seams antialiasing leaves between them.
