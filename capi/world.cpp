@@ -239,11 +239,15 @@ MICA_API mica_status mica_world_get_ids(const mica_world* world, int32_t kind, u
                                         int32_t* out_count) {
   return guarded(world, "mica_world_get_ids", [&] {
     require(world, "world");
-    if (kind < MICA_OBJECT_BODY || kind > MICA_OBJECT_DEVICE)
+    if (kind < MICA_OBJECT_BODY || kind > MICA_OBJECT_EMBEDDING)
       refuse(MICA_ERR_INVALID_ARGUMENT, "kind is " + std::to_string(kind) + ", not a MICA_OBJECT_* value");
-    static_assert(MICA_OBJECT_BODY == int(mica::IdKind::Body) && MICA_OBJECT_DEVICE == int(mica::IdKind::Device),
+    static_assert(MICA_OBJECT_BODY == int(mica::IdKind::Body) && MICA_OBJECT_DEVICE == int(mica::IdKind::Device) &&
+                      MICA_OBJECT_EMBEDDING == int(mica::IdKind::Embedding),
                   "the C object kinds are the core's id kinds");
-    const std::vector<uint64_t> ids = world->world.ids(mica::IdKind(kind));
+    std::vector<uint64_t> ids = world->world.ids(mica::IdKind(kind));
+    // The embeddings are the C layer's (capi/embedding.cpp), not the core world's.
+    if (kind == MICA_OBJECT_EMBEDDING)
+      world->embeddings.for_each([&](uint64_t id, const mica::Embedding&) { ids.push_back(id); });
     return copy_out(ids.data(), int32_t(ids.size()), 1, out, capacity, out_count);
   });
 }

@@ -390,8 +390,8 @@ function World:restore_state(state)
   self:check(C.mica_world_restore_state(self.ptr, state, #state))
 end
 
--- Since 0.6: the ids of the world's live objects of one kind (C.MICA_OBJECT_BODY, _LPC, _TOOL or
--- _DEVICE), in slot order: a uint64_t array (0-based) and its count.
+-- Since 0.6: the ids of the world's live objects of one kind (C.MICA_OBJECT_BODY, _LPC, _TOOL,
+-- _DEVICE or, since 0.7, _EMBEDDING), in slot order: a uint64_t array (0-based) and its count.
 function World:ids(kind)
   local count = ffi.new("int32_t[1]")
   self:check(C.mica_world_get_ids(self.ptr, kind, nil, 0, count))

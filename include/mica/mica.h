@@ -1090,14 +1090,15 @@ MICA_API mica_status mica_world_get_contacts(const mica_world* world, mica_conta
 #define MICA_OBJECT_LPC 2    /**< mica_world_get_ids(): constraints (since 0.6) */
 #define MICA_OBJECT_TOOL 3   /**< mica_world_get_ids(): tools (since 0.6) */
 #define MICA_OBJECT_DEVICE 4 /**< mica_world_get_ids(): devices (since 0.6) */
+#define MICA_OBJECT_EMBEDDING 5 /**< mica_world_get_ids(): embedded meshes (since 0.7) */
 
 /** The ids of the world's live objects of one kind (since 0.6): what a tool that did not build the
  *  world (an inspector, the replay tool) needs to read it. In slot order: creation order until an
  *  object of the kind is destroyed (a later one may then take its slot). The world's thread.
  *  @param world the world (not changed).
- *  @param kind MICA_OBJECT_BODY, _LPC, _TOOL or _DEVICE.
- *  @param out the caller's buffer (mica_body_id, mica_lpc_id, mica_tool_id or mica_device_id
- *         values), or NULL to ask for the count only. @param capacity its size in ids.
+ *  @param kind MICA_OBJECT_BODY, _LPC, _TOOL, _DEVICE or _EMBEDDING.
+ *  @param out the caller's buffer (mica_body_id, mica_lpc_id, mica_tool_id, mica_device_id or
+ *         mica_embedding_id values), or NULL to ask for the count only. @param capacity its size in ids.
  *  @param out_count receives the count (may be NULL when `out` is not).
  *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world`, or both `out` and `out_count`, NULL);
  *          MICA_ERR_INVALID_ARGUMENT (an unknown kind, `capacity` < 0); MICA_ERR_BUFFER_TOO_SMALL

@@ -4,7 +4,44 @@
 #include <cmath>
 #include <cstring>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 namespace mica {
+
+namespace {
+
+// Scales normals[3 i .. 3 i + 2] to unit length (or to 0 if it has none).
+void normalize(double* n) {
+  const double length2 = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
+  const double scale = length2 > 0 ? 1 / std::sqrt(length2) : 0;
+  n[0] *= scale;
+  n[1] *= scale;
+  n[2] *= scale;
+}
+
+// Two vertices at a time where SSE2 is there: std::sqrt, which may set errno, is not vectorised
+// by the compiler, and the square root and division were a quarter of the whole update (0.33 ->
+// 0.17 ms for 114k vertices). Bit for bit what normalize() gives.
+void normalize_all(double* normals, int32_t vertex_count) {
+  int32_t i = 0;
+#if defined(__SSE2__)
+  for (; i + 2 <= vertex_count; i += 2) {
+    double* n = normals + 3 * size_t(i);
+    const __m128d length2 =
+        _mm_set_pd(n[3] * n[3] + n[4] * n[4] + n[5] * n[5], n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    const __m128d scale = _mm_and_pd(_mm_cmpgt_pd(length2, _mm_setzero_pd()),
+                                     _mm_div_pd(_mm_set1_pd(1), _mm_sqrt_pd(length2)));
+    const double s0 = _mm_cvtsd_f64(scale), s1 = _mm_cvtsd_f64(_mm_unpackhi_pd(scale, scale));
+    n[0] *= s0, n[1] *= s0, n[2] *= s0;
+    n[3] *= s1, n[4] *= s1, n[5] *= s1;
+  }
+#endif
+  for (; i < vertex_count; ++i) normalize(normals + 3 * size_t(i));
+}
+
+}  // namespace
 
 void vertex_normals(const double* __restrict xyz, int32_t vertex_count, const int32_t* __restrict triangles,
                     int32_t triangle_count, double* __restrict normals) {
@@ -25,14 +62,7 @@ void vertex_normals(const double* __restrict xyz, int32_t vertex_count, const in
     q[0] += n0, q[1] += n1, q[2] += n2;
     r[0] += n0, r[1] += n1, r[2] += n2;
   }
-  for (int32_t i = 0; i < vertex_count; ++i) {
-    double* n = normals + 3 * size_t(i);
-    const double length2 = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
-    const double scale = length2 > 0 ? 1 / std::sqrt(length2) : 0;
-    n[0] *= scale;
-    n[1] *= scale;
-    n[2] *= scale;
-  }
+  normalize_all(normals, vertex_count);
 }
 
 }  // namespace mica

@@ -3,7 +3,8 @@
  * tool, its normals within a degree of the normals of its moved triangles; vertices outside the
  * body are projected within the radius and unbound beyond it (a warning naming them, and left as
  * they were by the update); a vertex that is not finite is refused by index; a destroyed body or
- * embedding is detected; the def and the arguments are checked. */
+ * embedding is detected; the def and the arguments are checked; mica_world_get_ids lists the live
+ * embeddings. */
 #include <stdarg.h>
 #include <stddef.h>
 #include <setjmp.h>
@@ -226,6 +227,36 @@ static void test_def_and_arguments(void** state) {
   mica_world_destroy(w);
 }
 
+/* MICA_OBJECT_EMBEDDING: the live embeddings in creation order, a destroyed one gone, and only
+ * embeddings (no body among them, no embedding among the bodies). */
+static void test_ids_list_the_embeddings(void** state) {
+  (void)state;
+  mica_body_id body;
+  mica_world* w = cube(&body);
+  const double xyz[3] = {0.05, 0.05, 0.05};
+  const mica_embedding_def def = mica_embedding_def_default();
+  mica_embedding_id e[3];
+  uint64_t ids[4];
+  int32_t count = -1;
+  OK(w, mica_world_get_ids(w, MICA_OBJECT_EMBEDDING, NULL, 0, &count));
+  assert_int_equal(count, 0);
+  for (int k = 0; k < 3; ++k) OK(w, mica_embedding_create(w, body, &def, xyz, 1, NULL, 0, &e[k]));
+  OK(w, mica_world_get_ids(w, MICA_OBJECT_EMBEDDING, ids, 4, &count));
+  assert_int_equal(count, 3);
+  for (int k = 0; k < 3; ++k) assert_true(ids[k] == e[k]);
+  assert_int_equal(mica_world_get_ids(w, MICA_OBJECT_EMBEDDING, ids, 2, &count), MICA_ERR_BUFFER_TOO_SMALL);
+  assert_int_equal(count, 3);
+  OK(w, mica_embedding_destroy(w, e[1]));
+  OK(w, mica_world_get_ids(w, MICA_OBJECT_EMBEDDING, ids, 4, &count));
+  assert_int_equal(count, 2);
+  assert_true(ids[0] == e[0] && ids[1] == e[2]);
+  OK(w, mica_world_get_ids(w, MICA_OBJECT_BODY, ids, 4, &count));
+  assert_int_equal(count, 1);
+  assert_true(ids[0] == body);
+  assert_int_equal(mica_world_get_ids(w, MICA_OBJECT_EMBEDDING + 1, ids, 4, &count), MICA_ERR_INVALID_ARGUMENT);
+  mica_world_destroy(w);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_nidus_under_a_tool),
@@ -233,6 +264,7 @@ int main(void) {
       cmocka_unit_test(test_a_vertex_not_finite_is_refused_by_index),
       cmocka_unit_test(test_a_destroyed_body_or_embedding_is_detected),
       cmocka_unit_test(test_def_and_arguments),
+      cmocka_unit_test(test_ids_list_the_embeddings),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

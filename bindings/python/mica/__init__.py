@@ -409,8 +409,9 @@ class World:
         self._check(native.mica_world_restore_state(self.handle, state, len(state)), "mica_world_restore_state")
 
     def ids(self, kind: int) -> list:
-        """The ids (ints) of the live objects of one kind: MICA_OBJECT_BODY, _LPC, _TOOL or
-        _DEVICE, in slot order (creation order until one of the kind is destroyed). Since 0.6."""
+        """The ids (ints) of the live objects of one kind: MICA_OBJECT_BODY, _LPC, _TOOL,
+        _DEVICE or (since 0.7) _EMBEDDING, in slot order (creation order until one of the kind is
+        destroyed). Since 0.6."""
         n = c_int32()
         self._check(native.mica_world_get_ids(self.handle, kind, None, 0, byref(n)), "mica_world_get_ids")
         out = (ctypes.c_uint64 * max(n.value, 1))()

@@ -300,8 +300,8 @@ namespace LibMica
             Check(MicaNative.mica_world_restore_state(Handle, state, (ulong)state.Length));
         }
 
-        /// <summary>The ids of the live objects of one kind (MICA_OBJECT_BODY, _LPC, _TOOL or
-        /// _DEVICE), in slot order: creation order until one of the kind is destroyed. Since 0.6.</summary>
+        /// <summary>The ids of the live objects of one kind (MICA_OBJECT_BODY, _LPC, _TOOL,
+        /// _DEVICE or, since 0.7, _EMBEDDING), in slot order: creation order until one of the kind is destroyed. Since 0.6.</summary>
         public ulong[] GetIds(int kind)
         {
             int n;

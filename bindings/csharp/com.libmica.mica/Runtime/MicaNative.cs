@@ -93,6 +93,7 @@ namespace LibMica
         public const int MICA_OBJECT_LPC = 2;
         public const int MICA_OBJECT_TOOL = 3;
         public const int MICA_OBJECT_DEVICE = 4;
+        public const int MICA_OBJECT_EMBEDDING = 5;
 
         // Since 0.7: embedded meshes.
         public const int MICA_EMBED_INSIDE = 0;
