@@ -9,6 +9,7 @@
  * projection constraints, and contact with tools.
  *
  * Conventions (see docs/architecture.md):
+ * - The header needs C99 or later (stdint.h types, `static inline` functions), or C++.
  * - Units are SI throughout: m, kg, s, N, Pa.
  * - Every call that can fail returns a ::mica_status; 0 is ::MICA_OK, negative values
  *   are errors, positive values are warnings (the call did its work). On an error the
@@ -57,7 +58,7 @@ extern "C" {
 /** Major version: incompatible ABI changes. */
 #define MICA_VERSION_MAJOR 0
 /** Minor version: compatible additions. */
-#define MICA_VERSION_MINOR 6
+#define MICA_VERSION_MINOR 7
 /** Patch version: fixes. */
 #define MICA_VERSION_PATCH 0
 /** major * 10000 + minor * 100 + patch */
@@ -331,7 +332,13 @@ MICA_API mica_status mica_world_set_gravity(mica_world* world, const double grav
 #define MICA_MASS_CONSISTENT 0    /**< consistent mass (rho V / 20)(1 + delta_ab) */
 #define MICA_MASS_LUMPED 1        /**< lumped mass rho V / 4 per node */
 
-/** How to create a body: material, model, mass, damping, placement. Fill with mica_body_def_default(). */
+/** How to create a body: material, model, mass, damping, placement. Fill with mica_body_def_default().
+ *  Creation refuses a material that takes a tet's mass (kg) or stiffness (Young's modulus times the
+ *  tet's size, N/m) outside [1e-100, 1e100] (E = 1e300 Pa, density = 1e-300 kg/m^3), naming the tet
+ *  and the value. Within that range a body is accepted even where double precision cannot step it:
+ *  tets whose mass is negligible against h^2 times their stiffness (a 1e-12 m box of tissue at
+ *  h = 10 ms: a ratio of 1e21) make every step fail with MICA_ERR_NUMERICAL, the message naming the
+ *  body ("the system matrix is not positive definite"), the world unchanged. */
 typedef struct mica_body_def {
   uint32_t struct_size;  /**< sizeof(mica_body_def) as the caller compiled it */
   int32_t model;         /**< MICA_MODEL_*; default co-rotational */
@@ -955,13 +962,15 @@ MICA_API mica_status mica_tool_teleport(mica_world* world, mica_tool_id tool, co
  *          MICA_ERR_STALE_ID (`tool` is null, of another kind or destroyed). */
 MICA_API mica_status mica_tool_get_pose(const mica_world* world, mica_tool_id tool, double out_position[3],
                                         double out_orientation[4]);
-/** Force and torque the bodies put on the tool in the last step, and its active contacts. The
+/** Force and torque the bodies put on the tool in the last step, and its active contacts: those
+ *  whose normal impulse was positive (pressing). mica_world_get_contacts() lists every contact
+ *  the step made with the tool, pressing or not (features closer than the margin). The
  *  world's thread (the one thread using the world at a time).
  *  @param world the world (not changed).
  *  @param tool the tool.
  *  @param out_force receives the force (N), or NULL.
  *  @param out_torque receives the torque about the tool origin (N m), or NULL.
- *  @param out_contacts receives the number of active contacts, or NULL.
+ *  @param out_contacts receives the number of active (pressing) contacts, or NULL.
  *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` or a required pointer is NULL);
  *          MICA_ERR_STALE_ID (`tool` is null, of another kind or destroyed). */
 MICA_API mica_status mica_tool_get_force(const mica_world* world, mica_tool_id tool, double out_force[3],
@@ -1160,13 +1169,15 @@ typedef struct mica_replay mica_replay;
  *          MICA_ERR_OUT_OF_MEMORY. The message: mica_world_last_error(NULL). */
 MICA_API mica_status mica_replay_open(const char* path, mica_replay** out_replay);
 
-/** Closes a replay and destroys its world.
+/** Closes a replay and destroys its world. The replay's thread (the one thread using the replay
+ *  and its world at a time).
  *  @param replay the replay, or NULL (nothing happens). */
 MICA_API void mica_replay_close(mica_replay* replay);
 
 /** The replay's world, to read between steps with any call that reads a world (positions, tool
  *  forces, contacts, mica_world_write_vtk, mica_world_last_error). Ids are the recorded ones.
- *  Changing the world makes the rest of the replay diverge. Owned by the replay.
+ *  Changing the world makes the rest of the replay diverge. Owned by the replay. The replay's
+ *  thread (the one thread using the replay and its world at a time).
  *  @param replay the replay.
  *  @return the world, or NULL when `replay` is NULL. */
 MICA_API mica_world* mica_replay_world(const mica_replay* replay);
