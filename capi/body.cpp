@@ -316,6 +316,33 @@ MICA_API mica_status mica_body_set_materials(mica_world* world, mica_body_id bod
   });
 }
 
+MICA_API mica_status mica_body_remove_tets(mica_world* world, mica_body_id body, const int32_t* tets, int32_t count,
+                                          double* out_removed_mass) {
+  return guarded(world, "mica_body_remove_tets", [&] {
+    require(world, "world");
+    check_count(count, 0, "count");
+    if (count > 0) require(tets, "tets");
+    const mica::Body& b = world->world.body(body);  // throws for a stale id
+    // A render mesh is bound to the body's tets and nodes by index.
+    world->embeddings.for_each([&](uint64_t, const mica::Embedding& e) {
+      if (e.body() == body)
+        mica::fail(mica::Errc::WrongState, b.name + " has an embedded render mesh: destroy the embedding first");
+    });
+    const double removed = world->world.remove_tets(body, count ? node_list(tets, count) : std::vector<int32_t>{});
+    if (out_removed_mass) *out_removed_mass = removed;
+    return MICA_OK;
+  });
+}
+
+MICA_API mica_status mica_body_get_topology_version(const mica_world* world, mica_body_id body, uint64_t* out) {
+  return guarded(world, "mica_body_get_topology_version", [&] {
+    require(world, "world");
+    require(out, "out");
+    *out = world->world.body(body).topology_version;
+    return MICA_OK;
+  });
+}
+
 MICA_API mica_status mica_body_get_node_masses(const mica_world* world, mica_body_id body, double* out,
                                                int32_t capacity, int32_t* out_count) {
   return guarded(world, "mica_body_get_node_masses", [&] {

@@ -453,7 +453,7 @@ class Program {
 
   void one_op() {
     const uint8_t op = in_.u8();
-    switch (op % 24) {
+    switch (op % 25) {
       case 0: create_box(); break;
       case 1: create_raw(); break;
       case 2: create_from_file(); break;
@@ -492,6 +492,7 @@ class Program {
         break;
       case 20: case 21: poll(); break;
       case 22: readers(); break;
+      case 24: remove_tets(); break;
       default: select(); break;
     }
   }
@@ -586,6 +587,19 @@ class Program {
     for (double& v : f) v = in_.d();
     both("mica_body_set_node_forces", [&](mica_world* w, int) {
       return mica_body_set_node_forces(w, body, nodes, f, n > 4 ? 4 : n);
+    });
+  }
+
+  // Resection: a few tets (a box of 2 x 2 x 2 cells has 40), duplicates and out of range included.
+  void remove_tets() {
+    const uint64_t body = pick_id(pools_.bodies);
+    const int32_t n = in_.count(6);
+    int32_t tets[6];
+    for (int32_t& e : tets) e = in_.u8() < 230 ? int32_t(in_.u8() % 44) : int32_t(in_.u32());
+    const bool null_tets = in_.u8() > 250, null_mass = in_.coin();
+    double mass = 0;
+    both("mica_body_remove_tets", [&](mica_world* w, int) {
+      return mica_body_remove_tets(w, body, null_tets ? nullptr : tets, n > 6 ? 6 : n, null_mass ? nullptr : &mass);
     });
   }
 

@@ -32,7 +32,7 @@ def u8(v):
 
 OPS = dict(box=0, raw=1, file=2, body_destroy=3, forces=4, lpc=5, lpc_remove=6, lpc_velocity=7,
            targets=8, grab=9, handle=10, tool=11, tool_destroy=12, pose=13, step=14, gravity=17,
-           device=18, device_destroy=19, poll=20, read=22, select=23)
+           device=18, device_destroy=19, poll=20, read=22, select=23, remove_tets=24)
 
 
 def world(solver=0, sweep=0, refactor=0, iterations=50, gravity=(0, 0, 0), friction=0.0, tol=1e-3):
@@ -150,6 +150,13 @@ def raw_duplicate():
     return b
 
 
+def remove_tets(tets, body_index=0, count=None):
+    b = u8(OPS['remove_tets']) + pick(body_index) + u8(len(tets) if count is None else count)
+    for k in range(6):
+        b += u8(0) + u8(tets[k] if k < len(tets) else 0)
+    return b + u8(0) + u8(0)  # the tets given, the mass asked for
+
+
 def destroy_body(index=0):
     return u8(OPS['body_destroy']) + pick(index)
 
@@ -183,6 +190,9 @@ SEEDS = {
     'tiny_steps': world(0) + box() + tool(position=(0.0, 0.008, 0.0)) + step() + raw_step(1e-10) +
         raw_step(5e-324) + raw_step(1e-9) + step(),
     'two_bodies': world(0) + box(cells=(1, 1, 1)) + box(lo=(-0.04, -0.005, -0.04), size=0.05) + step() * 3,
+    'remove_tets': world(2, gravity=(0.0, -9.81, 0.0)) + box(cells=(2, 2, 2)) + lpc_fixed([0, 1, 2, 3]) +
+        grab((0.0, 0.0, 0.0)) + step() + remove_tets([39, 38, 37]) + step() + remove_tets([5, 5]) +
+        remove_tets([43]) + remove_tets([0, 1, 2, 3, 4, 6]) + step() * 2 + read(0),
     'stale_ids': world(2) + box() + tool() + destroy_body() + destroy_body() + step() + read(0) +
         u8(OPS['tool_destroy']) + pick(0) + pose((0.0, 0.0, 0.0)),
 }

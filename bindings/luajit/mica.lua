@@ -282,6 +282,22 @@ function World:set_materials(body, youngs_modulus, poisson_ratio, density)
                                        array(poisson_ratio, "poisson_ratio"), array(density, "density"), tets))
 end
 
+-- Resection: removes the tets of a Lua table of 0-based tet indices; returns their mass (kg).
+-- Node and tet indices change (nodes no kept tet holds go, the rest are renumbered in order).
+function World:remove_tets(body, tets)
+  local removed = ffi.new("double[1]")
+  local list = #tets > 0 and ffi.new("int32_t[?]", #tets, tets) or nil
+  self:check(C.mica_body_remove_tets(self.ptr, body, list, #tets, removed))
+  return removed[0]
+end
+
+-- How many times the body's tets have changed (0 at creation), as a Lua number.
+function World:topology_version(body)
+  local out = ffi.new("uint64_t[1]")
+  self:check(C.mica_body_get_topology_version(self.ptr, body, out))
+  return tonumber(out[0])
+end
+
 -- Node masses (double[n], kg), strains (double[6 * t]: xx yy zz yz xz xy) and von Mises stress
 -- (double[t], Pa) per tet; each returns the array and its item count.
 function World:node_masses(body)

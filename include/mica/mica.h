@@ -673,6 +673,51 @@ MICA_API mica_status mica_body_set_materials(mica_world* world, mica_body_id bod
                                              const double* poisson_ratio, const double* density,
                                              int32_t tet_count);
 
+/** Resection: removes tets from a body, with everything that depends on them, in one call.
+ *  The kept tets keep their order (tet indices above a removed one move down). Nodes no kept tet
+ *  holds are removed and the others renumbered in their order: node indices change, so re-read
+ *  counts, tets, surface and positions after a removal (mica_body_get_topology_version() tells
+ *  that one happened). What follows:
+ *  - the model (stiffness and mass of the kept tets with their materials and regions, the
+ *    surface, the solver's factors, rebuilt as mica_body_set_materials() does);
+ *  - positions, velocities and node forces of the kept nodes;
+ *  - constraints and grabs: removed nodes leave their group, kept ones follow their new indices
+ *    (a grab's handle keeps their offsets); a group left with no node is destroyed and its id
+ *    becomes stale;
+ *  - contacts: the warm starts of the body's contacts are dropped, and the last step's contacts
+ *    readout (mica_world_get_contacts() and what reads contacts) is cleared for the
+ *    whole world, its indices being of the old numbering (the statistics stay);
+ *  - saved states: a state saved before the removal no longer fits the world (its shape
+ *    differs); a recording records the removal and replays it.
+ *  A part of the body left without a fixed node moves freely (it falls under gravity). The
+ *  world's thread (the one thread using the world at a time).
+ *  @param world the world.
+ *  @param body the body, static or dynamic.
+ *  @param tets `count` distinct tet indices in 0..tet_count-1 (NULL when `count` is 0; count 0
+ *         changes nothing).
+ *  @param count the number of tets to remove, fewer than the body has.
+ *  @param out_removed_mass receives the removed tets' mass, kg (the sum of density times rest
+ *         volume); may be NULL.
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` NULL, or `tets` NULL with `count` > 0);
+ *          MICA_ERR_STALE_ID (`body` is null, of another kind or destroyed); MICA_ERR_OUT_OF_RANGE
+ *          (a tet index outside the body's tets: the message names it and its position);
+ *          MICA_ERR_INVALID_ARGUMENT (`count` < 0, a tet listed twice, or every tet: destroy the
+ *          body instead); MICA_ERR_WRONG_STATE (the removal would empty a grasp a device drives,
+ *          or a render mesh is embedded in the body); MICA_ERR_OUT_OF_MEMORY. On any error
+ *          nothing changes. */
+MICA_API mica_status mica_body_remove_tets(mica_world* world, mica_body_id body, const int32_t* tets,
+                                           int32_t count, double* out_removed_mass);
+
+/** How many times the body's tets have changed (mica_body_remove_tets()): 0 at creation. A host
+ *  that keeps node or tet indices of a body re-reads them when this changes. The world's thread
+ *  (the one thread using the world at a time).
+ *  @param world the world (not changed).
+ *  @param body the body.
+ *  @param out receives the version.
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` or `out` is NULL); MICA_ERR_STALE_ID
+ *          (`body` is null, of another kind or destroyed). */
+MICA_API mica_status mica_body_get_topology_version(const mica_world* world, mica_body_id body, uint64_t* out);
+
 /** Mass of each node (kg), 1 value per node: the row sums of the body's mass matrix, the mass
  *  gravity pulls on. For linear tets each tet gives rho V / 4 to each of its nodes with either
  *  MICA_MASS_CONSISTENT or MICA_MASS_LUMPED, so the sum is the body's mass (density times

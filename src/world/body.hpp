@@ -58,6 +58,7 @@ struct BodyState {
   Vec3List node_forces;        // persistent user loads, N
   bool has_node_forces = false;
   uint64_t lpc_version = 0;    // bumped when a constraint on this body is added or removed
+  uint64_t topology_version = 0;  // bumped by each change of the tets (World::remove_tets)
   TriangleBvh bvh;             // over the surface triangles at x, refit every step
   // Co-rotational bodies: what the last step found at its end positions, the next step's start
   // rotations (World::start_rotations reuses them while x is still end.x).

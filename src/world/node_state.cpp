@@ -29,19 +29,23 @@ void check_values(const Body& b, const Vec3List& values, const char* what) {
 
 }  // namespace
 
-void World::set_positions(Id id, const Vec3List& x) {
-  Body& b = body(id);
-  check_values(b, x, "positions");
-  // The keys of the rows of the last step's contacts on this body (by its index then).
-  std::vector<uint64_t> stale;
-  int32_t index = -1;
+std::vector<uint64_t> World::contact_row_keys(Id id) const {
+  std::vector<uint64_t> keys;
+  int32_t index = -1;  // the body's index in the last step
   for (size_t k = 0; k < last_.bodies.size(); ++k)
     if (last_.bodies[k] == id) index = int32_t(k);
   for (size_t r = 0; r < last_.rows.size(); ++r) {
     const Contact& c = last_.contacts[size_t(last_.rows.contact[r])];
     const bool ours = (index >= 0 && (c.a.body == index || (c.b.count > 0 && c.b.body == index))) || c.other == id;
-    if (ours) stale.push_back(last_.rows.key[r]);
+    if (ours) keys.push_back(last_.rows.key[r]);
   }
+  return keys;
+}
+
+void World::set_positions(Id id, const Vec3List& x) {
+  Body& b = body(id);
+  check_values(b, x, "positions");
+  const std::vector<uint64_t> stale = contact_row_keys(id);
   b.x = x;  // the same size: no allocation, nothing thrown from here on
   b.end.x.clear();
   b.bvh.refit(b.x);

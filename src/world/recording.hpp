@@ -21,12 +21,12 @@ enum class RecordKind : uint32_t {
   SetGravity = 1, AddBody, RemoveBody, SetNodeForces, SetPositions, SetVelocities, SetMaterials,
   AddLpc, RemoveLpc, SetLpcVelocity, SetLpcTargets, Grab, SetHandlePose,
   AddTool, RemoveTool, SetToolPose, AddDevice, RemoveDevice, RestoreState, Step, End,
-  TeleportTool
+  TeleportTool, RemoveTets
 };
-constexpr uint32_t kLastRecordKind = uint32_t(RecordKind::TeleportTool);
+constexpr uint32_t kLastRecordKind = uint32_t(RecordKind::RemoveTets);
 
 constexpr char kRecordingMagic[8] = {'M', 'I', 'C', 'A', 'R', 'E', 'C', '1'};
-constexpr uint32_t kRecordingVersion = 2;            // 2: the end entry, tool teleports
+constexpr uint32_t kRecordingVersion = 2;            // 2: the end entry, tool teleports, tet removals
 constexpr uint32_t kRecordingVersionWithoutEnd = 1;  // libmica 0.6's, still replayed
 // Byte order and the size of a double: a recording is replayed where such values read back alike.
 constexpr uint32_t kRecordingLayout = 0x01020304u ^ uint32_t(sizeof(double) << 24);

@@ -162,6 +162,7 @@ void Replay::apply(World& world, RecordKind kind, ByteReader& in) {
       world.set_body_materials(id, materials);
       break;
     }
+    case RecordKind::RemoveTets: take_all(in, id, nodes); world.remove_tets(id, nodes); break;
     case RecordKind::AddLpc: {
       LpcSpec spec;
       take_all(in, id, nodes, spec, created);

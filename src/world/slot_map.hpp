@@ -88,6 +88,15 @@ class SlotMap {
     return *item;
   }
 
+  // The owning thread: puts `item` in the place of the live object `id` (same id); returns the old one.
+  std::unique_ptr<T> replace(Id id, std::unique_ptr<T> item) noexcept {
+    const uint32_t index = uint32_t(id & 0xffffffffu) - 1;
+    return std::unique_ptr<T>(slot(index).item.exchange(item.release(), std::memory_order_seq_cst));
+  }
+
+  // The owning thread: after this, erase() allocates nothing.
+  void reserve_free() { free_.reserve(size_); }
+
   // The owning thread. Waits (yielding) for open ReadGuards before it deletes the object.
   void erase(Id id) {
     if (!find(id)) return;

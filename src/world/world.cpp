@@ -95,11 +95,7 @@ Id World::add_body(const TetMesh& mesh, const BodySettings& settings, const Vec3
   if (!settings.is_static)
     for (Vec3List* w : {&body->v, &body->v_previous})
       for (Vec3& u : *w) u = velocity;
-  if (pool_ && !settings.is_static) {
-    body->element_colours = colour_elements(body->tets, body->fem.node_count(),
-                                            block_size_for(int32_t(body->tets.size()), 16, 1024));
-    body->node_colours = colour_nodes(body->fem.pattern, block_size_for(body->fem.node_count(), 8, 512));
-  }
+  colour_for_threads(*body);
   std::vector<BodyOverlap> overlaps = find_overlaps(*body);  // may throw: nothing changed yet
   overlapping_.reserve(overlapping_.size() + overlaps.size());
   Body& created = *body;
@@ -125,6 +121,12 @@ Id World::add_body(const TetMesh& mesh, const BodySettings& settings, const Vec3
   }
   if (recorder_) recorder_->write(RecordKind::AddBody, mesh, settings, translation, velocity, id);
   return id;
+}
+
+void World::colour_for_threads(Body& b) const {
+  if (!pool_ || !b.is_dynamic()) return;
+  b.element_colours = colour_elements(b.tets, b.fem.node_count(), block_size_for(int32_t(b.tets.size()), 16, 1024));
+  b.node_colours = colour_nodes(b.fem.pattern, block_size_for(b.fem.node_count(), 8, 512));
 }
 
 void World::remove_body(Id id) {

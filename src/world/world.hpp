@@ -153,6 +153,11 @@ class World {
   // drops the solver's factors of it; positions and velocities stay. Throws, changing nothing,
   // for a wrong count or a material out of its domain (the message names the tet).
   void set_body_materials(Id body, const std::vector<Material>& materials);
+  // Resection (remove_tets.cpp): removes the listed tets; returns their mass (kg). The kept tets
+  // keep their order, nodes left without a tet go and the rest are renumbered in order; the
+  // model, the state, the constraints and the warm starts follow (see there). Throws, changing
+  // nothing, for an index out of range, a duplicate, every tet, or a driven grasp it would empty.
+  double remove_tets(Id body, const std::vector<int32_t>& tets);
   // Numeric factorizations the solver has made of this body's systems so far.
   int64_t factorizations(Id body) const;
 
@@ -280,6 +285,11 @@ class World {
   template <class V, class BodyExtra>
   void visit_world_state(V& v, BodyExtra&& body_extra) const;
   Id insert_lpc(Id body, const std::vector<int32_t>& nodes, const LpcSpec& spec);  // add_lpc, unrecorded
+
+  // The keys of the rows of the last step's contacts that touch a body (their warm starts).
+  std::vector<uint64_t> contact_row_keys(Id body) const;
+  // A world with threads > 1 colours a dynamic body's tets and nodes for its parallel loops.
+  void colour_for_threads(Body& b) const;
 
   bool needs_loads(const Body& b) const;
   bool needs_damping(const Body& b) const;

@@ -718,6 +718,23 @@ class Body(_Object):
         self.world._check(native.mica_body_set_materials(self.world.handle, self.id, *pointers, tets),
                           "mica_body_set_materials")
 
+    def remove_tets(self, tets: ArrayLike) -> float:
+        """Removes these tets (resection); returns their mass, kg. Node and tet indices change:
+        nodes no kept tet holds go, the rest are renumbered in order (see topology_version)."""
+        tets = np.ascontiguousarray(tets, dtype=np.int32).ravel()
+        removed = c_double(0)
+        self.world._check(native.mica_body_remove_tets(self.world.handle, self.id,
+                                                       tets.ctypes.data_as(POINTER(c_int32)), len(tets),
+                                                       byref(removed)), "mica_body_remove_tets")
+        return removed.value
+
+    def topology_version(self) -> int:
+        """How many times the body's tets have changed (0 at creation)."""
+        out = ctypes.c_uint64(0)
+        self.world._check(native.mica_body_get_topology_version(self.world.handle, self.id, byref(out)),
+                          "mica_body_get_topology_version")
+        return out.value
+
     def node_masses(self) -> np.ndarray:
         """Mass of each node (n,), kg: the row sums of the mass matrix."""
         return self._get(native.mica_body_get_node_masses, 1, np.float64, "mica_body_get_node_masses").ravel()

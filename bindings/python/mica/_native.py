@@ -12,7 +12,7 @@ from ctypes import (CFUNCTYPE, POINTER, Structure, c_char, c_char_p, c_double, c
 
 # --- Constants (mica.h)
 MICA_VERSION_MAJOR = 0
-MICA_VERSION_MINOR = 6
+MICA_VERSION_MINOR = 7
 MICA_VERSION_PATCH = 0
 MICA_VERSION_NUMBER = MICA_VERSION_MAJOR * 10000 + MICA_VERSION_MINOR * 100 + MICA_VERSION_PATCH
 
@@ -392,6 +392,9 @@ PROTOTYPES = {
     "mica_body_get_tets": (mica_status, [mica_world_p, mica_body_id, _p(_i), _i, _p(_i)]),
     "mica_body_get_tet_regions": (mica_status, [mica_world_p, mica_body_id, _p(_i), _i, _p(_i)]),
     "mica_body_set_materials": (mica_status, [mica_world_p, mica_body_id, _p(_d), _p(_d), _p(_d), _i]),
+    # resection
+    "mica_body_remove_tets": (mica_status, [mica_world_p, mica_body_id, _p(_i), _i, _p(_d)]),
+    "mica_body_get_topology_version": (mica_status, [mica_world_p, mica_body_id, _p(c_uint64)]),
     "mica_body_get_node_masses": (mica_status, [mica_world_p, mica_body_id, _p(_d), _i, _p(_i)]),
     "mica_body_get_strains": (mica_status, [mica_world_p, mica_body_id, _p(_d), _i, _p(_i)]),
     "mica_body_get_von_mises": (mica_status, [mica_world_p, mica_body_id, _p(_d), _i, _p(_i)]),

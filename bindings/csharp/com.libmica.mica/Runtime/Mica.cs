@@ -551,6 +551,27 @@ namespace LibMica
             World.Check(MicaNative.mica_body_set_materials(World.Handle, Id, youngsModulus, poissonRatio, density, tets));
         }
 
+        /// <summary>Resection: removes these tets and returns their mass (kg). Node and tet indices
+        /// change: nodes no kept tet holds go, the rest are renumbered in order (see
+        /// TopologyVersion).</summary>
+        public double RemoveTets(int[] tets)
+        {
+            double removed;
+            World.Check(MicaNative.mica_body_remove_tets(World.Handle, Id, tets, tets.Length, out removed));
+            return removed;
+        }
+
+        /// <summary>How many times the body's tets have changed (0 at creation).</summary>
+        public ulong TopologyVersion
+        {
+            get
+            {
+                ulong version;
+                World.Check(MicaNative.mica_body_get_topology_version(World.Handle, Id, out version));
+                return version;
+            }
+        }
+
         double[] ReadDoubles(Func<double[], int, Tuple<int, int>> call, int width)
         {
             var first = call(null, 0);

@@ -16,7 +16,7 @@ namespace LibMica
 
         // --- Constants (mica.h)
         public const int MICA_VERSION_MAJOR = 0;
-        public const int MICA_VERSION_MINOR = 6;
+        public const int MICA_VERSION_MINOR = 7;
         public const int MICA_VERSION_PATCH = 0;
         public const int MICA_VERSION_NUMBER = MICA_VERSION_MAJOR * 10000 + MICA_VERSION_MINOR * 100 + MICA_VERSION_PATCH;
 
@@ -468,6 +468,13 @@ namespace LibMica
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
         public static extern int mica_body_set_materials(WorldHandle world, ulong body, double[] youngs_modulus,
                                                          double[] poisson_ratio, double[] density, int tet_count);
+
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern int mica_body_remove_tets(WorldHandle world, ulong body, int[] tets, int count,
+                                                       out double out_removed_mass);
+
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern int mica_body_get_topology_version(WorldHandle world, ulong body, out ulong @out);
 
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
         public static extern int mica_body_get_node_masses(WorldHandle world, ulong body, double[] @out, int capacity,
