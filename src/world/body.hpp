@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
-// A deformable (or static) body in three parts: the model it was made with (never changed after
-// creation), the state a step starts from and leaves, and the step's work arrays, sized once at
-// creation so that stepping does not allocate. A step writes only into the work arrays until it
+// A deformable (or static) body in three parts: the model it was made with (changed only by
+// World::set_body_materials, and by World::remove_tets, which rebuilds the whole body), the state
+// a step starts from and leaves, and the step's work arrays, sized once at creation so that
+// stepping does not allocate. A step writes only into the work arrays until it
 // commits (World::commit swaps what it made into the state), so a step that fails leaves the state
 // as it was. Body is the three together.
 #pragma once

@@ -510,6 +510,21 @@ class Behaviour(unittest.TestCase):
             cube = world.create_body_from_file(os.path.join(data, "two_regions_v41.msh"), translation=(2, 0, 0))
             self.assertEqual(list(cube.tet_regions()), [7, 7, 7, 9, 9, 0])
 
+    def test_remove_tets(self):
+        # Resection: the second cell of a bar goes; its mass is returned and the version bumped.
+        rho = 1000
+        with mica.World(gravity=(0, 0, 0)) as world:
+            body = world.create_box((0, 0, 0), (0.2, 0.1, 0.1), (2, 1, 1), 5, density=rho)
+            nodes, tets, _ = body.counts()
+            self.assertEqual(body.topology_version(), 0)
+            removed = body.remove_tets(np.arange(5, 10))
+            self.assertAlmostEqual(removed, rho * 0.1 * 0.1 * 0.1, delta=1e-12)
+            self.assertEqual(body.counts()[:2], (nodes - 4, tets - 5))
+            self.assertEqual(body.topology_version(), 1)
+            with self.assertRaises(mica.MicaError) as e:
+                body.remove_tets([0, 0])
+            self.assertIn("listed twice", e.exception.message)
+
     def test_library_found_next_to_the_build_tree(self):
         # The package copied into <build>/bindings/python finds <build>/libmica without help.
         pkg = os.path.join(os.environ["MICA_BINDINGS_BUILD_DIR"], "python")
