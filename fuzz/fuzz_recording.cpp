@@ -214,6 +214,9 @@ bool write_seeds(const std::string& dir) {
     mica_fuzz::press(s, 1);
     mica_fuzz::require_ok(w, mica_tool_destroy(w, tool), "mica_tool_destroy");
     mica_fuzz::require_ok(w, mica_device_destroy(w, s.device), "mica_device_destroy");
+    const int32_t corner_tet = 0;
+    mica_fuzz::require_ok(w, mica_body_remove_tets(w, s.body, &corner_tet, 1, nullptr), "mica_body_remove_tets");
+    mica_fuzz::require_ok(w, mica_step(w, 0.01), "mica_step");
     mica_fuzz::require_ok(w, mica_body_destroy(w, s.body), "mica_body_destroy");
     mica_fuzz::require_ok(w, mica_step(w, 0.01), "mica_step");
   }) && ok;
