@@ -132,6 +132,11 @@ static double* get_positions(mica_world* w, mica_body_id body, int32_t* n) {
   return x;
 }
 
+static double* step_and_get_positions(mica_world* w, mica_body_id body, int steps, int32_t* n) {
+  step_n(w, steps);
+  return get_positions(w, body, n);
+}
+
 static uint8_t* save(mica_world* w, size_t* bytes) {
   OK(w, mica_world_state_size(w, bytes));
   uint8_t* buffer = malloc(*bytes);
@@ -201,11 +206,9 @@ static void check_cut_steps_as_fresh(int32_t solver, int32_t threads) {
   mica_lpc_id again = 0;
   OK(b, mica_add_lpc(b, fresh, nodes, held, &def, &again));
 
-  step_n(a, 1);
-  step_n(b, 1);
   int32_t na = 0, nb = 0;
-  double* xa = get_positions(a, cut, &na);
-  double* xb = get_positions(b, fresh, &nb);
+  double* xa = step_and_get_positions(a, cut, 1, &na);
+  double* xb = step_and_get_positions(b, fresh, 1, &nb);
   assert_int_equal(na, nb);
   double worst = 0;
   for (int32_t i = 0; i < 3 * na; ++i) worst = fmax(worst, fabs(xa[i] - xb[i]) / L);
@@ -335,11 +338,9 @@ static void test_saved_states_across_a_removal(void** state) {
   mica_world* w2 = fixed_bar(&other, 0);
   remove_last_column(w2, other);
   OK(w2, mica_world_restore_state(w2, cut_state, cut_bytes));
-  step_n(w, 2);
-  step_n(w2, 2);
   int32_t n = 0, n2 = 0;
-  double* x = get_positions(w, body, &n);
-  double* x2 = get_positions(w2, other, &n2);
+  double* x = step_and_get_positions(w, body, 2, &n);
+  double* x2 = step_and_get_positions(w2, other, 2, &n2);
   assert_int_equal(n, n2);
   assert_memory_equal(x, x2, sizeof(double) * 3 * (size_t)n);
   free(x), free(x2), free(old_state), free(cut_state), free(check);
