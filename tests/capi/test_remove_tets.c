@@ -7,7 +7,8 @@
  *   default solvers, one and two threads).
  * - A grasp through the removed region keeps its remaining nodes; a grasp left without nodes is
  *   destroyed (its id is stale).
- * - Bad input is refused with a message naming it, the world bit for bit unchanged.
+ * - Bad input is refused with a message naming it, the world bit for bit unchanged; so is a
+ *   removal that would empty a grasp a device drives, or under an embedded render mesh.
  * - A state saved before a removal is refused by the cut world; one saved after it restores into
  *   a world cut the same way; a recording with removals replays bit for bit.
  * - A piece cut free of the fixed nodes falls at g. */
@@ -22,6 +23,7 @@
 #include <string.h>
 
 #include <mica/mica.h>
+#include <mica/mica_device.h>
 
 #include "capi_ok.h"
 
@@ -316,6 +318,35 @@ static void test_bad_input_changes_nothing(void** state) {
   mica_world_destroy(w);
 }
 
+/* A removal that would empty a grasp a device drives, or under an embedded render mesh, is refused. */
+static void test_what_holds_the_body_refuses(void** state) {
+  (void)state;
+  mica_body_id body = 0;
+  mica_world* w = fixed_bar(&body, 1);
+  int32_t tets[128];
+  const int32_t count = tets_between(w, body, 0.03, 1, tets);
+  const double end[3] = {L, 0.01, 0.01};
+  mica_lpc_id tip = 0;
+  OK(w, mica_lpc_grab(w, body, end, 0.003, 0, &tip));
+  mica_device_def dd = mica_device_def_default();
+  dd.backend = MICA_DEVICE_SIMULATED;
+  dd.lpc = tip;
+  mica_device_id device = 0;
+  OK(w, mica_device_create(w, &dd, &device));
+  expect_refused(w, body, tets, count, MICA_ERR_WRONG_STATE, "a device drives without nodes: destroy the device first");
+  OK(w, mica_device_destroy(w, device));
+
+  const double xyz[9] = {0.005, 0.005, 0.005, 0.015, 0.005, 0.005, 0.005, 0.015, 0.005};
+  const int32_t triangle[3] = {0, 1, 2};
+  const mica_embedding_def ed = mica_embedding_def_default();
+  mica_embedding_id sheet = 0;
+  OK(w, mica_embedding_create(w, body, &ed, xyz, 3, triangle, 1, &sheet));
+  expect_refused(w, body, tets, count, MICA_ERR_WRONG_STATE, "has an embedded render mesh: destroy the embedding first");
+  OK(w, mica_embedding_destroy(w, sheet));
+  OK(w, mica_body_remove_tets(w, body, tets, count, NULL));
+  mica_world_destroy(w);
+}
+
 static void test_saved_states_across_a_removal(void** state) {
   (void)state;
   mica_body_id body = 0;
@@ -422,6 +453,7 @@ int main(void) {
       cmocka_unit_test(test_cut_body_steps_as_a_fresh_one),
       cmocka_unit_test(test_grasp_through_the_removed_region),
       cmocka_unit_test(test_bad_input_changes_nothing),
+      cmocka_unit_test(test_what_holds_the_body_refuses),
       cmocka_unit_test(test_saved_states_across_a_removal),
       cmocka_unit_test(test_recording_replays_removals),
       cmocka_unit_test(test_a_piece_cut_free_falls),
