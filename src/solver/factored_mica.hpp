@@ -68,6 +68,8 @@ struct FactoredBodyCache {
 class FactoredMicaSolver : public CachingVelocitySolver<FactoredBodyCache> {
  public:
   explicit FactoredMicaSolver(const SolverSettings& settings = {}) : settings_(settings) {}
+  // prepare() (the factors, their preconditioners, W), then the active-set loop's rounds
+  // (solve_active_set), and the alternating loop's (alternate) where those did not settle.
   SolveReport solve(const SolveContext& ctx, std::vector<SolverBody>& bodies, const ContactRows& rows,
                     std::vector<double>& lambda) override;
   // W_rr of the last solve, per row (0 for a row nothing can move along).
@@ -125,7 +127,7 @@ class FactoredMicaSolver : public CachingVelocitySolver<FactoredBodyCache> {
     PcgSolver pcg;                    // preconditioned by this
     Vec3List rhs;                     // b + G^T lambda
     ContactNodes nodes;
-    Eigen::VectorXd response;  // Q^T S of a response P_c^-1 U f (the factor's frame, 3 per node: respond)
+    Eigen::VectorXd response;  // y with S Q y = P_c^-1 U f (the factor's frame, 3 per node: respond)
 
     void apply(const Vec3List& r, Vec3List& z) override;
     // Between the halves of z = P^-1 r: t = U^T z, force = -C t (Woodbury's forces), u = U^T of z
@@ -136,9 +138,9 @@ class FactoredMicaSolver : public CachingVelocitySolver<FactoredBodyCache> {
     // Adds the response to nodes.force, H M force (the factor's frame), to the halves' workspace;
     // false when there is no force.
     bool add_forces();
-    // response for the node forces nodes.force (U f), and nodes.exact; false when there are none.
+    // The response to the node forces nodes.force (U f), and nodes.exact; false when there are none.
     bool respond();
-    // out += S Q response, the contact nodes' values exact.
+    // out += S Q response, with the contact nodes' exact values.
     void add_turned(Vec3List& out) const;
   };
   // The contact rows' compliance (nr rows, nt row terms): W = G P_c^-1 G^T of the factors in use,
@@ -221,8 +223,9 @@ class FactoredMicaSolver : public CachingVelocitySolver<FactoredBodyCache> {
   // v += P_c^-1 G^T dlambda (a backward solve of the half columns).
   void apply_impulse_change(std::vector<SolverBody>& bodies, const ContactRows& rows,
                             const std::vector<double>& dlambda);
-  // small_.lambda_next solves the contact problem on W around lambda: 0 <= lambda_next _|_ w + W (lambda_next - lambda) >= 0
-  // on normal rows, Coulomb's cone on tangent pairs (frictional_contact.hpp).
+  // small_.lambda_next solves the contact problem on W around lambda: on normal rows
+  // 0 <= lambda_next _|_ w + W (lambda_next - lambda) >= 0, on tangent pairs Coulomb's cone
+  // (frictional_contact.hpp).
   void solve_small_lcp(const ContactRows& rows, double tolerance, const std::vector<double>& lambda,
                        const std::optional<std::chrono::steady_clock::time_point>& deadline);
   // Of the current lambda against the current row velocities rounds_.w (N s).
