@@ -225,7 +225,8 @@ void FactoredMicaSolver::FactoredBody::add_turned(Vec3List& out) const {
   // The contact nodes' exact values in place of the response's.
   for (size_t a = 0; a < nodes.node.size(); ++a) {
     const int32_t i = nodes.node[a];
-    out[i] += nodes.exact.segment<3>(3 * Eigen::Index(a)) - nodes.to_world[a] * response.segment<3>(3 * Eigen::Index(i));
+    out[i] += nodes.exact.segment<3>(3 * Eigen::Index(a)) -
+              nodes.to_world[a] * response.segment<3>(3 * Eigen::Index(i));
   }
 }
 
@@ -528,8 +529,8 @@ void FactoredMicaSolver::predict_impulses(const std::vector<SolverBody>& bodies,
   // Two solved velocity fields a step s of the impulses apart measure the true compliance along
   // it, y = W_true s = w - w_prev. A BFGS update takes that into W and keeps it symmetric
   // positive definite (while s.y > 0, as for the true W), so the rotations the warped factor
-  // misses stop slowing the loop.
-  if (a.round > 1 && std::max(a.inner_tolerance, a.previous_inner_tolerance) <= a.final_tolerance) {  // only solved pairs measure it
+  // misses stop slowing the loop. Only solved pairs measure it.
+  if (a.round > 1 && std::max(a.inner_tolerance, a.previous_inner_tolerance) <= a.final_tolerance) {
     compliance_.s = Eigen::Map<const Eigen::VectorXd>(rounds_.dlambda.data(), Eigen::Index(nr));
     compliance_.secant_update(rounds_.w, rounds_.w_prev);
   }

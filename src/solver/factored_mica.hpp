@@ -252,7 +252,8 @@ class FactoredMicaSolver : public CachingVelocitySolver<FactoredBodyCache> {
   bool solve_again(const std::vector<SolverBody>& bodies, Alternation& a, SolveReport& report);
   // The row velocities of the solved velocities, what they teach W, and the small problem's
   // impulses (small_.lambda_next, rounds_.dlambda).
-  void predict_impulses(const std::vector<SolverBody>& bodies, const ContactRows& rows, const std::vector<double>& lambda,
+  void predict_impulses(const std::vector<SolverBody>& bodies, const ContactRows& rows,
+                        const std::vector<double>& lambda,
                         const std::optional<SolveContext::Clock::time_point>& deadline, Alternation& a);
   // Whether the impulses have settled with the velocities balancing them (converged).
   bool settled(const std::vector<SolverBody>& bodies, const ContactRows& rows, const std::vector<double>& lambda,

@@ -369,7 +369,8 @@ SolveReport FactoredMicaSolver::solve_active_set(const SolveContext& ctx, std::v
   std::vector<double>& lambda_next = small_.lambda_next;
   as.W0 = compliance_.W;
   bool may_refactor = false;
-  for (const FactoredBody& f : factored_) may_refactor = may_refactor || (f.node_rotation && settings.refactor_after > 0);
+  for (const FactoredBody& f : factored_)
+    may_refactor = may_refactor || (f.node_rotation && settings.refactor_after > 0);
 
   SolveReport report;
   report.converged = false;
