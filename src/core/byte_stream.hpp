@@ -77,6 +77,10 @@ class ByteReader {
   size_t at_ = 0;
 };
 
+// Byte order and the size of a double, written in a file's header: a saved state or a recording is
+// read back only on a machine where its values read back alike.
+constexpr uint32_t kByteLayout = 0x01020304u ^ uint32_t(sizeof(double) << 24);
+
 // FNV-1a over bytes, continuing from `hash` (chain calls to hash several arrays).
 inline uint64_t fnv1a(const void* data, size_t size, uint64_t hash = 0xcbf29ce484222325ull) {
   const auto* p = static_cast<const uint8_t*>(data);

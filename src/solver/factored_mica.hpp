@@ -33,7 +33,9 @@
 
 #include "solver/frictional_contact.hpp"
 #include "solver/lagged_factor.hpp"
+#include "solver/flexible_cg.hpp"
 #include "solver/pcg.hpp"
+#include "solver/stall_watch.hpp"
 #include "solver/velocity_solver.hpp"
 
 namespace mica {
@@ -66,10 +68,12 @@ struct FactoredBodyCache {
 class FactoredMicaSolver : public CachingVelocitySolver<FactoredBodyCache> {
  public:
   explicit FactoredMicaSolver(const SolverSettings& settings = {}) : settings_(settings) {}
+  // prepare() (the factors, their preconditioners, W), then the active-set loop's rounds
+  // (solve_active_set), and the alternating loop's (alternate) where those did not settle.
   SolveReport solve(const SolveContext& ctx, std::vector<SolverBody>& bodies, const ContactRows& rows,
                     std::vector<double>& lambda) override;
   // W_rr of the last solve, per row (0 for a row nothing can move along).
-  const std::vector<double>& row_diagonal() const override { return diag_; }
+  const std::vector<double>& row_diagonal() const override { return compliance_.diag; }
   // The factors' refresh schedules and caches (LaggedFactor::begin, commit, rollback).
   void begin_step() override {
     for_each_cache([](FactoredBodyCache& c) { c.factor.begin(); });
@@ -92,15 +96,8 @@ class FactoredMicaSolver : public CachingVelocitySolver<FactoredBodyCache> {
   void restore_bodies(const std::vector<SavedBody>& bodies) override;
 
  private:
-  // What the loop needs beyond SolverBody, per body of a solve.
-  struct FactoredBody {
-    LaggedFactor* factor;                     // updated for this solve's system and constraints
-    FactoredBodyCache* cache;                 // the body's (factor is its)
-    const std::vector<Mat3>* node_rotation;   // null: the linear model (no warping)
-    const Projection* projection;
-  };
   // A body's contact nodes in a solve (its rows' terms' and extra stiffness's nodes: U), their
-  // half columns and the compliance among them, world frame, 3 entries per slot.
+  // half columns and the compliance among them, world frame, 3 entries per slot (m slots).
   struct ContactNodes {
     std::vector<int32_t> node;                    // per slot
     std::vector<const SupernodalSolve::HalfColumns*> columns;  // per slot: its half columns (the factor's frame)
@@ -116,62 +113,157 @@ class FactoredMicaSolver : public CachingVelocitySolver<FactoredBodyCache> {
     // of the forces); U^T of a response: the values a single-precision backward solve only
     // approximates, put back exactly.
     Eigen::VectorXd force, moved, t, u, exact;
-    Eigen::VectorXd load;  // the equalities' impulses on the contact nodes (equality_load2)
+    Eigen::VectorXd load;  // the equalities' impulses on the contact nodes (equality_loads)
   };
-  // The PCG's preconditioner for body bi: z = P_c^-1 r.
-  class CorrectedPreconditioner : public Preconditioner {
-   public:
-    CorrectedPreconditioner(FactoredMicaSolver* solver, size_t body) : solver_(solver), body_(body) {}
-    void apply(const Vec3List& r, Vec3List& z) override { solver_->precondition(body_, r, z); }
+  // Per body of a solve: its factor, updated for this solve's system and constraints, and what
+  // its velocity solve needs beyond SolverBody. As a preconditioner, z = P_c^-1 r: the warped
+  // factor with Woodbury's correction between its halves.
+  struct FactoredBody : Preconditioner {
+    LaggedFactor* factor = nullptr;
+    FactoredBodyCache* cache = nullptr;               // the body's (factor is its)
+    const std::vector<Mat3>* node_rotation = nullptr;  // null: the linear model (no warping)
+    const Projection* projection = nullptr;
+    WarpedFactorPreconditioner warp;  // bound to factor
+    PcgSolver pcg;                    // preconditioned by this
+    Vec3List rhs;                     // b + G^T lambda
+    ContactNodes nodes;
+    Eigen::VectorXd response;  // y with S Q y = P_c^-1 U f (the factor's frame, 3 per node: respond)
 
-   private:
-    FactoredMicaSolver* solver_;
-    size_t body_;
+    void apply(const Vec3List& r, Vec3List& z) override;
+    // Between the halves of z = P^-1 r: t = U^T z, force = -C t (Woodbury's forces), u = U^T of z
+    // corrected.
+    void start_correction();
+    // After the backward half into z (projected): z = u = t + Yc force exactly at the contact nodes.
+    void finish_correction(Vec3List& z);
+    // Adds the response to nodes.force, H M force (the factor's frame), to the halves' workspace;
+    // false when there is no force.
+    bool add_forces();
+    // The response to the node forces nodes.force (U f), and nodes.exact; false when there are none.
+    bool respond();
+    // out += S Q response, with the contact nodes' exact values.
+    void add_turned(Vec3List& out) const;
   };
-  // Each body's factor brought up to its system (factored_ in the bodies' order).
+  // The contact rows' compliance (nr rows, nt row terms): W = G P_c^-1 G^T of the factors in use,
+  // which the rounds' secant updates correct toward A's, and how the terms find their nodes.
+  struct Compliance {
+    std::vector<int32_t> term_slot;  // per row term: its node's slot in its body's nodes
+    std::vector<int32_t> term_row;   // per row term: its row
+    Eigen::MatrixXd W;               // nr x nr
+    std::vector<double> diag;        // W_rr, 0 for a row nothing can move along (row_diagonal)
+    std::vector<double> warped_diag;  // W_rr before the secant updates
+    // Two solved velocity fields s apart in the impulses measure the true compliance along it,
+    // y = w - w_prev: a BFGS update takes that into W (kept symmetric positive definite).
+    Eigen::VectorXd s, y, Ws;  // (no allocation once sized)
+    void secant_update(const std::vector<double>& w, const std::vector<double>& w_prev);
+    std::vector<int32_t> slot_of, last_slot;  // per node of the largest body, -1 (prepare_contact_nodes')
+  };
+  // The small contact problem on W (n <= nr live rows: those something can move along).
+  struct SmallProblem {
+    std::vector<double> lambda_next;  // per row: its solution
+    bool lemke_failed = false;        // Lemke's pivoting found no solution this solve (solve_small_lcp)
+    std::vector<int32_t> live, live_at;  // per live row its row; per row its live row or -1
+    Eigen::MatrixXd M;                   // W on the live rows, n x n
+    Eigen::VectorXd q, mu, start;
+    std::vector<int32_t> normal;
+    FrictionalSolution solution;
+    FrictionalWorkspace workspace;
+  };
+  // What the rounds of both loops measure (nr rows).
+  struct Rounds {
+    std::vector<double> w, w_prev;  // G v + bias of the current velocities, and of the last round's
+    std::vector<double> dlambda;    // the small problem's change of the impulses (the alternating loop's)
+    // The squared impulse that changes a row's velocity by the speed of its nodes (the largest over
+    // the rows): the tests' impulse scale is at least this. Below it a row velocity is zero to the
+    // tolerance, and impulses and their complementarity are the solves' round-off: two bodies that
+    // touch and fall together carry none, and a test relative to their ~1e-23 N s never passed.
+    double impulse_floor2 = 0;
+  };
+  // The active-set loop's (ne <= nr equalities, nb bodies).
+  struct ActiveSet {
+    std::vector<int32_t> eq;  // the rows held as equalities
+    Eigen::MatrixXd W0;       // G P_c^-1 G^T of the factor, without the secant updates (the projections need it exact)
+    // Sized to the largest active set seen (only ever grown); a set of ne rows uses the first ne
+    // entries (ne^2 of W_eq, column-major).
+    Eigen::VectorXd W_eq;
+    std::vector<std::unique_ptr<Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd>>> W_eq_solvers;  // by size
+    Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd>* W_eq_solver = nullptr;  // this set's
+    Eigen::VectorXd mu, mu_total, gap, eq_work, eq_y;  // per equality (nr entries kept)
+    std::vector<double> fixed, lambda_prev, lambda_check;  // per row
+    std::vector<double> row_weight;                        // per row: add_response's weights
+    std::vector<double> body_scale2;  // per body: |f|^2 (or its mass floor), constrained_solve's scale
+    FlexibleCg<BodyVectors> cg;       // per body, of the unknown y = S (v - z)
+    BodyVectors y, t, f;              // per body: y, scratch, the right-hand side S (b + G_F^T lambda_F - A z)
+    // The decomposition kept for active sets of ne rows, and those of every size up to nr made at once.
+    Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd>& equality_solver(Eigen::Index ne);
+    void prepare_equality_solvers(Eigen::Index nr);
+    // x = W_E^-1 rhs (the least-squares solution where rows are redundant).
+    void solve_equalities(const Eigen::Ref<const Eigen::VectorXd>& rhs, Eigen::Ref<Eigen::VectorXd> x);
+  };
+  // The alternating loop's state (solve()).
+  struct Alternation {
+    explicit Alternation(int32_t stall_rounds) : progress(stall_rounds) {}
+    int32_t round = 0;
+    bool may_refactor = false;  // only co-rotational bodies: a linear body's factor is its A
+    double final_tolerance = 0, inner_tolerance = 1, previous_inner_tolerance = 1;
+    double tighten = 1;  // without contact rows: how much tighter than the tolerance the solves must aim
+    bool velocities_solved = false;
+    double l_scale = 0;  // the impulses' scale, set by the first correction
+    StallWatch progress;
+  };
+
+  // Each body's factor brought up to its system, the preconditioners bound, W (factored_).
+  void prepare(const std::vector<SolverBody>& bodies, const ContactRows& rows, std::vector<double>& lambda);
   void update_factors(const std::vector<SolverBody>& bodies);
   // W, its diagonal and the rows nothing can move along, from the factor in use.
   void start_compliance(const std::vector<SolverBody>& bodies, const ContactRows& rows, std::vector<double>& lambda);
   void build_compliance(const std::vector<SolverBody>& bodies, const ContactRows& rows);
-  // The contact nodes, their half columns, Y and the Woodbury terms of each body (nodes_, term_slot_).
+  // The contact nodes, their half columns, Y and the Woodbury terms of each body (nodes,
+  // term_slot).
   void prepare_contact_nodes(const std::vector<SolverBody>& bodies, const ContactRows& rows);
-  // z = P_c^-1 r on body bi (the warped factor with Woodbury's correction between its halves).
-  void precondition(size_t bi, const Vec3List& r, Vec3List& z);
-  // Of body bi, between the halves of z = P^-1 r: t = U^T z, force = -C t (Woodbury's forces),
-  // u = U^T of z corrected.
-  void start_correction(size_t bi);
-  // After the backward half into z (projected): z = u = t + Yc force exactly at the contact nodes.
-  void finish_correction(size_t bi, Vec3List& z);
-  // Adds the response to nodes_[bi].force, H M force (the factor's frame), to the halves'
-  // workspace; false when there is no force.
-  bool add_forces(size_t bi);
   // v += P_c^-1 G^T dlambda (a backward solve of the half columns).
   void apply_impulse_change(std::vector<SolverBody>& bodies, const ContactRows& rows,
                             const std::vector<double>& dlambda);
-  // lambda_next_ solves the contact problem on W around lambda: 0 <= lambda_next _|_ w + W (lambda_next - lambda) >= 0
-  // on normal rows, Coulomb's cone on tangent pairs (frictional_contact.hpp).
+  // small_.lambda_next solves the contact problem on W around lambda: on normal rows
+  // 0 <= lambda_next _|_ w + W (lambda_next - lambda) >= 0, on tangent pairs Coulomb's cone
+  // (frictional_contact.hpp).
   void solve_small_lcp(const ContactRows& rows, double tolerance, const std::vector<double>& lambda,
                        const std::optional<std::chrono::steady_clock::time_point>& deadline);
-  // Of the current lambda against the current row velocities w_ (N s).
+  // Of the current lambda against the current row velocities rounds_.w (N s).
   double complementarity_error(const ContactRows& rows, const std::vector<double>& lambda);
   // The current systems factored now (co-rotational bodies), W and its diagonal from the new factor.
   void refactor_now(const std::vector<SolverBody>& bodies, const ContactRows& rows, std::vector<double>& lambda);
-  // Two solved velocity fields secant_s_ apart in the impulses measure the true compliance along
-  // it, y = w_ - w_prev_: a BFGS update takes that into W_ (kept symmetric positive definite).
-  void secant_update();
-  // w_ = G v + bias of the bodies' current velocities, and impulse_floor2_.
+  // rounds_.w = G v + bias of the bodies' current velocities, and rounds_.impulse_floor2.
   void row_velocities(const std::vector<SolverBody>& bodies, const ContactRows& rows);
-  // The squared impulse that changes a row's velocity by the speed of its nodes (the largest over
-  // the rows): the tests' impulse scale is at least this. Below it a row velocity is zero to the
-  // tolerance, and impulses and their complementarity are the solves' round-off: two bodies that
-  // touch and fall together carry none, and a test relative to their ~1e-23 N s never passed.
-  double impulse_floor2_ = 0;
+  // y such that S Q y = P_c^-1 G^T w on body bi for row weights w (FactoredBody::response: a
+  // backward solve of the half columns); false when no row with a weight has a term on the body.
+  bool body_response(size_t bi, const ContactRows& rows, const std::vector<double>& w);
+  // The report's measures of the velocities and impulses returned (contact_impulse scattered).
+  void balance(std::vector<SolverBody>& bodies, const ContactRows& rows, const std::vector<double>& lambda,
+               SolveReport& report);
+
+  // The alternating loop (solve()), from the active-set loop's report (or none), in stages:
+  SolveReport alternate(const SolveContext& ctx, std::vector<SolverBody>& bodies, const ContactRows& rows,
+                        std::vector<double>& lambda, SolveReport report);
+  // A v = b + G^T lambda on each body, to this round's tolerance.
+  void solve_velocities(const std::optional<SolveContext::Clock::time_point>& deadline,
+                        std::vector<SolverBody>& bodies, const ContactRows& rows, const std::vector<double>& lambda,
+                        Alternation& a, SolveReport& report);
+  // Without contact rows: whether the solves go on (tighter, or after a refactor) or stop.
+  bool solve_again(const std::vector<SolverBody>& bodies, Alternation& a, SolveReport& report);
+  // The row velocities of the solved velocities, what they teach W, and the small problem's
+  // impulses (small_.lambda_next, rounds_.dlambda).
+  void predict_impulses(const std::vector<SolverBody>& bodies, const ContactRows& rows,
+                        const std::vector<double>& lambda,
+                        const std::optional<SolveContext::Clock::time_point>& deadline, Alternation& a);
+  // Whether the impulses have settled with the velocities balancing them (converged).
+  bool settled(const std::vector<SolverBody>& bodies, const ContactRows& rows, const std::vector<double>& lambda,
+               Alternation& a, SolveReport& report);
 
   // The active-set loop (factored_mica_active_set.cpp, SolverSettings::active_set).
   SolveReport solve_active_set(const SolveContext& ctx, std::vector<SolverBody>& bodies, const ContactRows& rows,
                                std::vector<double>& lambda);
-  // eq_: the rows held as equalities for these impulses (pressing normal rows, sticking tangent
-  // pairs), and W_E = G_E P^-1 G_E^T factored; impulses at round-off level set to 0.
+  // active_.eq: the rows held as equalities for these impulses (pressing normal rows, sticking
+  // tangent pairs), and W_E = G_E P^-1 G_E^T factored; impulses at round-off level set to 0.
   void choose_equalities(const ContactRows& rows, std::vector<double>& lambda);
   // A v = b + G^T lambda with G_E v + bias_E = 0, by projected PCG; lambda_E out, the rest fixed.
   // Stops early with set_changed when the set is clearly wrong (set_clearly_wrong), impulse_scale2
@@ -180,81 +272,46 @@ class FactoredMicaSolver : public CachingVelocitySolver<FactoredBodyCache> {
                                 double tolerance, int32_t cap,
                                 const std::optional<SolveContext::Clock::time_point>& deadline, double impulse_scale2,
                                 bool& set_changed);
+  // constrained_solve's start: the fixed impulses' right-hand side f, and y from the warm start
+  // onto the equalities.
+  void start_constrained(std::vector<SolverBody>& bodies, const ContactRows& rows, const std::vector<double>& lambda);
+  // z = P_c^-1 r projected onto G_E z = 0, and mu, the impulses on E the residual asks for.
+  void precondition_constrained(const std::vector<SolverBody>& bodies, const ContactRows& rows);
+  // The equalities take mu's share of the residual; the worst body's relative residual, squared.
+  double constrained_residual2(const std::vector<SolverBody>& bodies, const ContactRows& rows);
   // During constrained_solve, at relative residual `residual`: the complementarity error of its
   // normal rows' impulses and velocities so far is above min(kWrongSet, kWrongFactor residual) of
-  // the impulses (it leaves them in lambda_check_ and w_). A right set's error shrinks with the
-  // residual (about 1e-16 of the impulses once solved); a wrong set's settles at the size of the
+  // the impulses (it leaves them in lambda_check and rounds_.w). A right set's error shrinks with
+  // the residual (about 1e-16 of the impulses once solved); a wrong set's settles at the size of the
   // impulse it gets wrong, which may be below kWrongSet.
   bool set_clearly_wrong(const std::vector<SolverBody>& bodies, const ContactRows& rows,
                          const std::vector<double>& lambda, const Eigen::Ref<const Eigen::VectorXd>& mu_total,
                          double impulse_scale2, double residual);
   static constexpr double kWrongSet = 1e-2;
   static constexpr double kWrongFactor = 3;
-  // x = W_E^-1 rhs (the least-squares solution where rows are redundant).
-  void solve_equalities(const Eigen::Ref<const Eigen::VectorXd>& rhs, Eigen::Ref<Eigen::VectorXd> x);
-  // y_ such that S Q y_ = P_c^-1 G^T w on body bi for row weights w (the factor's frame: a
-  // backward solve of the half columns); false when no row with a weight has a term on the body.
-  bool body_response(size_t bi, const ContactRows& rows, const std::vector<double>& w);
-  // The same for the node forces nodes_[bi].force (U f); false when there are none.
-  bool respond(size_t bi);
-  // out += S Q y_ on body bi.
-  void add_turned(size_t bi, Vec3List& out) const;
   // out += P_c^-1 G_which^T x (a backward solve of the half columns).
   void add_response(const std::vector<SolverBody>& bodies, const ContactRows& rows, const std::vector<int32_t>& which,
-                    const Eigen::Ref<const Eigen::VectorXd>& x, std::vector<Vec3List>& out);
+                    const Eigen::Ref<const Eigen::VectorXd>& x, BodyVectors& out);
   // out -= S G_E^T x.
   void subtract_row_forces(const std::vector<SolverBody>& bodies, const ContactRows& rows,
-                           const Eigen::Ref<const Eigen::VectorXd>& x, std::vector<Vec3List>& out) const;
-  // nodes_[b].load = S G_E^T x on body b's contact nodes, the equalities' load on the bodies (part
+                           const Eigen::Ref<const Eigen::VectorXd>& x, BodyVectors& out) const;
+  // nodes.load = S G_E^T x on each body's contact nodes, the equalities' load on the bodies (part
   // of the scale of constrained_solve's residual).
   void equality_loads(const std::vector<SolverBody>& bodies, const ContactRows& rows,
                       const Eigen::Ref<const Eigen::VectorXd>& x);
   // out = G_E y (no bias).
-  void rows_times(const ContactRows& rows, const std::vector<Vec3List>& y, Eigen::Ref<Eigen::VectorXd> out) const;
-  // out = G_E U u of the bodies' nodes_.u, and each body's force -= U^T G_E^T x.
+  void rows_times(const ContactRows& rows, const BodyVectors& y, Eigen::Ref<Eigen::VectorXd> out) const;
+  // out = G_E U u of the bodies' nodes.u, and each body's force -= U^T G_E^T x.
   void rows_times_nodes(const ContactRows& rows, Eigen::Ref<Eigen::VectorXd> out) const;
   void subtract_node_forces(const ContactRows& rows, const Eigen::Ref<const Eigen::VectorXd>& x);
-  // The decomposition kept for active sets of ne rows, and those of every size up to nr made at once.
-  Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd>& equality_solver(Eigen::Index ne);
-  void prepare_equality_solvers(Eigen::Index nr);
 
   SolverSettings settings_;
   double set_check_residual_ = kSetCheckResidual;
-  std::vector<FactoredBody> factored_;
-  std::vector<PcgSolver> pcg_;
-  std::vector<WarpedFactorPreconditioner> warp_;
-  std::vector<CorrectedPreconditioner> corrected_;
-  std::vector<ContactNodes> nodes_;                   // per body
-  std::vector<int32_t> term_slot_;                    // per row term: its node's slot in its body's nodes_
-  std::vector<int32_t> term_row_;                     // per row term: its row
-  std::vector<int32_t> slot_of_, last_slot_;          // per node, -1 (scratch of prepare_contact_nodes)
-  Eigen::MatrixXd W_;                                 // G P_c^-1 G^T
-  std::vector<double> w_, w_prev_, lambda_next_, dlambda_, diag_;
-  std::vector<int32_t> live_, live_at_, contact_nodes_;
-  Eigen::MatrixXd small_M_;                           // W on the live rows
-  Eigen::VectorXd small_q_, small_mu_, small_start_;
-  std::vector<int32_t> small_normal_;
-  FrictionalSolution small_solution_;
-  bool lemke_failed_ = false;  // this solve's small problem had no solution by pivoting (solve_small_lcp)
-  FrictionalWorkspace small_workspace_;
-  std::vector<double> warped_diag_;  // W_rr before the secant updates
-  std::vector<double> body_scale2_;  // constrained_solve: each body's |f|^2 (or its mass floor)
-  std::vector<Vec3List> rhs_;
-  Eigen::VectorXd y_;
-  std::vector<double> row_weight_;  // add_response's row weights
-  Eigen::VectorXd secant_s_, secant_y_, secant_Ws_;  // secant_update's (no allocation once sized)
-  // The active-set loop's.
-  Eigen::MatrixXd W0_;  // G P_c^-1 G^T of the factor, without the secant updates (the projections need it exact)
-  // Sized to the largest active set seen (only ever grown); a set of ne rows uses the first ne
-  // entries (ne^2 of W_eq_, column-major).
-  Eigen::VectorXd W_eq_;
-  std::vector<std::unique_ptr<Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd>>> W_eq_solvers_;  // by size
-  Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd>* W_eq_solver_ = nullptr;  // this set's
-  std::vector<int32_t> eq_;
-  Eigen::VectorXd mu_, mu_total_, row_scratch_, eq_work_, eq_y_;
-  std::vector<double> fixed_, lambda_prev_, lambda_check_;
-  std::vector<Vec3List> cy_, cr_, cz_, cp_, cq_, ct_, cf_;  // per body: y, r, z, p, A p, scratch, rhs
-  std::vector<Vec3List> cz_last_;                           // per body: the last z (the flexible beta)
+  std::vector<FactoredBody> factored_;  // per body
+  Compliance compliance_;
+  SmallProblem small_;
+  Rounds rounds_;
+  ActiveSet active_;
 };
 
 }  // namespace mica

@@ -17,11 +17,13 @@
 #include <Eigen/QR>
 #include <algorithm>
 #include <cmath>
+#include <initializer_list>
+#include <limits>
 
 #include "core/error.hpp"
 #include "solver/cod_solve.hpp"
 #include "solver/factored_mica.hpp"
-#include "solver/mica_solver.hpp"
+#include "solver/flexible_cg.hpp"
 
 namespace mica {
 
@@ -30,24 +32,6 @@ namespace {
 // Rounds of the active-set loop before it hands over to the alternating loop (a set that keeps
 // changing: contacts flickering at the threshold of pressing or sticking).
 constexpr int32_t kMaxRounds = 25;
-
-double dot(const std::vector<Vec3List>& a, const std::vector<Vec3List>& b) {
-  double s = 0;
-  for (size_t k = 0; k < a.size(); ++k) s += flat(a[k]).dot(flat(b[k]));
-  return s;
-}
-
-// a.b and a.c in one pass.
-std::pair<double, double> dots(const std::vector<Vec3List>& a, const std::vector<Vec3List>& b,
-                               const std::vector<Vec3List>& c) {
-  double ab = 0, ac = 0;
-  for (size_t k = 0; k < a.size(); ++k)
-    for (size_t i = 0; i < a[k].size(); ++i) {
-      ab += a[k][i].dot(b[k][i]);
-      ac += a[k][i].dot(c[k][i]);
-    }
-  return {ab, ac};
-}
 
 void project_free(const Projection& projection, Vec3List& y) {
   for (int32_t i : projection.nodes) y[i] = projection.S[i] * y[i];
@@ -61,38 +45,40 @@ void at_least(Eigen::VectorXd& v, Eigen::Index n) {
 }  // namespace
 
 void FactoredMicaSolver::choose_equalities(const ContactRows& rows, std::vector<double>& lambda) {
+  ActiveSet& as = active_;
+  const std::vector<double>& diag = compliance_.diag;
   // Impulses below 1e-12 of the largest are the small solver's round-off: not pressing.
   double largest = 0;
   for (size_t r = 0; r < rows.size(); ++r)
     if (rows.normal_of[r] < 0) largest = std::max(largest, lambda[r]);
   const double pressing = 1e-12 * largest;
-  eq_.clear();
+  as.eq.clear();
   for (size_t r = 0; r < rows.size(); ++r) {
     const int32_t n = rows.normal_of[r];
     if (n < 0) {
       if (lambda[r] <= pressing) lambda[r] = 0;
-      else if (diag_[r] > 0) eq_.push_back(int32_t(r));
+      else if (diag[r] > 0) as.eq.push_back(int32_t(r));
       continue;
     }
     if (lambda[n] == 0) lambda[r] = 0;  // the normal row comes first: already cleared
-    if (lambda[n] == 0 || diag_[r] == 0 || diag_[n] == 0) continue;
+    if (lambda[n] == 0 || diag[r] == 0 || diag[n] == 0) continue;
     const size_t first = rows.first_tangent(r) ? r : r - 1;  // the pair sticks or slides together
     const double t = std::hypot(lambda[first], lambda[first + 1]);
-    if (t < (1 - 1e-6) * rows.mu[r] * lambda[n]) eq_.push_back(int32_t(r));  // inside the disk: sticks
+    if (t < (1 - 1e-6) * rows.mu[r] * lambda[n]) as.eq.push_back(int32_t(r));  // inside the disk: sticks
   }
-  const Eigen::Index ne = Eigen::Index(eq_.size()), nr = Eigen::Index(rows.size());
+  const Eigen::Index ne = Eigen::Index(as.eq.size()), nr = Eigen::Index(rows.size());
   // Workspaces for any active set of these rows (ne <= nr), grown with the rows only.
-  at_least(W_eq_, nr * nr);
-  for (Eigen::VectorXd* v : {&mu_, &mu_total_, &row_scratch_, &eq_work_, &eq_y_}) at_least(*v, nr);
-  prepare_equality_solvers(nr);
-  Eigen::Map<Eigen::MatrixXd> W_eq(W_eq_.data(), ne, ne);
+  at_least(as.W_eq, nr * nr);
+  for (Eigen::VectorXd* v : {&as.mu, &as.mu_total, &as.gap, &as.eq_work, &as.eq_y}) at_least(*v, nr);
+  as.prepare_equality_solvers(nr);
+  Eigen::Map<Eigen::MatrixXd> W_eq(as.W_eq.data(), ne, ne);
   for (Eigen::Index a = 0; a < ne; ++a)
-    for (Eigen::Index b = 0; b < ne; ++b) W_eq(a, b) = W0_(eq_[a], eq_[b]);
+    for (Eigen::Index b = 0; b < ne; ++b) W_eq(a, b) = as.W0(as.eq[a], as.eq[b]);
   // Rank-revealing: rows pressing on nodes that cannot all move independently are redundant.
   if (ne > 0) {
-    W_eq_solver_ = &equality_solver(ne);
-    W_eq_solver_->setThreshold(1e-10);
-    W_eq_solver_->compute(W_eq);
+    as.W_eq_solver = &as.equality_solver(ne);
+    as.W_eq_solver->setThreshold(1e-10);
+    as.W_eq_solver->compute(W_eq);
   }
 }
 
@@ -101,68 +87,74 @@ void FactoredMicaSolver::choose_equalities(const ContactRows& rows, std::vector<
 // (their memory is ~ n^3 / 3 doubles: 5.6 MB at 128); larger sets make theirs on first use.
 constexpr Eigen::Index kPreparedEqualitySizes = 128;
 
-void FactoredMicaSolver::prepare_equality_solvers(Eigen::Index nr) {
-  for (Eigen::Index k = Eigen::Index(W_eq_solvers_.size()); k <= std::min(nr, kPreparedEqualitySizes); ++k)
-    W_eq_solvers_.push_back(std::make_unique<Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd>>(k, k));
+void FactoredMicaSolver::ActiveSet::prepare_equality_solvers(Eigen::Index nr) {
+  for (Eigen::Index k = Eigen::Index(W_eq_solvers.size()); k <= std::min(nr, kPreparedEqualitySizes); ++k)
+    W_eq_solvers.push_back(std::make_unique<Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd>>(k, k));
 }
 
-Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd>& FactoredMicaSolver::equality_solver(Eigen::Index ne) {
-  if (Eigen::Index(W_eq_solvers_.size()) <= ne) W_eq_solvers_.resize(size_t(ne) + 1);
-  auto& solver = W_eq_solvers_[size_t(ne)];
+Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd>& FactoredMicaSolver::ActiveSet::equality_solver(
+    Eigen::Index ne) {
+  if (Eigen::Index(W_eq_solvers.size()) <= ne) W_eq_solvers.resize(size_t(ne) + 1);
+  auto& solver = W_eq_solvers[size_t(ne)];
   if (!solver) solver = std::make_unique<Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd>>(ne, ne);
   return *solver;
 }
 
-void FactoredMicaSolver::solve_equalities(const Eigen::Ref<const Eigen::VectorXd>& rhs, Eigen::Ref<Eigen::VectorXd> x) {
-  if (!eq_.empty()) cod_solve(*W_eq_solver_, rhs, x, eq_work_, eq_y_);
+void FactoredMicaSolver::ActiveSet::solve_equalities(const Eigen::Ref<const Eigen::VectorXd>& rhs,
+                                                     Eigen::Ref<Eigen::VectorXd> x) {
+  if (!eq.empty()) cod_solve(*W_eq_solver, rhs, x, eq_work, eq_y);
 }
 
 void FactoredMicaSolver::add_response(const std::vector<SolverBody>& bodies, const ContactRows& rows,
                                       const std::vector<int32_t>& which, const Eigen::Ref<const Eigen::VectorXd>& x,
-                                      std::vector<Vec3List>& out) {
-  row_weight_.assign(rows.size(), 0.0);  // keeps its capacity
-  for (size_t a = 0; a < which.size(); ++a) row_weight_[size_t(which[a])] = x(Eigen::Index(a));
+                                      BodyVectors& out) {
+  std::vector<double>& weight = active_.row_weight;
+  weight.assign(rows.size(), 0.0);  // keeps its capacity
+  for (size_t a = 0; a < which.size(); ++a) weight[size_t(which[a])] = x(Eigen::Index(a));
   for (size_t bi = 0; bi < bodies.size(); ++bi)
-    if (body_response(bi, rows, row_weight_)) add_turned(bi, out[bi]);
+    if (body_response(bi, rows, weight)) factored_[bi].add_turned(out[bi]);
 }
 
 void FactoredMicaSolver::subtract_row_forces(const std::vector<SolverBody>& bodies, const ContactRows& rows,
-                                             const Eigen::Ref<const Eigen::VectorXd>& x,
-                                             std::vector<Vec3List>& out) const {
-  for (size_t a = 0; a < eq_.size(); ++a) {
-    const int32_t r = eq_[a];
+                                             const Eigen::Ref<const Eigen::VectorXd>& x, BodyVectors& out) const {
+  const std::vector<int32_t>& eq = active_.eq;
+  for (size_t a = 0; a < eq.size(); ++a) {
+    const int32_t r = eq[a];
     for (int32_t t = rows.start[r]; t < rows.start[r + 1]; ++t) {
-      const Projection& p = *bodies[rows.terms[t].body].projection;
-      const int32_t i = rows.terms[t].node;
-      const Vec3 g = rows.terms[t].coef * x(Eigen::Index(a)) * rows.direction[r];
-      out[rows.terms[t].body][i] -= p.active() && p.is_constrained[i] ? Vec3(p.S[i] * g) : g;
+      const RowTerm& term = rows.terms[t];
+      const Vec3 g = term.coef * x(Eigen::Index(a)) * rows.direction[r];
+      out[term.body][term.node] -= bodies[term.body].projection->free_part(term.node, g);
     }
   }
 }
 
 void FactoredMicaSolver::rows_times_nodes(const ContactRows& rows, Eigen::Ref<Eigen::VectorXd> out) const {
-  for (size_t a = 0; a < eq_.size(); ++a) {
-    const int32_t r = eq_[a];
+  const std::vector<int32_t>& eq = active_.eq;
+  for (size_t a = 0; a < eq.size(); ++a) {
+    const int32_t r = eq[a];
     double c = 0;
     for (int32_t t = rows.start[r]; t < rows.start[r + 1]; ++t)
-      c += rows.terms[t].coef * rows.direction[r].dot(nodes_[rows.terms[t].body].u.segment<3>(3 * term_slot_[t]));
+      c += rows.terms[t].coef *
+           rows.direction[r].dot(factored_[rows.terms[t].body].nodes.u.segment<3>(3 * compliance_.term_slot[t]));
     out(Eigen::Index(a)) = c;
   }
 }
 
 void FactoredMicaSolver::subtract_node_forces(const ContactRows& rows, const Eigen::Ref<const Eigen::VectorXd>& x) {
-  for (size_t a = 0; a < eq_.size(); ++a) {
-    const int32_t r = eq_[a];
+  const std::vector<int32_t>& eq = active_.eq;
+  for (size_t a = 0; a < eq.size(); ++a) {
+    const int32_t r = eq[a];
     for (int32_t t = rows.start[r]; t < rows.start[r + 1]; ++t)
-      nodes_[rows.terms[t].body].force.segment<3>(3 * term_slot_[t]) -=
+      factored_[rows.terms[t].body].nodes.force.segment<3>(3 * compliance_.term_slot[t]) -=
           (rows.terms[t].coef * x(Eigen::Index(a))) * rows.direction[r];
   }
 }
 
-void FactoredMicaSolver::rows_times(const ContactRows& rows, const std::vector<Vec3List>& y,
+void FactoredMicaSolver::rows_times(const ContactRows& rows, const BodyVectors& y,
                                     Eigen::Ref<Eigen::VectorXd> out) const {
-  for (size_t a = 0; a < eq_.size(); ++a) {
-    const int32_t r = eq_[a];
+  const std::vector<int32_t>& eq = active_.eq;
+  for (size_t a = 0; a < eq.size(); ++a) {
+    const int32_t r = eq[a];
     double c = 0;
     for (int32_t t = rows.start[r]; t < rows.start[r + 1]; ++t)
       c += rows.terms[t].coef * rows.direction[r].dot(y[rows.terms[t].body][rows.terms[t].node]);
@@ -172,15 +164,15 @@ void FactoredMicaSolver::rows_times(const ContactRows& rows, const std::vector<V
 
 void FactoredMicaSolver::equality_loads(const std::vector<SolverBody>& bodies, const ContactRows& rows,
                                         const Eigen::Ref<const Eigen::VectorXd>& x) {
-  for (ContactNodes& cn : nodes_) cn.load.setZero();
-  for (size_t a = 0; a < eq_.size(); ++a) {
-    const int32_t r = eq_[a];
+  const std::vector<int32_t>& eq = active_.eq;
+  for (FactoredBody& f : factored_) f.nodes.load.setZero();
+  for (size_t a = 0; a < eq.size(); ++a) {
+    const int32_t r = eq[a];
     for (int32_t t = rows.start[r]; t < rows.start[r + 1]; ++t) {
       const RowTerm& term = rows.terms[t];
-      const Projection& p = *bodies[term.body].projection;
       const Vec3 g = term.coef * x(Eigen::Index(a)) * rows.direction[r];
-      nodes_[term.body].load.segment<3>(3 * term_slot_[t]) +=
-          p.active() && p.is_constrained[term.node] ? Vec3(p.S[term.node] * g) : g;
+      factored_[term.body].nodes.load.segment<3>(3 * compliance_.term_slot[t]) +=
+          bodies[term.body].projection->free_part(term.node, g);
     }
   }
 }
@@ -189,23 +181,26 @@ bool FactoredMicaSolver::set_clearly_wrong(const std::vector<SolverBody>& bodies
                                            const std::vector<double>& lambda,
                                            const Eigen::Ref<const Eigen::VectorXd>& mu_total, double impulse_scale2,
                                            double residual) {
+  ActiveSet& as = active_;
+  std::vector<double>& w = rounds_.w;
   // The impulses and row velocities of the solve so far: lambda_E from the equalities' share, the
   // rest as fixed; v = y + z at the rows' nodes.
-  lambda_check_ = lambda;
-  for (size_t a = 0; a < eq_.size(); ++a) lambda_check_[size_t(eq_[a])] = -mu_total(Eigen::Index(a));
-  w_.assign(rows.size(), 0.0);
+  std::vector<double>& check = as.lambda_check;
+  check = lambda;
+  for (size_t a = 0; a < as.eq.size(); ++a) check[size_t(as.eq[a])] = -mu_total(Eigen::Index(a));
+  w.assign(rows.size(), 0.0);
   double l2 = 0;
   for (size_t r = 0; r < rows.size(); ++r) {
     double c = rows.bias[r];
     for (int32_t t = rows.start[r]; t < rows.start[r + 1]; ++t) {
       const RowTerm& term = rows.terms[t];
       const Projection& p = *bodies[term.body].projection;
-      Vec3 v = cy_[term.body][term.node];
+      Vec3 v = as.y[term.body][term.node];
       if (p.active() && p.is_constrained[term.node]) v += p.z[term.node];
       c += term.coef * rows.direction[r].dot(v);
     }
-    w_[r] = c;
-    l2 += lambda_check_[r] * lambda_check_[r];
+    w[r] = c;
+    l2 += check[r] * check[r];
   }
   // A right set of normal rows gives no complementarity error however loosely solved (pressing
   // rows push, the others do not sink); a wrong one an error of the size of the impulse it gets
@@ -213,45 +208,46 @@ bool FactoredMicaSolver::set_clearly_wrong(const std::vector<SolverBody>& bodies
   // the solve is loose.)
   double e2 = 0;
   for (size_t r = 0; r < rows.size(); ++r) {
-    if (rows.normal_of[r] >= 0 || diag_[r] == 0) continue;
-    const double next = std::max(0.0, lambda_check_[r] - w_[r] / warped_diag_[r]);
-    e2 += (next - lambda_check_[r]) * (next - lambda_check_[r]);
+    if (rows.normal_of[r] >= 0 || compliance_.diag[r] == 0) continue;
+    const double next = std::max(0.0, check[r] - w[r] / compliance_.warped_diag[r]);
+    e2 += (next - check[r]) * (next - check[r]);
   }
   // The limit follows the residual down: a round that would converge with its set still wrong
   // (its error settling below kWrongSet) stops when the error no longer shrinks with it, not
   // after a full solve (8-9 iterations of a nidus step, in about 1 step of 20).
   const double limit = std::min(kWrongSet, kWrongFactor * residual);
-  return e2 > limit * limit * std::max({l2, impulse_scale2, impulse_floor2_, 1e-300});
+  return e2 > limit * limit * std::max({l2, impulse_scale2, rounds_.impulse_floor2, 1e-300});
 }
 
-SolveReport FactoredMicaSolver::constrained_solve(std::vector<SolverBody>& bodies, const ContactRows& rows,
-                                                  std::vector<double>& lambda, double tolerance, int32_t cap,
-                                                  const std::optional<SolveContext::Clock::time_point>& deadline,
-                                                  double impulse_scale2, bool& set_changed) {
-  using Clock = SolveContext::Clock;
+void FactoredMicaSolver::start_constrained(std::vector<SolverBody>& bodies, const ContactRows& rows,
+                                           const std::vector<double>& lambda) {
+  ActiveSet& as = active_;
+  FlexibleCg<BodyVectors>& cg = as.cg;
   const size_t nb = bodies.size();
-  for (std::vector<Vec3List>* v : {&cy_, &cr_, &cz_, &cp_, &cq_, &ct_, &cf_, &cz_last_}) v->resize(nb);
+  const std::initializer_list<BodyVectors*> vectors = {&cg.r, &cg.z, &cg.p, &cg.q, &cg.z_last, &as.y, &as.t, &as.f};
+  for (BodyVectors* v : vectors) v->resize(nb);
   // The fixed impulses: every row but the equalities.
-  fixed_ = lambda;
-  for (int32_t r : eq_) fixed_[r] = 0;
-  scatter_contact_impulses(rows, fixed_, bodies);
+  as.fixed = lambda;
+  for (int32_t r : as.eq) as.fixed[r] = 0;
+  scatter_contact_impulses(rows, as.fixed, bodies);
   for (size_t bi = 0; bi < nb; ++bi) {
     const SolverBody& body = bodies[bi];
     const size_t n = size_t(body.node_count());
-    for (std::vector<Vec3List>* v : {&cy_, &cr_, &cz_, &cp_, &cq_, &ct_, &cf_, &cz_last_}) (*v)[bi].resize(n);
-    rhs_[bi] = *body.b;
-    for (size_t i = 0; i < n; ++i) rhs_[bi][i] += (*body.contact_impulse)[i];
-    body.projected().right_hand_side(rhs_[bi], cf_[bi], ct_[bi]);  // S (b + G_F^T lambda_F - A z)
-    cy_[bi] = *body.v;
-    project_free(*body.projection, cy_[bi]);  // the unknown y = S (v - z)
+    for (BodyVectors* v : vectors) (*v)[bi].resize(n);
+    Vec3List& rhs = factored_[bi].rhs;
+    rhs = *body.b;
+    for (size_t i = 0; i < n; ++i) rhs[i] += (*body.contact_impulse)[i];
+    body.projected().right_hand_side(rhs, as.f[bi], as.t[bi]);  // S (b + G_F^T lambda_F - A z)
+    as.y[bi] = *body.v;
+    project_free(*body.projection, as.y[bi]);  // the unknown y = S (v - z)
   }
   // Onto the equalities: G_E (y + z) + bias_E = 0, through P^-1 G_E^T and W_E = G_E P^-1 G_E^T.
-  const Eigen::Index ne = Eigen::Index(eq_.size());
-  auto gap = row_scratch_.head(ne);
-  auto mu = mu_.head(ne), mu_total = mu_total_.head(ne);
-  rows_times(rows, cy_, gap);
-  for (size_t a = 0; a < eq_.size(); ++a) {
-    const int32_t r = eq_[a];
+  const Eigen::Index ne = Eigen::Index(as.eq.size());
+  auto gap = as.gap.head(ne);
+  auto mu = as.mu.head(ne);
+  rows_times(rows, as.y, gap);
+  for (size_t a = 0; a < as.eq.size(); ++a) {
+    const int32_t r = as.eq[a];
     double c = rows.bias[r];
     for (int32_t t = rows.start[r]; t < rows.start[r + 1]; ++t) {
       const SolverBody& body = bodies[rows.terms[t].body];
@@ -261,53 +257,81 @@ SolveReport FactoredMicaSolver::constrained_solve(std::vector<SolverBody>& bodie
     }
     gap(Eigen::Index(a)) = -(gap(Eigen::Index(a)) + c);
   }
-  solve_equalities(gap, mu);
-  add_response(bodies, rows, eq_, mu, cy_);
-
-  set_changed = false;
-  SolveReport report;
+  as.solve_equalities(gap, mu);
+  add_response(bodies, rows, as.eq, mu, as.y);
   // Each body's residual is relative to its own loads, as in the momentum test that follows the
   // solve (momentum_residual): a small body's may not hide in a large one's.
-  body_scale2_.resize(nb);
+  as.body_scale2.resize(nb);
   for (size_t bi = 0; bi < nb; ++bi) {
     const ProjectedSystem sys = bodies[bi].projected();
-    sys.apply(cy_[bi], cq_[bi], ct_[bi]);
-    for (size_t i = 0; i < cy_[bi].size(); ++i) cr_[bi][i] = cf_[bi][i] - cq_[bi][i];
+    sys.apply(as.y[bi], cg.q[bi], as.t[bi]);
+    for (size_t i = 0; i < as.y[bi].size(); ++i) cg.r[bi][i] = as.f[bi][i] - cg.q[bi][i];
     double floor2 = 0;  // momentum_residual's floor, 1e-6 of each node's mass
     for (double m : bodies[bi].fem->node_mass) floor2 += 1e-12 * m * m;
-    body_scale2_[bi] = std::max(flat(cf_[bi]).squaredNorm(), floor2);
+    as.body_scale2[bi] = std::max(flat(as.f[bi]).squaredNorm(), floor2);
   }
-  double rz = 0;
-  mu_total.setZero();
+  as.mu_total.head(ne).setZero();
+}
+
+void FactoredMicaSolver::precondition_constrained(const std::vector<SolverBody>& bodies, const ContactRows& rows) {
+  // Both corrections of P^-1 r (Woodbury's and the projection's) are responses to forces on the
+  // contact nodes, added between the halves of its solve pair.
+  ActiveSet& as = active_;
+  const Eigen::Index ne = Eigen::Index(as.eq.size());
+  auto gap = as.gap.head(ne);
+  auto mu = as.mu.head(ne);
+  for (size_t bi = 0; bi < bodies.size(); ++bi) {
+    factored_[bi].warp.forward(as.cg.r[bi]);
+    factored_[bi].start_correction();
+  }
+  rows_times_nodes(rows, gap);
+  as.solve_equalities(gap, mu);
+  subtract_node_forces(rows, mu);
+  for (size_t bi = 0; bi < bodies.size(); ++bi) {
+    FactoredBody& f = factored_[bi];
+    f.add_forces();
+    f.warp.backward(as.cg.z[bi]);
+    project_free(*bodies[bi].projection, as.cg.z[bi]);
+    f.finish_correction(as.cg.z[bi]);
+  }
+}
+
+double FactoredMicaSolver::constrained_residual2(const std::vector<SolverBody>& bodies, const ContactRows& rows) {
+  // The equalities take their share of the residual, r -= S G_E^T mu, at every step (the
+  // residual update of Gould, Hribar and Nocedal: without it round-off in the projection stalls
+  // the residual of a solve far from its factor's system); what is left must be small.
+  ActiveSet& as = active_;
+  const Eigen::Index ne = Eigen::Index(as.eq.size());
+  auto mu = as.mu.head(ne), mu_total = as.mu_total.head(ne);
+  mu_total += mu;
+  subtract_row_forces(bodies, rows, mu, as.cg.r);
+  equality_loads(bodies, rows, mu_total);
+  double worst2 = 0;
+  for (size_t bi = 0; bi < bodies.size(); ++bi) {
+    const double g2 = flat(as.cg.r[bi]).squaredNorm();
+    if (!std::isfinite(g2)) fail(Errc::Numerical, "the constrained velocity solve diverged (loads or state overflow)");
+    worst2 = std::max(worst2, g2 / std::max({as.body_scale2[bi], factored_[bi].nodes.load.squaredNorm(), 1e-300}));
+  }
+  return worst2;
+}
+
+SolveReport FactoredMicaSolver::constrained_solve(std::vector<SolverBody>& bodies, const ContactRows& rows,
+                                                  std::vector<double>& lambda, double tolerance, int32_t cap,
+                                                  const std::optional<SolveContext::Clock::time_point>& deadline,
+                                                  double impulse_scale2, bool& set_changed) {
+  ActiveSet& as = active_;
+  start_constrained(bodies, rows, lambda);
+  const auto mu_total = as.mu_total.head(Eigen::Index(as.eq.size()));
+  const auto apply = [&](const BodyVectors& p, BodyVectors& q) {
+    for (size_t bi = 0; bi < bodies.size(); ++bi) bodies[bi].projected().apply(p[bi], q[bi], as.t[bi]);
+  };
+  set_changed = false;
+  SolveReport report;
+  as.cg.start();
   for (;;) {
-    // z = P_c^-1 r projected onto G_E z = 0; mu: the impulses on E the residual asks for. Both
-    // corrections of P^-1 r (Woodbury's and the projection's) are responses to forces on the
-    // contact nodes, added between the halves of its solve pair.
-    for (size_t bi = 0; bi < nb; ++bi) {
-      warp_[bi].forward(cr_[bi]);
-      start_correction(bi);
-    }
-    rows_times_nodes(rows, gap);
-    solve_equalities(gap, mu);
-    subtract_node_forces(rows, mu);
-    for (size_t bi = 0; bi < nb; ++bi) {
-      add_forces(bi);
-      warp_[bi].backward(cz_[bi]);
-      project_free(*bodies[bi].projection, cz_[bi]);
-      finish_correction(bi, cz_[bi]);
-    }
-    // The equalities take their share of the residual, r -= S G_E^T mu, at every step (the
-    // residual update of Gould, Hribar and Nocedal: without it round-off in the projection stalls
-    // the residual of a solve far from its factor's system); what is left must be small.
-    mu_total += mu;
-    subtract_row_forces(bodies, rows, mu, cr_);
-    equality_loads(bodies, rows, mu_total);
-    double worst2 = 0;
-    for (size_t bi = 0; bi < nb; ++bi) {
-      const double g2 = flat(cr_[bi]).squaredNorm();
-      if (!std::isfinite(g2)) fail(Errc::Numerical, "the constrained velocity solve diverged (loads or state overflow)");
-      worst2 = std::max(worst2, g2 / std::max({body_scale2_[bi], nodes_[bi].load.squaredNorm(), 1e-300}));
-    }
+    // z = P_c^-1 r projected onto G_E z = 0; mu: the impulses on E the residual asks for.
+    precondition_constrained(bodies, rows);
+    const double worst2 = constrained_residual2(bodies, rows);
     report.residual = std::sqrt(worst2);
     report.converged = worst2 <= tolerance * tolerance;
     if (report.converged || report.iterations >= cap) break;
@@ -317,42 +341,21 @@ SolveReport FactoredMicaSolver::constrained_solve(std::vector<SolverBody>& bodie
       set_changed = true;
       break;
     }
-    if (deadline && report.iterations > 0 && Clock::now() >= *deadline) {
+    if (deadline && report.iterations > 0 && SolveContext::Clock::now() >= *deadline) {
       report.out_of_time = true;
       break;
     }
-    const auto [rz_new, rz_last] = dots(cr_, cz_, cz_last_);
-    if (report.iterations == 0) {
-      cp_ = cz_;
-    } else {
-      // Polak-Ribiere's beta (flexible CG, Notay 2000): the preconditioner solves in single
-      // precision, which is not quite the same linear map at every step, and Fletcher-Reeves'
-      // rz_new / rz then stalls near float's precision (1.2e-7 on test_friction_physics).
-      const double beta = (rz_new - rz_last) / rz;
-      for (size_t bi = 0; bi < nb; ++bi)
-        for (size_t i = 0; i < cp_[bi].size(); ++i) cp_[bi][i] = cz_[bi][i] + beta * cp_[bi][i];
-    }
-    rz = rz_new;
-    cz_last_.swap(cz_);  // the next preconditioner step writes all of cz_
-    for (size_t bi = 0; bi < nb; ++bi) bodies[bi].projected().apply(cp_[bi], cq_[bi], ct_[bi]);
-    const double pq = dot(cp_, cq_);
-    if (!(pq > 0)) break;  // breakdown: not positive definite on the equalities' null space
-    const double alpha = rz / pq;
-    for (size_t bi = 0; bi < nb; ++bi)
-      for (size_t i = 0; i < cy_[bi].size(); ++i) {
-        cy_[bi][i] += alpha * cp_[bi][i];
-        cr_[bi][i] -= alpha * cq_[bi][i];
-      }
+    if (!as.cg.step(as.y, apply)) break;  // breakdown: not positive definite on the equalities' null space
     ++report.iterations;
   }
-  for (size_t bi = 0; bi < nb; ++bi) {
+  for (size_t bi = 0; bi < bodies.size(); ++bi) {
     Vec3List& v = *bodies[bi].v;
-    v = cy_[bi];
+    v = as.y[bi];
     const Projection& p = *bodies[bi].projection;
     for (int32_t i : p.nodes) v[i] += p.z[i];
   }
   // The residual the equalities took, f - A y = S G_E^T mu_total = -S G_E^T lambda_E.
-  for (size_t a = 0; a < eq_.size(); ++a) lambda[eq_[a]] = -mu_total(Eigen::Index(a));
+  for (size_t a = 0; a < as.eq.size(); ++a) lambda[as.eq[a]] = -mu_total(Eigen::Index(a));
   return report;
 }
 
@@ -362,9 +365,12 @@ SolveReport FactoredMicaSolver::solve_active_set(const SolveContext& ctx, std::v
   const SolverSettings& settings = settings_;
   const std::optional<Clock::time_point>& deadline = ctx.deadline;
   const size_t nr = rows.size();
-  W0_ = W_;
+  ActiveSet& as = active_;
+  std::vector<double>& lambda_next = small_.lambda_next;
+  as.W0 = compliance_.W;
   bool may_refactor = false;
-  for (const FactoredBody& f : factored_) may_refactor = may_refactor || (f.node_rotation && settings.refactor_after > 0);
+  for (const FactoredBody& f : factored_)
+    may_refactor = may_refactor || (f.node_rotation && settings.refactor_after > 0);
 
   SolveReport report;
   report.converged = false;
@@ -378,23 +384,23 @@ SolveReport FactoredMicaSolver::solve_active_set(const SolveContext& ctx, std::v
   row_velocities(bodies, rows);
   solve_small_lcp(rows, settings.tolerance, lambda, deadline);
   double l_scale = 0;
-  for (double l : lambda_next_) l_scale += l * l;
+  for (double l : lambda_next) l_scale += l * l;
   int32_t outer = 0;
-  bool have_pair = false;  // lambda_prev_ and w_prev_ are a solved round of this solve and factor
+  bool have_pair = false;  // lambda_prev and w_prev are a solved round of this solve and factor
   while (report.iterations < settings.max_iterations) {
     if (deadline && outer > 0 && Clock::now() >= *deadline) {
       report.out_of_time = true;
       break;
     }
     if (may_refactor && report.iterations >= settings.refactor_after) {  // as in solve(): once
-      refactor_now(bodies, rows, lambda_next_);
-      W0_ = W_;
+      refactor_now(bodies, rows, lambda_next);
+      as.W0 = compliance_.W;
       may_refactor = false;
       have_pair = false;
     }
     ++outer;
     ++report.solves;
-    lambda = lambda_next_;
+    lambda = lambda_next;
     choose_equalities(rows, lambda);
     const int32_t cap = may_refactor ? std::max(1, settings.refactor_after - report.iterations)
                                      : settings.max_iterations - report.iterations;
@@ -424,12 +430,11 @@ SolveReport FactoredMicaSolver::solve_active_set(const SolveContext& ctx, std::v
     double l2 = 0;
     for (double l : lambda) l2 += l * l;
     l_scale = std::max(l_scale, l2);
-    report.impulse_change = complementarity_error(rows, lambda) / std::sqrt(std::max({l_scale, impulse_floor2_, 1e-300}));
+    report.impulse_change =
+        complementarity_error(rows, lambda) / std::sqrt(std::max({l_scale, rounds_.impulse_floor2, 1e-300}));
     if (report.impulse_change <= settings.tolerance) {
       rows.project(lambda);  // a sliding pair kept its impulse while lambda_n was solved: back onto the disk
-      scatter_contact_impulses(rows, lambda, bodies);
-      report.momentum_residual = momentum_residual(bodies);
-      report.residual = std::max({report.velocity_change, report.impulse_change, report.momentum_residual});
+      balance(bodies, rows, lambda, report);
       report.converged = report.momentum_residual <= settings.tolerance;
       if (report.converged) return report;
       // Solved to its own test but not to the momentum test (the recurrence's residual has drifted
@@ -440,19 +445,17 @@ SolveReport FactoredMicaSolver::solve_active_set(const SolveContext& ctx, std::v
     // The solved pair measures the true compliance along the impulses' change (secant update, as
     // in solve()); then the small problem around the solved impulses predicts the next set.
     if (have_pair) {
-      secant_s_ = Eigen::Map<const Eigen::VectorXd>(lambda.data(), Eigen::Index(nr)) -
-                  Eigen::Map<const Eigen::VectorXd>(lambda_prev_.data(), Eigen::Index(nr));
-      secant_update();
+      compliance_.s = Eigen::Map<const Eigen::VectorXd>(lambda.data(), Eigen::Index(nr)) -
+                      Eigen::Map<const Eigen::VectorXd>(as.lambda_prev.data(), Eigen::Index(nr));
+      compliance_.secant_update(rounds_.w, rounds_.w_prev);
     }
-    w_prev_ = w_;
-    lambda_prev_ = lambda;
+    rounds_.w_prev = rounds_.w;
+    as.lambda_prev = lambda;
     have_pair = true;
     solve_small_lcp(rows, settings.tolerance, lambda, deadline);
   }
   rows.project(lambda);
-  scatter_contact_impulses(rows, lambda, bodies);
-  report.momentum_residual = momentum_residual(bodies);
-  report.residual = std::max({report.velocity_change, report.impulse_change, report.momentum_residual});
+  balance(bodies, rows, lambda, report);
   return report;
 }
 

@@ -2,6 +2,7 @@
 #include "solver/lagged_factor.hpp"
 
 #include <algorithm>
+#include <type_traits>
 
 namespace mica {
 
@@ -271,6 +272,9 @@ void LaggedFactor::load_slot(Slot& slot, ByteReader& in, const BlockPattern& pat
   slot.direct.factorize(ProjectedSystem{pattern, slot.A, slot.projection});
   require_halves(slot);
 }
+
+// A saved state holds the key's bytes: h, alpha, beta and the constraint version.
+static_assert(sizeof(LaggedFactor::Key) == 4 * 8 && std::is_trivially_copyable_v<LaggedFactor::Key>);
 
 void LaggedFactor::save(ByteWriter& out) const {
   out.put(key_);

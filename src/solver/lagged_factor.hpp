@@ -35,12 +35,12 @@ namespace mica {
 
 class LaggedFactor {
  public:
+  // What the factor in use was made for: the system's and the constraint set's
+  // (SolverBody::system, constraint_version).
   struct Key {
-    double h = 0, alpha = 0, beta = 0;
-    uint64_t lpc_version = ~uint64_t(0);
-    bool operator==(const Key& o) const {
-      return h == o.h && alpha == o.alpha && beta == o.beta && lpc_version == o.lpc_version;
-    }
+    SystemKey system;
+    uint64_t constraint_version = ~uint64_t(0);  // none yet: the first update factors
+    bool operator==(const Key& o) const { return system == o.system && constraint_version == o.constraint_version; }
   };
   LaggedFactor();
   ~LaggedFactor();  // waits for a background factorization in flight

@@ -50,8 +50,4 @@ class MicaSolver : public VelocitySolver {
   std::vector<std::array<double, 2>> block_sums_;  // coloured sweep: |dv|^2 and |v|^2 per block, in sweep order
 };
 
-// |S (b + G^T lambda - A v)| / max(|S b|, |S G^T lambda|, |S A v|, |S M v|, 1 um/s of momentum
-// per node), the worst body's, with M lumped and G^T lambda from SolverBody::contact_impulse.
-double momentum_residual(const std::vector<SolverBody>& bodies);
-
 }  // namespace mica

@@ -3,18 +3,20 @@
 #pragma once
 #include <chrono>
 #include <optional>
+#include "solver/flexible_cg.hpp"
 #include "solver/projected_system.hpp"
 
 namespace mica {
 
 struct PcgWorkspace {
-  Vec3List r, z, z_last, p, q, tmp, rhs;
+  FlexibleCg<Vec3List> cg;
+  Vec3List tmp, rhs;
   std::vector<Mat3> inv_diag;
   void resize(size_t n);  // allocates only when n changes
 };
 
-// z = M^-1 r for a symmetric positive definite approximation M of the projected system; the
-// solver projects its result (z = S z) itself.
+// z = M^-1 r for a symmetric positive definite approximation M of the projected system, written
+// to every entry of z; the solver projects its result (z = S z) itself.
 class Preconditioner {
  public:
   virtual ~Preconditioner() = default;
@@ -24,7 +26,7 @@ class Preconditioner {
 // Projected PCG as a LinearSolver: stops when ||P y - rhs|| <= tolerance ||rhs||, after
 // max_iterations, or at the deadline (if one is set). Block-Jacobi preconditioned unless given
 // another preconditioner, which may round (a single-precision factor): the search directions
-// take Polak-Ribiere's beta (flexible CG), which such a preconditioner does not stall.
+// take Polak-Ribiere's beta (flexible_cg.hpp), which such a preconditioner does not stall.
 class PcgSolver : public LinearSolver {
  public:
   using Clock = std::chrono::steady_clock;

@@ -12,6 +12,11 @@ void Projection::reset(int32_t node_count) {
   nodes.clear();
 }
 
+const Mat3& Projection::projector(int32_t i) const {
+  static const Mat3 identity = Mat3::Identity();
+  return active() && is_constrained[i] ? S[i] : identity;
+}
+
 void Projection::constrain(int32_t node, const Mat3& C, const Vec3& velocity) {
   const Mat3 I = Mat3::Identity();
   const Mat3 C_old = I - S[node];

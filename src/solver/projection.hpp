@@ -16,6 +16,10 @@ struct Projection {
   std::vector<uint8_t> is_constrained;
 
   bool active() const { return !nodes.empty(); }
+  // S_i v, the part of v free at node i (v itself at a free node).
+  Vec3 free_part(int32_t i, const Vec3& v) const { return active() && is_constrained[i] ? Vec3(S[i] * v) : v; }
+  // S_i (the identity at a free node).
+  const Mat3& projector(int32_t i) const;
   // Frees every node of a body with `node_count` nodes (allocates only on a size change).
   void reset(int32_t node_count);
   // Adds the constrained directions `C` (a projector, I - S of the new constraint) at `node`

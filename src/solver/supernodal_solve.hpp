@@ -1,12 +1,18 @@
 // SPDX-License-Identifier: Apache-2.0
 // The triangular solve pair with CHOLMOD's supernodal LL^T factor, for one right-hand side,
 // written out by hand, in double or from a copy of the factor in single or half precision.
-// cholmod_solve2 makes two BLAS-2 calls per supernode and triangle; the velocity systems here
-// have about a thousand supernodes of a few columns each (the nidus: 1101 of ~7.5), and the
-// pair is bound by reading the factor from memory (8.6 MB on the nidus). The factored sweep's
-// preconditioner needs no more than the copy's precision (its projection and residuals stay in
-// double): a half or a quarter of the bytes to read. bench_factor prints all four;
-// tests/solver/test_supernodal_solve.cpp holds them to cholmod_solve2.
+// Why beside CHOLMOD, which factors: the factored sweep solves one right-hand side at a time,
+// and a contact node's half columns are a forward solve of a sparse one (its three unit
+// columns). CHOLMOD's sparse right-hand side (cholmod_solve2's Bset) works on simplicial factors
+// only: it turns a supernodal factor simplicial, for good. For a dense one, cholmod_solve2 makes
+// two BLAS-2 calls per supernode and triangle, where the velocity systems here have about a
+// thousand supernodes of a few columns each (the nidus: 1101 of ~7.5), and the pair is bound by
+// reading the factor from memory (8.6 MB on the nidus). The factored sweep's preconditioner
+// needs no more than the copy's precision (its projection and residuals stay in double): a half
+// or a quarter of the bytes to read. On the nidus a pair takes 0.419 ms with cholmod_solve2 and
+// 0.137 ms by hand from the half copy (0.385 in double, 0.243 in single; bench_factor, no node
+// held: docs/performance.md's factorization table); tests/solver/test_supernodal_solve.cpp
+// holds them to cholmod_solve2.
 #pragma once
 #include <cholmod.h>
 

@@ -175,5 +175,8 @@ void zero_velocities(std::vector<SolverBody>& bodies);
 // contact_impulse of every body = G^T lambda.
 void scatter_contact_impulses(const ContactRows& rows, const std::vector<double>& lambda,
                               std::vector<SolverBody>& bodies);
+// |S (b + G^T lambda - A v)| / max(|S b|, |S G^T lambda|, |S A v|, |S M v|, 1 um/s of momentum
+// per node), the worst body's, with M lumped and G^T lambda from SolverBody::contact_impulse.
+double momentum_residual(const std::vector<SolverBody>& bodies);
 
 }  // namespace mica

@@ -13,7 +13,7 @@ Recorder::Recorder(const std::string& path, const WorldSettings& settings) : pat
   ByteWriter header;
   header.put_bytes(kRecordingMagic, sizeof kRecordingMagic);
   header.put(kRecordingVersion);
-  header.put(kRecordingLayout);
+  header.put(kByteLayout);
   put(header, settings);
   if (std::fwrite(header.bytes().data(), 1, header.bytes().size(), file_) != header.bytes().size()) {
     std::fclose(file_);

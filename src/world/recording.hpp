@@ -28,8 +28,6 @@ constexpr uint32_t kLastRecordKind = uint32_t(RecordKind::RemoveTets);
 constexpr char kRecordingMagic[8] = {'M', 'I', 'C', 'A', 'R', 'E', 'C', '1'};
 constexpr uint32_t kRecordingVersion = 2;            // 2: the end entry, tool teleports, tet removals
 constexpr uint32_t kRecordingVersionWithoutEnd = 1;  // libmica 0.6's, still replayed
-// Byte order and the size of a double: a recording is replayed where such values read back alike.
-constexpr uint32_t kRecordingLayout = 0x01020304u ^ uint32_t(sizeof(double) << 24);
 
 // What precedes each entry's payload in the file.
 struct RecordEntryHeader {

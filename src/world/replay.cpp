@@ -39,7 +39,7 @@ Replay::Replay(std::vector<uint8_t> bytes, std::string name) : bytes_(std::move(
   uint32_t layout = 0;
   header(version_);
   header(layout);
-  if ((version_ != kRecordingVersion && version_ != kRecordingVersionWithoutEnd) || layout != kRecordingLayout)
+  if ((version_ != kRecordingVersion && version_ != kRecordingVersionWithoutEnd) || layout != kByteLayout)
     fail(Errc::Parse, name_ + " is of format " + std::to_string(version_) + " (layout " + std::to_string(layout) +
                           "); this libmica replays formats " + std::to_string(kRecordingVersionWithoutEnd) + " to " +
                           std::to_string(kRecordingVersion) + " recorded on a machine like this one");

@@ -38,8 +38,6 @@ constexpr char kMagic[8] = {'M', 'I', 'C', 'A', 'S', 'T', 'A', 'T'};
 // 2: the contacts' curvature impulses; 3: v_previous; 4: solves, factorizations; 5: the step's
 // work (contact impulses, start rotations, tool velocities) left out, the energy debt one number
 constexpr uint32_t kFormatVersion = 5;
-// Byte order and the size of a double: a state is read back only where it was written.
-constexpr uint32_t kLayout = 0x01020304u ^ uint32_t(sizeof(double) << 24);
 
 struct Header {
   char magic[8];
@@ -340,7 +338,7 @@ std::vector<uint8_t> World::save_state() const {
   Header header{};
   std::memcpy(header.magic, kMagic, sizeof kMagic);
   header.version = kFormatVersion;
-  header.layout = kLayout;
+  header.layout = kByteLayout;
   header.size = bytes.size();
   header.checksum = fnv1a(bytes.data() + kHeaderSize, bytes.size() - kHeaderSize);
   std::memcpy(bytes.data(), &header, kHeaderSize);
@@ -356,7 +354,7 @@ void World::restore_state(const uint8_t* data, size_t size) {
   std::memcpy(&header, data, kHeaderSize);
   if (std::memcmp(header.magic, kMagic, sizeof kMagic) != 0)
     fail(Errc::Parse, "the buffer is not a saved libmica state (no MICASTAT header)");
-  if (header.version != kFormatVersion || header.layout != kLayout)
+  if (header.version != kFormatVersion || header.layout != kByteLayout)
     fail(Errc::Parse, "the state is of format " + std::to_string(header.version) + " (layout " +
                           std::to_string(header.layout) + "); this libmica reads format " +
                           std::to_string(kFormatVersion) + " written on a machine like this one");

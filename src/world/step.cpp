@@ -2,6 +2,8 @@
 // The step: one linearised backward-Euler step at velocity level, per body
 //   A v+ = b,  A = M + h C + h^2 K,  b = M v + h (f_int(x) + f_ext),  x+ = x + h v+,
 // under the projection constraints (I - S) v+ = z. Each stage runs only when the plan holds it.
+// Tested as a whole by tests/world/test_plan.cpp (the stages a scene calls for) and
+// tests/capi/test_world_state.c (the step as a transaction, for every solver).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -189,7 +191,8 @@ void World::follow_devices() {
   devices_.for_each([&](Id, DeviceLink& link) {
     ScenePose pose;
     const Id target = link.settings().tool ? link.settings().tool : link.settings().lpc;
-    // (The servo path publishes only finite unit poses; checked again: a tool never gets NaN.)
+    // (The servo path publishes only finite unit poses; checked again: a tool never gets NaN. Not
+    // require_rotation's check: a device's pose is taken as it is, not normalised as a host's is.)
     if (!target || !link.latest_pose(pose) || !pose.position.allFinite() || !pose.orientation.coeffs().allFinite() ||
         !(std::fabs(pose.orientation.norm() - 1) < 1e-6))
       return;

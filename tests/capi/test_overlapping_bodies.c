@@ -17,22 +17,13 @@
 
 #include <mica/mica.h>
 
-typedef struct {
-  int warnings;
-  char last[1024];
-} log_capture;
+#include "log_capture.h"
 
-static void capture(int32_t level, const char* message, void* user) {
-  log_capture* c = user;
-  if (level != MICA_LOG_WARNING) return;
-  c->warnings++;
-  snprintf(c->last, sizeof c->last, "%s", message);
-}
 
 static mica_world* make_world(log_capture* log, double gravity_y) {
   mica_world_def wd = mica_world_def_default(); /* MICA, factored sweep */
   wd.gravity[1] = gravity_y;
-  wd.log = capture;
+  wd.log = capture_log;
   wd.log_user = log;
   mica_world* w = NULL;
   assert_int_equal(mica_world_create(&wd, &w), MICA_OK);

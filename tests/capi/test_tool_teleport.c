@@ -18,24 +18,14 @@
 
 #include "box_scene.h"
 #include "capi_ok.h"
+#include "log_capture.h"
 
-typedef struct log_capture {
-  int warnings;
-  char last[1024];
-} log_capture;
-
-static void capture(int32_t level, const char* message, void* user) {
-  log_capture* c = user;
-  if (level != MICA_LOG_WARNING) return;
-  c->warnings += 1;
-  snprintf(c->last, sizeof c->last, "%s", message);
-}
 
 /* The cube [0, 0.1]^3 fixed at its base, no gravity, and a 1 cm sphere created at `start`. */
 static mica_world* cube_and_sphere(const double start[3], log_capture* log, box_scene* s) {
   mica_world_def wd = mica_world_def_default();
   wd.gravity[1] = 0;
-  wd.log = capture;
+  wd.log = capture_log;
   wd.log_user = log;
   mica_world* w = NULL;
   OK(NULL, mica_world_create(&wd, &w));

@@ -157,6 +157,22 @@ static void free_readout(readout* r) {
   free(r->state);
 }
 
+/* Both worlds step `steps` times with the tool at (x0 + dx k, y, z) and read out alike after each
+ * step (but for timings). */
+static void step_alike(scene* a, scene* b, int steps, double x0, double dx) {
+  for (int k = 0; k < steps; ++k) {
+    const double p[3] = {x0 + dx * k, 0.1 + 0.02 - 0.003, 0.05}, q[4] = {1, 0, 0, 0};
+    OK(a->w, mica_tool_set_pose(a->w, a->box.tool, p, q));
+    OK(b->w, mica_tool_set_pose(b->w, b->box.tool, p, q));
+    OK(a->w, mica_step(a->w, 0.01));
+    OK(b->w, mica_step(b->w, 0.01));
+    readout ra = read_world(a, 0), rb = read_world(b, 0);
+    assert_same_readout(&ra, &rb);
+    free_readout(&ra);
+    free_readout(&rb);
+  }
+}
+
 static void test_a_failed_step_changes_no_readout(void** state) {
   (void)state;
   for (size_t k = 0; k < sizeof kCases / sizeof kCases[0]; ++k) {
@@ -186,14 +202,7 @@ static void test_a_failed_step_changes_no_readout(void** state) {
     free_readout(&before);
     free_readout(&after);
     /* And the world goes on as if the step had never been tried. */
-    for (int i = 0; i < 3; ++i) {
-      OK(failing.w, mica_step(failing.w, 0.01));
-      OK(twin.w, mica_step(twin.w, 0.01));
-      readout a = read_world(&failing, 0), b = read_world(&twin, 0);
-      assert_same_readout(&a, &b);
-      free_readout(&a);
-      free_readout(&b);
-    }
+    step_alike(&failing, &twin, 3, 0.03, 0);
     mica_world_destroy(failing.w);
     mica_world_destroy(twin.w);
   }
@@ -218,17 +227,7 @@ static void test_a_restored_state_reads_and_steps_as_the_original(void** state) 
     assert_same_readout(&saved, &back);
     free_readout(&saved);
     free_readout(&back);
-    for (int i = 0; i < 4; ++i) {
-      const double p[3] = {0.03 + 0.001 * i, 0.1 + 0.02 - 0.004, 0.05}, q[4] = {1, 0, 0, 0};
-      OK(original.w, mica_tool_set_pose(original.w, original.box.tool, p, q));
-      OK(restored.w, mica_tool_set_pose(restored.w, restored.box.tool, p, q));
-      OK(original.w, mica_step(original.w, 0.01));
-      OK(restored.w, mica_step(restored.w, 0.01));
-      readout a = read_world(&original, 0), b = read_world(&restored, 0);
-      assert_same_readout(&a, &b);
-      free_readout(&a);
-      free_readout(&b);
-    }
+    step_alike(&original, &restored, 4, 0.03, 0.001);
     mica_world_destroy(original.w);
     mica_world_destroy(restored.w);
   }

@@ -142,7 +142,7 @@ static void test_rollback_leaves_the_saved_factor(void**) {
   Twist t = make_twist(1);
   for (int k = 0; k < 3; ++k) step(t);
   const Body& b = t.world->body(t.body);
-  const LaggedFactor::Key key{0.01, 0, 0, 0};
+  const LaggedFactor::Key key{SystemKey{0.01, 0, 0}, 0};
   LaggedFactor factor;
   factor.update(b.fem, key, b.A, b.projection, &b.rotations(), 1);  // factors now, then refreshes every step
   step(t);
@@ -169,7 +169,7 @@ static void test_background_columns_are_the_same_bits(void**) {
   Twist t = make_twist(1);
   step(t);
   const Body& b = t.world->body(t.body);
-  const LaggedFactor::Key key{0.01, 0, 0, 0};
+  const LaggedFactor::Key key{SystemKey{0.01, 0, 0}, 0};
   LaggedFactor worker, stepper;
   stepper.set_background_columns(false);
   std::vector<Mat3> node_rotation;
@@ -207,7 +207,7 @@ static void test_loads_a_state_with_dense_columns(void**) {
   std::vector<Mat3> node_rotation;
   compute_node_rotations(b.fem, b.rotations(), node_rotation);
   LaggedFactor factor;
-  factor.update(b.fem, LaggedFactor::Key{0.01, 0, 0, 0}, b.A, b.projection, &node_rotation, 0);
+  factor.update(b.fem, LaggedFactor::Key{SystemKey{0.01, 0, 0}, 0}, b.A, b.projection, &node_rotation, 0);
   ByteWriter now;
   factor.save(now);
   const int64_t n = b.fem.node_count();
