@@ -64,8 +64,6 @@ struct ToolScratch {
 
 struct Tool : ToolModel, ToolState, ToolScratch {
   const ToolModel& model() const { return *this; }
-  const ToolState& state() const { return *this; }
-  const ToolScratch& scratch() const { return *this; }
 };
 
 // Checks the parameters the shape uses (finite; radius, half_length, half_extents > 0; a plane

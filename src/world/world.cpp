@@ -298,10 +298,7 @@ void World::teleport_tool(Id id, const Vec3& position, const Eigen::Quaterniond&
   t.position = t.previous_position = position;
   t.orientation = t.previous_orientation = orientation.normalized();
   // Its contacts' impulses are of another place: no warm start, no curvature term from them.
-  for (size_t r = 0; r < last_.rows.size(); ++r) {
-    const Contact& c = last_.contacts[size_t(last_.rows.contact[r])];
-    if (c.tool >= 0 && last_.tools[size_t(c.tool)] == id) warm_start_.erase(last_.rows.key[r]);
-  }
+  for (uint64_t key : contact_row_keys(id)) warm_start_.erase(key);
   if (recorder_) recorder_->write(RecordKind::TeleportTool, id, position, orientation);
 }
 

@@ -286,8 +286,8 @@ class World {
   void visit_world_state(V& v, BodyExtra&& body_extra) const;
   Id insert_lpc(Id body, const std::vector<int32_t>& nodes, const LpcSpec& spec);  // add_lpc, unrecorded
 
-  // The keys of the rows of the last step's contacts that touch a body (their warm starts).
-  std::vector<uint64_t> contact_row_keys(Id body) const;
+  // The keys of the rows of the last step's contacts that touch a body or a tool (their warm starts).
+  std::vector<uint64_t> contact_row_keys(Id id) const;
   // A world with threads > 1 colours a dynamic body's tets and nodes for its parallel loops.
   void colour_for_threads(Body& b) const;
 
