@@ -17,12 +17,14 @@ mica_body_def body_defaults() {
   d.youngs_modulus = 1e4;
   d.poisson_ratio = 0.3;
   d.density = 1000;
+  d.cutting_resistance = mica::kDefaultCuttingResistance;
   return d;
 }
 
 struct BodyInput {
   mica::BodySettings settings;
   mica::Vec3 translation, velocity;
+  double cutting_resistance;  // N/m, every tet
 };
 
 BodyInput translate(const mica_body_def* def) {
@@ -41,6 +43,10 @@ BodyInput translate(const mica_body_def* def) {
   in.settings.is_static = d.is_static == 1;
   in.translation = vec3(d.translation, "def->translation");
   in.velocity = vec3(d.velocity, "def->velocity");
+  if (!(d.cutting_resistance >= 0) || !std::isfinite(d.cutting_resistance))
+    refuse(MICA_ERR_INVALID_ARGUMENT, "def->cutting_resistance is " + mica::number_text(d.cutting_resistance) +
+                                          " N/m, must be finite and >= 0");
+  in.cutting_resistance = d.cutting_resistance;
   return in;
 }
 
@@ -50,6 +56,8 @@ mica_status create(mica_world* world, const mica_body_def* def, const mica::TetM
                    mica_body_id* out) {
   const BodyInput in = translate(def);
   *out = world->world.add_body(mesh, in.settings, in.translation, in.velocity);
+  if (in.cutting_resistance != mica::kDefaultCuttingResistance)
+    world->world.set_cutting_resistance(*out, std::vector<double>(mesh.tets.size(), in.cutting_resistance));
   const std::vector<mica::BodyOverlap>& overlaps = world->world.overlaps_at_creation();
   if (overlaps.empty()) return MICA_OK;
   try {
@@ -330,6 +338,37 @@ MICA_API mica_status mica_body_remove_tets(mica_world* world, mica_body_id body,
     });
     const double removed = world->world.remove_tets(body, count ? node_list(tets, count) : std::vector<int32_t>{});
     if (out_removed_mass) *out_removed_mass = removed;
+    return MICA_OK;
+  });
+}
+
+MICA_API mica_status mica_body_cut(mica_world* world, mica_body_id body, const double* triangles,
+                                   int32_t triangle_count, int32_t* out_faces_cut, int32_t* out_nodes_added) {
+  return guarded(world, "mica_body_cut", [&] {
+    require(world, "world");
+    check_count(triangle_count, 0, "triangle_count");
+    if (triangle_count > 0) require(triangles, "triangles");
+    const mica::Body& b = world->world.body(body);  // throws for a stale id
+    world->embeddings.for_each([&](uint64_t, const mica::Embedding& e) {
+      if (e.body() == body)
+        mica::fail(mica::Errc::WrongState, b.name + " has an embedded render mesh: destroy the embedding first");
+    });
+    mica::Vec3List corners(size_t(triangle_count) * 3);
+    for (size_t k = 0; k < corners.size(); ++k) corners[k] = mica::Vec3(triangles[3 * k], triangles[3 * k + 1], triangles[3 * k + 2]);
+    const mica::World::CutResult r = world->world.cut(body, corners);
+    if (out_faces_cut) *out_faces_cut = r.faces;
+    if (out_nodes_added) *out_nodes_added = r.nodes_added;
+    return MICA_OK;
+  });
+}
+
+MICA_API mica_status mica_body_set_cutting_resistance(mica_world* world, mica_body_id body, const double* per_tet,
+                                                      int32_t tet_count) {
+  return guarded(world, "mica_body_set_cutting_resistance", [&] {
+    require(world, "world");
+    require(per_tet, "per_tet");
+    check_count(tet_count, 0, "tet_count");
+    world->world.set_cutting_resistance(body, std::vector<double>(per_tet, per_tet + tet_count));
     return MICA_OK;
   });
 }

@@ -56,7 +56,11 @@ MICA_API mica_status mica_tool_create(mica_world* world, const mica_tool_def* de
     t.orientation = quaternion(d.orientation, "def->orientation");
     t.margin = d.margin;
     t.friction = d.friction;
+    if (d.blade != 0 && d.blade != 1) refuse(MICA_ERR_INVALID_ARGUMENT, "def->blade must be 0 or 1");
+    if (d.blade && t.shape != mica::ToolShape::Capsule)
+      refuse(MICA_ERR_INVALID_ARGUMENT, "def->blade is 1 for a tool that is not a capsule (a blade's edge is a capsule's segment)");
     *out_tool = world->world.add_tool(t);
+    if (d.blade) world->world.set_tool_blade(*out_tool, true);
     return MICA_OK;
   });
 }

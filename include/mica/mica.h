@@ -351,6 +351,9 @@ typedef struct mica_body_def {
   double rayleigh_beta;  /**< stiffness-proportional damping, s, >= 0; default 0 */
   double translation[3]; /**< m, added to every node at creation; default 0 */
   double velocity[3];    /**< m/s, initial velocity of every node; default 0 */
+  double cutting_resistance; /**< N per m of blade edge the tissue bears before a blade parts it
+                                  (mica_tool_def.blade), >= 0, every tet (since 0.8; per tet:
+                                  mica_body_set_cutting_resistance()); default 200 */
 } mica_body_def;
 
 /** Fills `def` with defaults, writing only its first `struct_size` bytes. Thread: any.
@@ -708,7 +711,49 @@ MICA_API mica_status mica_body_set_materials(mica_world* world, mica_body_id bod
 MICA_API mica_status mica_body_remove_tets(mica_world* world, mica_body_id body, const int32_t* tets,
                                            int32_t count, double* out_removed_mass);
 
-/** How many times the body's tets have changed (mica_body_remove_tets()): 0 at creation. A host
+/** Incision (since 0.8): separates a body along a cut surface, given as triangles where the body
+ *  is now (world space; a blade's sweep between two poses is two triangles). A face shared by two
+ *  tets is cut when the segment between the two tets' centroids crosses a triangle; the nodes of
+ *  the cut faces are then duplicated so that the tets on either side no longer share them (a node
+ *  at the cut's edge, whose tets stay joined around it, is kept whole: the cut stops there). No tet
+ *  is added, removed or changed in shape: the mass and every tet's quality stay, and the cut
+ *  follows the element faces (within one element of the triangles; docs/cutting.md). Node copies
+ *  are numbered after the body's nodes; tet indices stay, and each tet keeps its region and
+ *  material. What follows is as for mica_body_remove_tets(), and: a held node's copies are all
+ *  held by its groups (a grab's handle holds each copy at the node's offset); each copy starts at
+ *  its node's position and velocity, with its share of the node's force. A cut that separates no
+ *  node changes nothing (the topology version stays). Recorded and replayed. The world's thread
+ *  (the one thread using the world at a time).
+ *  @param world the world.
+ *  @param body the body, static or dynamic.
+ *  @param triangles 9 * `triangle_count` coordinates, m: each triangle's three corners (NULL when
+ *         `triangle_count` is 0).
+ *  @param triangle_count the number of triangles, >= 0.
+ *  @param out_faces_cut receives the number of faces the triangles crossed; may be NULL.
+ *  @param out_nodes_added receives the number of node copies made; may be NULL.
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` NULL, or `triangles` NULL with a count
+ *          above 0); MICA_ERR_STALE_ID (`body` is null, of another kind or destroyed);
+ *          MICA_ERR_INVALID_ARGUMENT (`triangle_count` < 0, a corner not finite: the message names
+ *          the triangle); MICA_ERR_WRONG_STATE (a render mesh is embedded in the body);
+ *          MICA_ERR_OUT_OF_MEMORY. On any error nothing changes. */
+MICA_API mica_status mica_body_cut(mica_world* world, mica_body_id body, const double* triangles,
+                                   int32_t triangle_count, int32_t* out_faces_cut, int32_t* out_nodes_added);
+
+/** Sets each tet's cutting resistance (since 0.8): the force per metre of blade edge the tissue
+ *  bears before a blade (mica_tool_def.blade) parts it, N/m. The world's thread (the one thread
+ *  using the world at a time).
+ *  @param world the world.
+ *  @param body the body.
+ *  @param per_tet `tet_count` values, finite and >= 0 (0: any press cuts).
+ *  @param tet_count the body's tet count.
+ *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` or `per_tet` NULL); MICA_ERR_STALE_ID
+ *          (`body`); MICA_ERR_INVALID_ARGUMENT (`tet_count` not the body's, a value negative or
+ *          not finite: the message names the tet). On any error nothing changes. */
+MICA_API mica_status mica_body_set_cutting_resistance(mica_world* world, mica_body_id body, const double* per_tet,
+                                                      int32_t tet_count);
+
+/** How many times the body's tets have changed (mica_body_remove_tets(), mica_body_cut(), a
+ *  blade's cut): 0 at creation. A host
  *  that keeps node or tet indices of a body re-reads them when this changes. The world's thread
  *  (the one thread using the world at a time).
  *  @param world the world (not changed).
@@ -934,6 +979,13 @@ typedef struct mica_tool_def {
   const double* hull_points; /**< m, hull: 3 * hull_point_count coordinates in the tool frame (copied) */
   int32_t hull_point_count;  /**< hull: number of points, 4 to 64 */
   int32_t reserved0;     /**< zero */
+  int32_t blade;         /**< 1: a capsule that is a blade, as a scalpel's: its segment (local z)
+                              the edge, its local x-z plane the blade's plane. Where it presses a
+                              body along its local x harder than the tissue's cutting resistance
+                              times the length of edge in the tissue, the body is cut, after the
+                              step, in the blade's plane from the edge to about one element ahead
+                              (docs/cutting.md); since 0.8; default 0 */
+  int32_t reserved1;     /**< zero */
 } mica_tool_def;
 
 /** Fills `def` with defaults, writing only its first `struct_size` bytes. Thread: any.

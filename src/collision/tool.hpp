@@ -25,6 +25,7 @@ struct ToolModel {
   Vec3List hull_points;          // m, convex hull: the hull of these points (tool frame)
   double margin = 0.0;           // m, contacts are made for gaps below this
   double friction = 0.0;         // Coulomb coefficient between the tool and tissue
+  bool blade = false;            // a capsule whose segment cuts (world/blade.cpp)
 
   // Derived from hull_points by prepare_tool_shape (null for other shapes); shared by copies.
   std::shared_ptr<const HullData> hull;

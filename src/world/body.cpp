@@ -6,6 +6,7 @@ namespace mica {
 BodyModel::BodyModel(const TetMesh& mesh, const BodySettings& s, const std::string& body_name, uint64_t body_key)
     : settings(s), name(body_name), key(body_key), fem(build_fem_model(mesh, s.material, s.mass, body_name)),
       tets(mesh.tets), regions(mesh.regions.empty() ? std::vector<int32_t>(mesh.tets.size(), 0) : mesh.regions),
+      cutting_resistance(mesh.tets.size(), kDefaultCuttingResistance),
       surface(extract_surface(mesh)),
       surface_node_list(surface_nodes(surface)) {
   const Vec3List& x = fem.rest;

@@ -19,6 +19,8 @@
 
 namespace mica {
 
+constexpr double kDefaultCuttingResistance = 200;  // N/m: of the order of soft tissue's toughness, J/m^2
+
 struct BodySettings {
   Material material;
   double rayleigh_alpha = 0;  // 1/s
@@ -38,6 +40,7 @@ struct BodyModel {
   FemModel fem;                // rebuilt by World::set_body_materials (same rest shape and tets)
   std::vector<Tet> tets;
   std::vector<int32_t> regions;  // per tet: the mesh file's region (Gmsh physical tag), else 0
+  std::vector<double> cutting_resistance;  // per tet, N/m of blade edge (World::set_cutting_resistance)
   std::vector<Tri> surface;
   std::vector<int32_t> surface_node_list;  // candidates for contact
   double surface_edge = 0;                 // m, mean surface edge length: the deepest penetration looked for

@@ -21,12 +21,12 @@ enum class RecordKind : uint32_t {
   SetGravity = 1, AddBody, RemoveBody, SetNodeForces, SetPositions, SetVelocities, SetMaterials,
   AddLpc, RemoveLpc, SetLpcVelocity, SetLpcTargets, Grab, SetHandlePose,
   AddTool, RemoveTool, SetToolPose, AddDevice, RemoveDevice, RestoreState, Step, End,
-  TeleportTool, RemoveTets
+  TeleportTool, RemoveTets, Cut, SetCuttingResistance, SetBlade
 };
-constexpr uint32_t kLastRecordKind = uint32_t(RecordKind::RemoveTets);
+constexpr uint32_t kLastRecordKind = uint32_t(RecordKind::SetBlade);
 
 constexpr char kRecordingMagic[8] = {'M', 'I', 'C', 'A', 'R', 'E', 'C', '1'};
-constexpr uint32_t kRecordingVersion = 2;            // 2: the end entry, tool teleports, tet removals
+constexpr uint32_t kRecordingVersion = 2;            // 2: the end entry, tool teleports, tet removals, cuts
 constexpr uint32_t kRecordingVersionWithoutEnd = 1;  // libmica 0.6's, still replayed
 
 // What precedes each entry's payload in the file.
@@ -175,6 +175,7 @@ static_assert(sizeof(void*) != 8 || sizeof(SolverSettings) == 48, "a new solver 
 static_assert(sizeof(void*) != 8 || sizeof(BodySettings) == 48, "a new body setting: record it above");
 static_assert(sizeof(void*) != 8 || sizeof(LpcSpec) == 80, "a new constraint setting: record it above");
 static_assert(sizeof(void*) != 8 || sizeof(DeviceSettings) == 144, "a new device setting: record it above");
-static_assert(sizeof(void*) != 8 || sizeof(ToolModel) == 152, "a new tool field: record it above");
+// ToolModel::blade is recorded as its own entry (SetBlade), so that 0.7 recordings still read.
+static_assert(sizeof(void*) != 8 || sizeof(ToolModel) == 160, "a new tool field: record it above");
 
 }  // namespace mica

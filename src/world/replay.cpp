@@ -163,6 +163,19 @@ void Replay::apply(World& world, RecordKind kind, ByteReader& in) {
       break;
     }
     case RecordKind::RemoveTets: take_all(in, id, nodes); world.remove_tets(id, nodes); break;
+    case RecordKind::Cut: take_all(in, id, values); world.cut(id, values); break;
+    case RecordKind::SetCuttingResistance: {
+      std::vector<double> resistance;
+      take_all(in, id, resistance);
+      world.set_cutting_resistance(id, resistance);
+      break;
+    }
+    case RecordKind::SetBlade: {
+      bool blade = false;
+      take_all(in, id, blade);
+      world.set_tool_blade(id, blade);
+      break;
+    }
     case RecordKind::AddLpc: {
       LpcSpec spec;
       take_all(in, id, nodes, spec, created);

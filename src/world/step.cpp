@@ -165,6 +165,7 @@ void World::advance(double h) {
   stats.ms_last_step = std::chrono::duration<double, std::milli>(StepContext::Clock::now() - ctx.start).count();
   commit(ctx);  // nothing throws from here on
   publish_force_models();
+  cut_with_blades(ctx);
 }
 
 void World::follow_devices() {

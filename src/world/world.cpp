@@ -170,6 +170,26 @@ void World::set_body_materials(Id id, const std::vector<Material>& materials) {
   if (recorder_) recorder_->write(RecordKind::SetMaterials, id, materials);
 }
 
+void World::set_cutting_resistance(Id id, const std::vector<double>& per_tet) {
+  Body& b = body(id);
+  if (per_tet.size() != b.tets.size())
+    fail(Errc::InvalidArgument, std::to_string(per_tet.size()) + " cutting resistances for the " +
+                                    std::to_string(b.tets.size()) + " tets of " + b.name);
+  for (size_t e = 0; e < per_tet.size(); ++e)
+    if (!(per_tet[e] >= 0) || !std::isfinite(per_tet[e]))
+      fail(Errc::InvalidArgument, b.name + ": the cutting resistance of tet " + std::to_string(e) + " is " +
+                                      number_text(per_tet[e]) + " N/m, must be finite and >= 0");
+  b.cutting_resistance = per_tet;
+  if (recorder_) recorder_->write(RecordKind::SetCuttingResistance, id, per_tet);
+}
+
+void World::set_tool_blade(Id id, bool blade) {
+  Tool& t = tools_.get(id, "tool");
+  if (blade && t.shape != ToolShape::Capsule) fail(Errc::InvalidArgument, "only a capsule tool can be a blade (its segment is the edge)");
+  t.blade = blade;
+  if (recorder_) recorder_->write(RecordKind::SetBlade, id, blade);
+}
+
 Mat3 constrained_projector(const LpcSpec& spec) {
   auto unit = [](const Vec3& d, const char* what) {
     const double n = d.norm();

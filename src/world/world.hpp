@@ -19,6 +19,7 @@
 #include "world/stats.hpp"
 #include "world/step_results.hpp"
 #include "world/step_context.hpp"
+#include "world/topology_change.hpp"
 
 namespace mica {
 
@@ -158,6 +159,21 @@ class World {
   // model, the state, the constraints and the warm starts follow (see there). Throws, changing
   // nothing, for an index out of range, a duplicate, every tet, or a driven grasp it would empty.
   double remove_tets(Id body, const std::vector<int32_t>& tets);
+  // Incision (cut.cpp): separates the body along the triangles (world space, where the body is
+  // now) by duplicating the nodes of the faces they cross; no tet is added or removed, so the
+  // mass stays. Returns what it separated. Throws, changing nothing, for a triangle not finite.
+  struct CutResult {
+    int32_t faces = 0;        // faces separated
+    int32_t nodes_added = 0;  // node copies made
+  };
+  CutResult cut(Id body, const Vec3List& triangle_corners);
+  // Per tet, the force per metre of blade edge the tissue bears before it parts (N/m, >= 0);
+  // throws, changing nothing, for a wrong count or a value not finite or negative.
+  void set_cutting_resistance(Id body, const std::vector<double>& per_tet);
+  // Makes a capsule tool a blade (blade.cpp) or an ordinary tool; throws for another shape.
+  void set_tool_blade(Id tool, bool blade);
+  // Told of each change of a body's tets, once it is made (the C layer's render meshes follow).
+  void set_topology_listener(TopologyListener listener) { topology_listener_ = std::move(listener); }
   // Numeric factorizations the solver has made of this body's systems so far.
   int64_t factorizations(Id body) const;
 
@@ -291,6 +307,13 @@ class World {
   // A world with threads > 1 colours a dynamic body's tets and nodes for its parallel loops.
   void colour_for_threads(Body& b) const;
 
+  // Makes the body's model, state and constraints follow a new topology (topology_change.cpp);
+  // throws, changing nothing, when it cannot (a driven grasp left without nodes).
+  void adopt_topology(Id body, NewTopology& topology);
+  CutResult cut_body(Id body, const Vec3List& triangle_corners);  // cut(), unrecorded
+  // After a step: the cuts its blades made (blade.cpp).
+  void cut_with_blades(const StepContext& ctx);
+
   bool needs_loads(const Body& b) const;
   bool needs_damping(const Body& b) const;
 
@@ -315,6 +338,7 @@ class World {
   bool warned_exact_rows_ = false;
   std::vector<BodyOverlap> last_overlaps_;          // of the last add_body
   std::unique_ptr<Recorder> recorder_;              // while recording
+  TopologyListener topology_listener_;              // the C layer's, told of each topology change
   std::vector<AdoptedPose> adopted_;                // the poses follow_devices gave tools this step
   const std::vector<AdoptedPose>* replayed_ = nullptr;  // step_replayed: these instead of the devices
   std::vector<std::pair<Id, Id>> overlapping_;      // pairs whose contacts are skipped until their bounds part

@@ -26,6 +26,7 @@
 #include <mica/mica_device.h>
 
 #include "capi_ok.h"
+#include "topology_scene.h"
 
 #define L 0.04 /* m, the bar's length along x; 4 cells of 0.01 m */
 
@@ -62,44 +63,6 @@ static mica_lpc_id fix_left_end(mica_world* w, mica_body_id body) {
   return lpc;
 }
 
-typedef struct {
-  int32_t nodes, tets;
-  double* rest; /* 3 a node */
-  int32_t* tet; /* 4 a tet */
-} mesh;
-
-static mesh get_mesh(mica_world* w, mica_body_id body) {
-  mesh m;
-  OK(w, mica_body_get_counts(w, body, &m.nodes, &m.tets, NULL));
-  m.rest = malloc(sizeof(double) * 3 * (size_t)m.nodes);
-  m.tet = malloc(sizeof(int32_t) * 4 * (size_t)m.tets);
-  OK(w, mica_body_get_rest_positions(w, body, m.rest, m.nodes, NULL));
-  OK(w, mica_body_get_tets(w, body, m.tet, m.tets, NULL));
-  return m;
-}
-
-static void free_mesh(mesh* m) {
-  free(m->rest);
-  free(m->tet);
-}
-
-static double rest_centroid_x(const mesh* m, int32_t e) {
-  double x = 0;
-  for (int a = 0; a < 4; ++a) x += 0.25 * m->rest[3 * m->tet[4 * e + a]];
-  return x;
-}
-
-static double rest_volume(const mesh* m, int32_t e) {
-  const double* p[4];
-  for (int a = 0; a < 4; ++a) p[a] = m->rest + 3 * m->tet[4 * e + a];
-  double d[3][3];
-  for (int a = 0; a < 3; ++a)
-    for (int k = 0; k < 3; ++k) d[a][k] = p[a + 1][k] - p[0][k];
-  const double det = d[0][0] * (d[1][1] * d[2][2] - d[1][2] * d[2][1]) - d[0][1] * (d[1][0] * d[2][2] - d[1][2] * d[2][0]) +
-                     d[0][2] * (d[1][0] * d[2][1] - d[1][1] * d[2][0]);
-  return fabs(det) / 6;
-}
-
 /* The tets whose rest centroid x lies in (lo, hi); returns their count. */
 static int32_t tets_between(mica_world* w, mica_body_id body, double lo, double hi, int32_t* out) {
   mesh m = get_mesh(w, body);
@@ -112,38 +75,13 @@ static int32_t tets_between(mica_world* w, mica_body_id body, double lo, double 
   return count;
 }
 
-static double total_mass(mica_world* w, mica_body_id body) {
-  int32_t n = 0;
-  OK(w, mica_body_get_counts(w, body, &n, NULL, NULL));
-  double* m = malloc(sizeof(double) * (size_t)n);
-  OK(w, mica_body_get_node_masses(w, body, m, n, NULL));
-  double sum = 0;
-  for (int32_t i = 0; i < n; ++i) sum += m[i];
-  free(m);
-  return sum;
-}
-
 static void step_n(mica_world* w, int n) {
   for (int k = 0; k < n; ++k) OK(w, mica_step(w, 0.01));
-}
-
-static double* get_positions(mica_world* w, mica_body_id body, int32_t* n) {
-  OK(w, mica_body_get_counts(w, body, n, NULL, NULL));
-  double* x = malloc(sizeof(double) * 3 * (size_t)*n);
-  OK(w, mica_body_get_positions(w, body, x, *n, NULL));
-  return x;
 }
 
 static double* step_and_get_positions(mica_world* w, mica_body_id body, int steps, int32_t* n) {
   step_n(w, steps);
   return get_positions(w, body, n);
-}
-
-static uint8_t* save(mica_world* w, size_t* bytes) {
-  OK(w, mica_world_state_size(w, bytes));
-  uint8_t* buffer = malloc(*bytes);
-  OK(w, mica_world_save_state(w, buffer, *bytes));
-  return buffer;
 }
 
 /* ------------------------------------------------------------------------------------------ */
