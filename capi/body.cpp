@@ -322,15 +322,12 @@ MICA_API mica_status mica_body_remove_tets(mica_world* world, mica_body_id body,
     require(world, "world");
     check_count(count, 0, "count");
     if (count > 0) require(tets, "tets");
-    const mica::Body& b = world->world.body(body);  // throws for a stale id
-    // A render mesh is bound to the body's tets and nodes by index.
-    world->embeddings.for_each([&](uint64_t, const mica::Embedding& e) {
-      if (e.body() == body)
-        mica::fail(mica::Errc::WrongState, b.name + " has an embedded render mesh: destroy the embedding first");
-    });
+    world->world.body(body);  // throws for a stale id
+    // The body's render meshes follow the change (follow_topology, capi/embedding.cpp).
+    world->topology_warning.clear();
     const double removed = world->world.remove_tets(body, count ? node_list(tets, count) : std::vector<int32_t>{});
     if (out_removed_mass) *out_removed_mass = removed;
-    return MICA_OK;
+    return topology_warning(world, "mica_body_remove_tets");
   });
 }
 

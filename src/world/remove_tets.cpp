@@ -27,6 +27,7 @@ struct KeptMesh {
   std::vector<Material> materials;
   std::vector<int32_t> new_index;
   std::vector<int32_t> old_index;  // per new node
+  std::vector<int32_t> old_tet;    // per new tet
   double removed_mass = 0;         // kg
 };
 
@@ -71,6 +72,7 @@ KeptMesh kept_mesh(const Body& b, const std::vector<int32_t>& tets) {
     k.mesh.tets.push_back(t);
     k.mesh.regions.push_back(b.regions[e]);
     k.materials.push_back(b.fem.materials[e]);
+    k.old_tet.push_back(int32_t(e));
   }
   return k;
 }
@@ -129,6 +131,11 @@ double World::remove_tets(Id id, const std::vector<int32_t>& tets) {
   fresh->lpc_version = b.lpc_version + 1;
   fresh->topology_version = b.topology_version + 1;
   fresh->matrix_version = b.matrix_version + 1;
+  TopologyChange change;
+  change.body = id;
+  change.topology_version = fresh->topology_version;
+  change.node_origin = std::move(k.old_index);
+  change.tet_origin = std::move(k.old_tet);
   const std::vector<uint64_t> stale = contact_row_keys(id);
   lpcs_.reserve_free();  // so that erase below allocates nothing
 
@@ -148,6 +155,7 @@ double World::remove_tets(Id id, const std::vector<int32_t>& tets) {
   last_.lambda.clear();
   last_.curvature_impulse.clear();
   last_.debt = 0;
+  if (topology_listener_) topology_listener_(change, body(id));
   if (recorder_) recorder_->write(RecordKind::RemoveTets, id, tets);
   return k.removed_mass;
 }

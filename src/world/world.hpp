@@ -19,6 +19,7 @@
 #include "world/stats.hpp"
 #include "world/step_results.hpp"
 #include "world/step_context.hpp"
+#include "world/topology_change.hpp"
 
 namespace mica {
 
@@ -158,6 +159,8 @@ class World {
   // model, the state, the constraints and the warm starts follow (see there). Throws, changing
   // nothing, for an index out of range, a duplicate, every tet, or a driven grasp it would empty.
   double remove_tets(Id body, const std::vector<int32_t>& tets);
+  // Told of each change of a body's tets, once it is made (the C layer's render meshes follow).
+  void set_topology_listener(TopologyListener listener) { topology_listener_ = std::move(listener); }
   // Numeric factorizations the solver has made of this body's systems so far.
   int64_t factorizations(Id body) const;
 
@@ -315,6 +318,7 @@ class World {
   bool warned_exact_rows_ = false;
   std::vector<BodyOverlap> last_overlaps_;          // of the last add_body
   std::unique_ptr<Recorder> recorder_;              // while recording
+  TopologyListener topology_listener_;              // the C layer's, told of each topology change
   std::vector<AdoptedPose> adopted_;                // the poses follow_devices gave tools this step
   const std::vector<AdoptedPose>* replayed_ = nullptr;  // step_replayed: these instead of the devices
   std::vector<std::pair<Id, Id>> overlapping_;      // pairs whose contacts are skipped until their bounds part
