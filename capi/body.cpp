@@ -330,15 +330,12 @@ MICA_API mica_status mica_body_remove_tets(mica_world* world, mica_body_id body,
     require(world, "world");
     check_count(count, 0, "count");
     if (count > 0) require(tets, "tets");
-    const mica::Body& b = world->world.body(body);  // throws for a stale id
-    // A render mesh is bound to the body's tets and nodes by index.
-    world->embeddings.for_each([&](uint64_t, const mica::Embedding& e) {
-      if (e.body() == body)
-        mica::fail(mica::Errc::WrongState, b.name + " has an embedded render mesh: destroy the embedding first");
-    });
+    world->world.body(body);  // throws for a stale id
+    // The body's render meshes follow the change (follow_topology, capi/embedding.cpp).
+    world->topology_warning.clear();
     const double removed = world->world.remove_tets(body, count ? node_list(tets, count) : std::vector<int32_t>{});
     if (out_removed_mass) *out_removed_mass = removed;
-    return MICA_OK;
+    return topology_warning(world, "mica_body_remove_tets");
   });
 }
 
@@ -348,17 +345,15 @@ MICA_API mica_status mica_body_cut(mica_world* world, mica_body_id body, const d
     require(world, "world");
     check_count(triangle_count, 0, "triangle_count");
     if (triangle_count > 0) require(triangles, "triangles");
-    const mica::Body& b = world->world.body(body);  // throws for a stale id
-    world->embeddings.for_each([&](uint64_t, const mica::Embedding& e) {
-      if (e.body() == body)
-        mica::fail(mica::Errc::WrongState, b.name + " has an embedded render mesh: destroy the embedding first");
-    });
+    world->world.body(body);  // throws for a stale id
+    // The body's render meshes follow the change (follow_topology, capi/embedding.cpp).
+    world->topology_warning.clear();
     mica::Vec3List corners(size_t(triangle_count) * 3);
     for (size_t k = 0; k < corners.size(); ++k) corners[k] = mica::Vec3(triangles[3 * k], triangles[3 * k + 1], triangles[3 * k + 2]);
     const mica::World::CutResult r = world->world.cut(body, corners);
     if (out_faces_cut) *out_faces_cut = r.faces;
     if (out_nodes_added) *out_nodes_added = r.nodes_added;
-    return MICA_OK;
+    return topology_warning(world, "mica_body_cut");
   });
 }
 

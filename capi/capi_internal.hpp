@@ -14,11 +14,29 @@
 #include "embedding/embedding.hpp"
 #include "world/world.hpp"
 
+struct mica_world;
+
+namespace mica_capi {
+// The world's topology listener (capi/embedding.cpp): each embedding of the changed body follows
+// the change; never throws (an embedding that cannot follow is left with every vertex unbound).
+void follow_topology(mica_world* world, const mica::TopologyChange& change, const mica::Body& body) noexcept;
+}  // namespace mica_capi
+
 struct mica_world {
-  explicit mica_world(const mica::WorldSettings& s) : world(s) {}
+  explicit mica_world(const mica::WorldSettings& s) : world(s) {
+    world.set_topology_listener([this](const mica::TopologyChange& change, const mica::Body& body) {
+      mica_capi::follow_topology(this, change, body);
+    });
+  }
+  mica_world(const mica_world&) = delete;  // the listener holds this address
+  mica_world& operator=(const mica_world&) = delete;
   mica::World world;
-  // Render meshes bound to the world's bodies (capi/embedding.cpp): they read bodies, never change them.
+  // Render meshes bound to the world's bodies (capi/embedding.cpp): they read bodies, never change
+  // them, and follow a change of their body's tets (follow_topology).
   mica::SlotMap<mica::Embedding, mica::IdKind::Embedding> embeddings;
+  // What the last topology change left unbound in the embeddings, for the call that made it to
+  // return as a warning ("" when nothing).
+  std::string topology_warning;
   mutable std::string last_error;
   mica_log_fn log = nullptr;
   void* log_user = nullptr;
@@ -38,6 +56,10 @@ mica_status to_status(mica::Errc code);
 
 // Records "function: message" on the world (or the thread) and logs it.
 mica_status report(const mica_world* world, mica_status status, const char* function, const std::string& message);
+
+// After a call that changed a body's tets: MICA_OK, or MICA_WARN_UNBOUND_VERTICES with the
+// listener's message as the world's last error (capi/embedding.cpp).
+mica_status topology_warning(mica_world* world, const char* function);
 
 // A refusal by the C layer's own checks, with the status to return.
 struct Refusal {

@@ -41,6 +41,47 @@ std::string unbound_message(const mica::Embedding& e, double radius) {
 
 }  // namespace
 
+namespace mica_capi {
+
+void follow_topology(mica_world* world, const mica::TopologyChange& change, const mica::Body& body) noexcept {
+  world->embeddings.for_each([&](uint64_t id, mica::Embedding& e) {
+    if (e.body() != change.body) return;
+    std::string message;
+    try {
+      const mica::Embedding::FollowReport r = e.follow(change, body.fem.rest, body.tets, body.surface);
+      if (r.unbound > 0)
+        message = "embedding " + decltype(world->embeddings)::hex(id) + ": " + std::to_string(r.unbound) + " of the " +
+                  std::to_string(r.inside + r.projected + r.unbound) + " vertices whose tets went are farther than "
+                  "the radius (" + mica::number_text(e.radius()) + " m) from the body and unbound; " +
+                  std::to_string(e.count(mica::VertexKind::Unbound)) + " of " + std::to_string(e.vertex_count()) +
+                  " are unbound now, and mica_embedding_update leaves their positions as they are";
+    } catch (...) {
+      e.unbind_all(int32_t(body.x.size()), change.topology_version);  // consistent, and says so
+      try {
+        message = "embedding " + decltype(world->embeddings)::hex(id) + " could not follow the change of its body's tets: all " +
+                  std::to_string(e.vertex_count()) + " vertices are unbound (destroy it and embed again)";
+      } catch (...) {
+      }
+    }
+    if (message.empty()) return;
+    try {
+      if (!world->topology_warning.empty()) world->topology_warning += "; ";
+      world->topology_warning += message;
+    } catch (...) {
+    }
+    if (world->log) world->log(MICA_LOG_WARNING, message.c_str(), world->log_user);
+  });
+}
+
+mica_status topology_warning(mica_world* world, const char* function) {
+  if (world->topology_warning.empty()) return MICA_OK;
+  world->last_error = std::string(function) + ": " + world->topology_warning;
+  world->topology_warning.clear();
+  return MICA_WARN_UNBOUND_VERTICES;
+}
+
+}  // namespace mica_capi
+
 static_assert(MICA_EMBED_INSIDE == int(mica::VertexKind::Inside) && MICA_EMBED_PROJECTED == int(mica::VertexKind::Projected) &&
                   MICA_EMBED_UNBOUND == int(mica::VertexKind::Unbound),
               "the C vertex kinds are the core's");
@@ -69,6 +110,7 @@ MICA_API mica_status mica_embedding_create(mica_world* world, mica_body_id body,
     const mica::Body& b = world->world.body(body);
     auto e = std::make_unique<mica::Embedding>(body, b.fem.rest, b.tets, b.surface, xyz, vertex_count, triangles,
                                                triangle_count, d.radius);
+    e->set_topology_version(b.topology_version);
     const bool unbound = e->count(mica::VertexKind::Unbound) > 0;
     std::string warning = unbound ? "mica_embedding_create: " + unbound_message(*e, d.radius) : std::string();
     *out_embedding = world->embeddings.insert(std::move(e));  // nothing may fail after this
@@ -122,7 +164,12 @@ MICA_API mica_status mica_embedding_update(const mica_world* world, mica_embeddi
                     n = uintptr_t(out_normals);  // as integers: the two may be unrelated arrays
     if (out_normals && n < a + bytes && a < n + bytes)
       refuse(MICA_ERR_INVALID_ARGUMENT, "out_xyz and out_normals overlap: pass two arrays");
-    e.update(body_of(world, e).x, out_xyz, out_normals);
+    const mica::Body& b = body_of(world, e);
+    if (b.topology_version != e.topology_version())  // every change is followed: this is a bug
+      refuse(MICA_ERR_INTERNAL, "the embedding is of the body's tets at topology version " +
+                                    std::to_string(e.topology_version()) + ", the body is at " +
+                                    std::to_string(b.topology_version));
+    e.update(b.x, out_xyz, out_normals);
     return MICA_OK;
   });
 }

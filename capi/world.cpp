@@ -175,6 +175,7 @@ MICA_API mica_status mica_step(mica_world* world, double dt) {
   return guarded(world, "mica_step", [&] {
     require(world, "world");
     world->world.step(dt);
+    world->topology_warning.clear();  // a blade's cut: its render meshes' warnings went to the log
     return world->world.stats().converged ? MICA_OK : MICA_WARN_NOT_CONVERGED;
   });
 }

@@ -691,7 +691,11 @@ MICA_API mica_status mica_body_set_materials(mica_world* world, mica_body_id bod
  *    readout (mica_world_get_contacts() and what reads contacts) is cleared for the
  *    whole world, its indices being of the old numbering (the statistics stay);
  *  - saved states: a state saved before the removal no longer fits the world (its shape
- *    differs); a recording records the removal and replays it.
+ *    differs); a recording records the removal and replays it;
+ *  - render meshes embedded in the body (mica_embedding_create(), since 0.7): a vertex whose tet
+ *    is kept keeps its weights and follows the tet's new nodes, to the bit where it was; a vertex
+ *    whose tet is removed is bound again as at creation (inside another tet, projected within the
+ *    embedding's radius, or unbound: mica_embedding_get_kinds() and _get_counts() say which).
  *  A part of the body left without a fixed node moves freely (it falls under gravity). The
  *  world's thread (the one thread using the world at a time).
  *  @param world the world.
@@ -701,13 +705,14 @@ MICA_API mica_status mica_body_set_materials(mica_world* world, mica_body_id bod
  *  @param count the number of tets to remove, fewer than the body has.
  *  @param out_removed_mass receives the removed tets' mass, kg (the sum of density times rest
  *         volume); may be NULL.
- *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` NULL, or `tets` NULL with `count` > 0);
- *          MICA_ERR_STALE_ID (`body` is null, of another kind or destroyed); MICA_ERR_OUT_OF_RANGE
- *          (a tet index outside the body's tets: the message names it and its position);
- *          MICA_ERR_INVALID_ARGUMENT (`count` < 0, a tet listed twice, or every tet: destroy the
- *          body instead); MICA_ERR_WRONG_STATE (the removal would empty a grasp a device drives,
- *          or a render mesh is embedded in the body); MICA_ERR_OUT_OF_MEMORY. On any error
- *          nothing changes. */
+ *  @return MICA_OK; MICA_WARN_UNBOUND_VERTICES (removed, but vertices of an embedded render mesh
+ *          whose tets went are now unbound: the message says how many, and the update leaves
+ *          their positions as they were); or MICA_ERR_NULL_ARGUMENT (`world` NULL, or `tets` NULL
+ *          with `count` > 0); MICA_ERR_STALE_ID (`body` is null, of another kind or destroyed);
+ *          MICA_ERR_OUT_OF_RANGE (a tet index outside the body's tets: the message names it and
+ *          its position); MICA_ERR_INVALID_ARGUMENT (`count` < 0, a tet listed twice, or every
+ *          tet: destroy the body instead); MICA_ERR_WRONG_STATE (the removal would empty a grasp a
+ *          device drives); MICA_ERR_OUT_OF_MEMORY. On any error nothing changes. */
 MICA_API mica_status mica_body_remove_tets(mica_world* world, mica_body_id body, const int32_t* tets,
                                            int32_t count, double* out_removed_mass);
 
@@ -734,8 +739,10 @@ MICA_API mica_status mica_body_remove_tets(mica_world* world, mica_body_id body,
  *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` NULL, or `triangles` NULL with a count
  *          above 0); MICA_ERR_STALE_ID (`body` is null, of another kind or destroyed);
  *          MICA_ERR_INVALID_ARGUMENT (`triangle_count` < 0, a corner not finite: the message names
- *          the triangle); MICA_ERR_WRONG_STATE (a render mesh is embedded in the body);
- *          MICA_ERR_OUT_OF_MEMORY. On any error nothing changes. */
+ *          the triangle); MICA_ERR_OUT_OF_MEMORY. On any error nothing changes.
+ *          MICA_WARN_UNBOUND_VERTICES: the cut was made, and a render mesh embedded in the body
+ *          (mica_embedding_create) was left with vertices it could not bind again (the message
+ *          says how many). */
 MICA_API mica_status mica_body_cut(mica_world* world, mica_body_id body, const double* triangles,
                                    int32_t triangle_count, int32_t* out_faces_cut, int32_t* out_nodes_added);
 

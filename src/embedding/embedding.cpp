@@ -9,6 +9,7 @@
 #include "embedding/surface_projection.hpp"
 #include "embedding/tet_locator.hpp"
 #include "embedding/vertex_normals.hpp"
+#include "world/topology_change.hpp"
 
 namespace mica {
 
@@ -36,37 +37,65 @@ void check_input(const double* xyz, int32_t vertex_count, const int32_t* triangl
     }
 }
 
+// Binds points of the rest frame to a mesh: the grid over its tets, and the surface's tree made
+// for the first point outside.
+class Binder {
+ public:
+  Binder(const Vec3List& rest, const std::vector<Tet>& tets, const std::vector<Tri>& surface, double radius)
+      : rest_(rest), tets_(tets), surface_(surface), radius_(radius), locator_(rest, tets) {}
+
+  // The tet of p (-1: unbound), its weights and its kind.
+  int32_t bind(const Vec3& p, Weights& w, VertexKind& kind) {
+    kind = VertexKind::Inside;
+    int32_t e = locator_.locate(p, kInsideTolerance, w);
+    if (e >= 0) return e;
+    if (!projection_) projection_ = std::make_unique<SurfaceProjection>(rest_, tets_, surface_);
+    double distance;
+    e = projection_->nearest_tet(p, radius_, distance);
+    kind = e < 0 ? VertexKind::Unbound : VertexKind::Projected;
+    if (e >= 0) w = locator_.weights(e, p);
+    return e;
+  }
+
+ private:
+  const Vec3List& rest_;
+  const std::vector<Tet>& tets_;
+  const std::vector<Tri>& surface_;
+  double radius_;
+  TetLocator locator_;
+  std::unique_ptr<SurfaceProjection> projection_;
+};
+
+template <class B>
+void set_binding(B& b, int32_t e, const std::vector<Tet>& tets, const Weights& w) {
+  if (e < 0) {
+    b.nodes = {-1, -1, -1, -1};
+    b.weights = {0, 0, 0, 0};
+  } else {
+    b.nodes = tets[size_t(e)];
+    b.weights = {w[0], w[1], w[2], w[3]};
+  }
+}
+
 }  // namespace
 
 Embedding::Embedding(uint64_t body, const Vec3List& rest, const std::vector<Tet>& tets,
                      const std::vector<Tri>& surface, const double* xyz, int32_t vertex_count,
                      const int32_t* triangles, int32_t triangle_count, double radius)
-    : body_(body), node_count_(int32_t(rest.size())) {
+    : body_(body), node_count_(int32_t(rest.size())), tet_count_(int32_t(tets.size())), radius_(radius) {
   check_input(xyz, vertex_count, triangles, triangle_count, radius);
-  const TetLocator locator(rest, tets);
-  std::unique_ptr<SurfaceProjection> projection;  // made for the first vertex outside the body
+  Binder binder(rest, tets, surface, radius);
   bindings_.resize(size_t(vertex_count));
+  tet_.resize(size_t(vertex_count));
   kinds_.resize(size_t(vertex_count));
+  rest_xyz_.assign(xyz, xyz + 3 * size_t(vertex_count));
   for (int32_t i = 0; i < vertex_count; ++i) {
     const Vec3 p(xyz[3 * size_t(i)], xyz[3 * size_t(i) + 1], xyz[3 * size_t(i) + 2]);
     Weights w;
-    VertexKind kind = VertexKind::Inside;
-    int32_t e = locator.locate(p, kInsideTolerance, w);
-    if (e < 0) {
-      if (!projection) projection = std::make_unique<SurfaceProjection>(rest, tets, surface);
-      double distance;
-      e = projection->nearest_tet(p, radius, distance);
-      kind = e < 0 ? VertexKind::Unbound : VertexKind::Projected;
-      if (e >= 0) w = locator.weights(e, p);
-    }
-    Binding& b = bindings_[size_t(i)];
-    if (e < 0) {
-      b.nodes = {-1, -1, -1, -1};
-      b.weights = {0, 0, 0, 0};
-    } else {
-      b.nodes = tets[size_t(e)];
-      b.weights = {w[0], w[1], w[2], w[3]};
-    }
+    VertexKind kind;
+    const int32_t e = binder.bind(p, w, kind);
+    set_binding(bindings_[size_t(i)], e, tets, w);
+    tet_[size_t(i)] = e;
     kinds_[size_t(i)] = int32_t(kind);
     ++counts_[size_t(kind)];
   }
@@ -88,6 +117,76 @@ void Embedding::update(const Vec3List& x, double* out_xyz, double* out_normals) 
     for (int a = 0; a < 3; ++a) out[a] = w0 * x0[a] + w1 * x1[a] + w2 * x2[a] + w3 * x3[a];
   }
   if (out_normals) vertex_normals(out_xyz, vertex_count(), triangles_.data(), triangle_count(), out_normals);
+}
+
+Embedding::FollowReport Embedding::follow(const TopologyChange& change, const Vec3List& rest,
+                                          const std::vector<Tet>& tets, const std::vector<Tri>& surface) {
+  if (change.node_origin.size() != rest.size() || change.tet_origin.size() != tets.size())
+    fail(Errc::InvalidArgument, "the change names " + std::to_string(change.node_origin.size()) + " nodes and " +
+                                    std::to_string(change.tet_origin.size()) + " tets, the new mesh has " +
+                                    std::to_string(rest.size()) + " and " + std::to_string(tets.size()));
+  if (count(VertexKind::Unbound) == vertex_count()) {  // nothing to follow (or unbound by a failed follow)
+    node_count_ = int32_t(rest.size());
+    tet_count_ = int32_t(tets.size());
+    topology_version_ = change.topology_version;
+    return {};
+  }
+  // Each old tet's new index, -1 if it went.
+  std::vector<int32_t> now(size_t(tet_count_), -1);
+  for (size_t e = 0; e < change.tet_origin.size(); ++e) {
+    const int32_t old = change.tet_origin[e];
+    if (old < 0 || old >= tet_count_)
+      fail(Errc::InvalidArgument, "new tet " + std::to_string(e) + " comes from tet " + std::to_string(old) +
+                                      ", outside the embedding's 0.." + std::to_string(tet_count_ - 1));
+    if (now[size_t(old)] < 0) now[size_t(old)] = int32_t(e);
+  }
+  FollowReport report;
+  std::vector<Binding> bindings = bindings_;
+  std::vector<int32_t> tet = tet_, kinds = kinds_;
+  std::array<int32_t, 3> counts = counts_;
+  std::unique_ptr<Binder> binder;  // made for the first vertex whose tet went
+  for (size_t i = 0; i < bindings.size(); ++i) {
+    if (tet[i] < 0) continue;  // unbound stays unbound
+    const int32_t e = now[size_t(tet[i])];
+    if (e >= 0) {  // the tet stays: same weights (same rest shape, corners in the same order), new nodes
+      bindings[i].nodes = tets[size_t(e)];
+      tet[i] = e;
+      ++report.followed;
+      continue;
+    }
+    if (!binder) binder = std::make_unique<Binder>(rest, tets, surface, radius_);
+    Weights w;
+    VertexKind kind;
+    const int32_t found = binder->bind(Vec3(rest_xyz_[3 * i], rest_xyz_[3 * i + 1], rest_xyz_[3 * i + 2]), w, kind);
+    set_binding(bindings[i], found, tets, w);
+    tet[i] = found;
+    --counts[size_t(kinds[i])];
+    kinds[i] = int32_t(kind);
+    ++counts[size_t(kind)];
+    ++(kind == VertexKind::Inside ? report.inside : kind == VertexKind::Projected ? report.projected : report.unbound);
+  }
+  // Nothing below throws.
+  bindings_.swap(bindings);
+  tet_.swap(tet);
+  kinds_.swap(kinds);
+  counts_ = counts;
+  node_count_ = int32_t(rest.size());
+  tet_count_ = int32_t(tets.size());
+  topology_version_ = change.topology_version;
+  return report;
+}
+
+void Embedding::unbind_all(int32_t node_count, uint64_t topology_version) noexcept {
+  for (Binding& b : bindings_) {
+    b.nodes = {-1, -1, -1, -1};
+    b.weights = {0, 0, 0, 0};
+  }
+  for (int32_t& e : tet_) e = -1;
+  for (int32_t& k : kinds_) k = int32_t(VertexKind::Unbound);
+  counts_ = {0, 0, int32_t(kinds_.size())};
+  node_count_ = node_count;
+  tet_count_ = 0;
+  topology_version_ = topology_version;
 }
 
 }  // namespace mica

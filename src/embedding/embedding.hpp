@@ -2,6 +2,8 @@
 // A host's fine mesh embedded in a body's tets: each vertex bound once, at the body's rest shape,
 // to a tet and four barycentric weights, then placed from the tet's current nodes after each step
 // (SOFA's barycentric mapping, iMSTK's PointToTetMap). The triangles give area-weighted normals.
+// After a change of the body's tets (resection, incision) only the vertices whose tet went are
+// bound again (follow).
 #pragma once
 #include <array>
 #include <cstdint>
@@ -10,6 +12,8 @@
 #include "core/types.hpp"
 
 namespace mica {
+
+struct TopologyChange;
 
 // How a vertex was bound (the values of MICA_EMBED_*).
 enum class VertexKind : int32_t {
@@ -32,17 +36,44 @@ class Embedding {
             double radius);
 
   uint64_t body() const { return body_; }
-  int32_t node_count() const { return node_count_; }  // the body's, at binding
+  int32_t node_count() const { return node_count_; }  // the body's, at binding or at the last follow
+  uint64_t topology_version() const { return topology_version_; }  // the body's that the bindings are of
+  void set_topology_version(uint64_t version) { topology_version_ = version; }
+  double radius() const { return radius_; }
   int32_t vertex_count() const { return int32_t(kinds_.size()); }
   int32_t triangle_count() const { return int32_t(triangles_.size() / 3); }
   const std::vector<int32_t>& kinds() const { return kinds_; }  // VertexKind values, per vertex
   int32_t count(VertexKind kind) const { return counts_[size_t(kind)]; }
+  int32_t tet(int32_t vertex) const { return tet_[size_t(vertex)]; }  // -1: unbound
 
   // Writes each bound vertex's position, interpolated from the body's current node positions x, into
   // out_xyz (3 per vertex); an unbound vertex's entries are left as they are. With out_normals,
-  // then the area-weighted normals of the triangles at out_xyz (3 per vertex). Allocates nothing.
-  // Throws Error(WrongState) if x is not of the body's node count.
+  // then the area-weighted normals of the triangles at out_xyz (3 per vertex), (vertex_normals()).
+  // Allocates nothing. Throws Error(WrongState) if x is not of the body's node count.
   void update(const Vec3List& x, double* out_xyz, double* out_normals) const;
+
+  // What follow() did to the vertices whose tet the change removed.
+  struct FollowReport {
+    int32_t followed = 0;   // bound to a tet that stays: same weights, the tet's new nodes
+    int32_t inside = 0;     // their tet removed, found inside another
+    int32_t projected = 0;  // their tet removed, projected onto the new surface within the radius
+    int32_t unbound = 0;    // their tet removed, nothing within the radius: unbound from now on
+  };
+
+  // Follows a change of the body's tets to its new mesh (rest positions, tets, surface): a vertex
+  // bound to a tet that stays (change.tet_origin names it) keeps its kind and weights and takes the
+  // tet's new nodes (a cut keeps every tet: the vertex follows the node copies its tet now holds);
+  // a vertex whose tet is gone is bound again from its rest position as at creation (inside
+  // another tet, projected within the radius, or unbound). Unbound vertices stay unbound (the new
+  // surface is no nearer to them). Throws Error(InvalidArgument) for a change whose sizes or
+  // origins do not fit the embedding or the new mesh; a failed follow changes nothing.
+  FollowReport follow(const TopologyChange& change, const Vec3List& rest, const std::vector<Tet>& tets,
+                      const std::vector<Tri>& surface);
+
+  // Every vertex unbound, for a body of `node_count` nodes at `topology_version` (after a change
+  // that could not be followed: the update then leaves the host's positions as they are).
+  // Allocates nothing, never throws.
+  void unbind_all(int32_t node_count, uint64_t topology_version) noexcept;
 
  private:
   struct Binding {
@@ -52,7 +83,12 @@ class Embedding {
 
   uint64_t body_;
   int32_t node_count_;
-  std::vector<Binding> bindings_;  // per vertex
+  int32_t tet_count_;              // the body's, at binding or at the last follow
+  uint64_t topology_version_ = 0;  // set by the owner (the C layer) from the body's
+  double radius_;
+  std::vector<Binding> bindings_;  // per vertex: all the update reads of it, 48 bytes
+  std::vector<int32_t> tet_;       // per vertex: its tet (-1: unbound), for follow()
+  std::vector<double> rest_xyz_;   // the vertices as given, for binding again in follow()
   std::vector<int32_t> kinds_;
   std::array<int32_t, 3> counts_{};
   std::vector<int32_t> triangles_;

@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 // The few UnityEngine types the documented C# samples use, so that test_doc_samples.py compiles
 // and runs them on Mono outside Unity: Debug writes to the console; a MonoBehaviour is a plain
-// object whose Start, FixedUpdate and OnDestroy the test calls in Unity's order.
+// object whose Start, FixedUpdate and OnDestroy the test calls in Unity's order; a Mesh keeps what
+// it is given; a GameObject holds components.
 namespace UnityEngine
 {
     public struct Vector3
@@ -22,9 +23,49 @@ namespace UnityEngine
         public Vector3 position;
     }
 
-    public class MonoBehaviour
+    public class Component
+    {
+    }
+
+    public class GameObject
+    {
+        readonly System.Collections.Generic.List<Component> components = new System.Collections.Generic.List<Component>();
+        public T AddComponent<T>() where T : Component, new()
+        {
+            var c = new T();
+            components.Add(c);
+            return c;
+        }
+        public T GetComponent<T>() where T : Component
+        {
+            foreach (var c in components)
+                if (c is T) return (T)c;
+            return null;
+        }
+    }
+
+    public class MonoBehaviour : Component
     {
         public bool enabled = true;
+        public GameObject gameObject = new GameObject();
+    }
+
+    public class Mesh
+    {
+        public Vector3[] vertices;
+        public Vector3[] normals;
+        public int[] triangles;
+        public void MarkDynamic() { }
+        public void RecalculateBounds() { }
+    }
+
+    public class MeshFilter : Component
+    {
+        public Mesh mesh;
+    }
+
+    public class MeshRenderer : Component
+    {
     }
 
     public static class Debug

@@ -4,7 +4,8 @@
  * body are projected within the radius and unbound beyond it (a warning naming them, and left as
  * they were by the update); a vertex that is not finite is refused by index; a destroyed body or
  * embedding is detected; the def and the arguments are checked; mica_world_get_ids lists the live
- * embeddings. */
+ * embeddings; a resection under the mesh keeps the vertices of kept tets to the bit and binds the
+ * others again. */
 #include <stdarg.h>
 #include <stddef.h>
 #include <setjmp.h>
@@ -257,6 +258,92 @@ static void test_ids_list_the_embeddings(void** state) {
   mica_world_destroy(w);
 }
 
+
+/* Resection under an embedded mesh: the fine surface of the cube [0, 0.1]^3 and points inside it;
+ * the cells with x > 0.075 removed. Vertices with x < 0.05 are in kept tets: placed as before, to
+ * the bit. Those in the removed cells are bound again: on the new face (x = 0.075) inside a kept tet,
+ * deep in the removed part (x > 0.08) more than the radius from what is left, unbound, left as they
+ * were, and the call warns. */
+static void test_removal_keeps_the_kept_and_rebinds_the_rest(void** state) {
+  (void)state;
+  mica_body_id body;
+  mica_world* w = cube(&body);
+  fine_surface fine;
+  OK(w, fine_surface_of_body(w, body, 3, &fine));
+  const int32_t n = fine.vertex_count;
+  int32_t nodes = 0, tet_count = 0;
+  OK(w, mica_body_get_counts(w, body, &nodes, &tet_count, NULL));
+  /* A bend, so that each vertex depends on its own tet. */
+  double* x = malloc(sizeof(double) * 3 * (size_t)nodes);
+  OK(w, mica_body_get_rest_positions(w, body, x, nodes, NULL));
+  for (int32_t i = 0; i < nodes; ++i) x[3 * i + 1] += 0.3 * x[3 * i] * x[3 * i] + 0.1 * x[3 * i + 2] * x[3 * i];
+  OK(w, mica_body_set_positions(w, body, x, nodes));
+  const mica_embedding_def ed = mica_embedding_def_default();
+  mica_embedding_id e = MICA_NULL_ID;
+  OK(w, mica_embedding_create(w, body, &ed, fine.xyz, n, fine.triangles, fine.triangle_count, &e));
+  double* before = malloc(sizeof(double) * 3 * (size_t)n);
+  double* after = malloc(sizeof(double) * 3 * (size_t)n);
+  double* normals = malloc(sizeof(double) * 3 * (size_t)n);
+  OK(w, mica_embedding_update(w, e, before, normals));
+  memcpy(after, before, sizeof(double) * 3 * (size_t)n);
+
+  /* The tets whose centroid has x > 0.075. */
+  double* rest = malloc(sizeof(double) * 3 * (size_t)nodes);
+  int32_t* tets = malloc(sizeof(int32_t) * 4 * (size_t)tet_count);
+  int32_t* removed = malloc(sizeof(int32_t) * (size_t)tet_count);
+  OK(w, mica_body_get_rest_positions(w, body, rest, nodes, NULL));
+  OK(w, mica_body_get_tets(w, body, tets, tet_count, NULL));
+  int32_t count = 0;
+  for (int32_t t = 0; t < tet_count; ++t) {
+    double cx = 0;
+    for (int k = 0; k < 4; ++k) cx += rest[3 * tets[4 * t + k]] / 4;
+    if (cx > 0.075) removed[count++] = t;
+  }
+  assert_int_equal(mica_body_remove_tets(w, body, removed, count, NULL), MICA_WARN_UNBOUND_VERTICES);
+  const char* message = mica_world_last_error(w);
+  if (!strstr(message, "mica_body_remove_tets") || !strstr(message, "unbound")) fail_msg("message: %s", message);
+  OK(w, mica_embedding_update(w, e, after, normals));
+  int32_t* kinds = malloc(sizeof(int32_t) * (size_t)n);
+  OK(w, mica_embedding_get_kinds(w, e, kinds, n, NULL));
+  int32_t kept = 0, deep = 0, counted[3] = {0, 0, 0};
+  for (int32_t i = 0; i < n; ++i) {
+    const double vx = fine.xyz[3 * i];
+    ++counted[kinds[i]];
+    if (vx < 0.05 - 1e-9) {
+      ++kept;
+      assert_int_equal(kinds[i], MICA_EMBED_INSIDE);
+      if (memcmp(after + 3 * i, before + 3 * i, 3 * sizeof(double)) != 0) fail_msg("kept vertex %d moved", i);
+    } else if (fabs(vx - 0.075) < 1e-9) {
+      assert_int_equal(kinds[i], MICA_EMBED_INSIDE); /* on the new face: found in a kept tet */
+    } else if (vx > 0.08) {
+      ++deep;
+      assert_int_equal(kinds[i], MICA_EMBED_UNBOUND);
+      if (memcmp(after + 3 * i, before + 3 * i, 3 * sizeof(double)) != 0) fail_msg("unbound vertex %d was written", i);
+    }
+  }
+  int32_t inside = 0, projected = 0, unbound = 0;
+  OK(w, mica_embedding_get_counts(w, e, NULL, &inside, &projected, &unbound));
+  assert_int_equal(inside, counted[MICA_EMBED_INSIDE]);
+  assert_int_equal(projected, counted[MICA_EMBED_PROJECTED]);
+  assert_int_equal(unbound, counted[MICA_EMBED_UNBOUND]);
+  print_message("removal: %d of %d vertices kept to the bit, %d deep in the removed part unbound (%d unbound, %d projected)\n",
+                kept, n, deep, unbound, projected);
+  assert_true(kept > n / 3 && deep > 0);
+  /* And the body steps on with the mesh on it. */
+  OK(w, mica_step(w, 0.01));
+  OK(w, mica_embedding_update(w, e, after, normals));
+  free(x);
+  free(before);
+  free(after);
+  free(normals);
+  free(rest);
+  free(tets);
+  free(removed);
+  free(kinds);
+  fine_surface_free(&fine);
+  mica_world_destroy(w);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_nidus_under_a_tool),
@@ -265,6 +352,7 @@ int main(void) {
       cmocka_unit_test(test_a_destroyed_body_or_embedding_is_detected),
       cmocka_unit_test(test_def_and_arguments),
       cmocka_unit_test(test_ids_list_the_embeddings),
+      cmocka_unit_test(test_removal_keeps_the_kept_and_rebinds_the_rest),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -3,7 +3,8 @@
 // and under a rigid motion every bound vertex lands where it should (1e-12 m); vertices outside
 // the body are projected within the radius and unbound beyond it, left as they were; the normals
 // are the area-weighted normals of the moved triangles; the update allocates nothing; bad input is
-// refused by name.
+// refused by name. After a resection the vertices of kept tets are placed as before, to the bit,
+// and those of removed tets are bound again; after a cut every vertex follows its tet's copies.
 #include "embedding/embedding.hpp"
 #include "embedding/tet_locator.hpp"
 #include "embedding/vertex_normals.hpp"
@@ -14,6 +15,7 @@
 #endif
 #include "haptics/alloc_counter.hpp"
 #include "test_util.hpp"
+#include "world/topology_change.hpp"
 
 using namespace mica;
 
@@ -226,6 +228,206 @@ static void test_update_refuses_another_node_count(void**) {
   fail_msg("a shorter node array was taken");
 }
 
+
+namespace {
+
+// A resection as World::remove_tets makes it: the tets whose centroid has x > cut go, the nodes no
+// kept tet holds go, the rest are renumbered in order.
+struct Resection {
+  TopologyChange change;
+  TetMesh mesh;
+  std::vector<Tri> surface;
+};
+
+Resection resect(const Box& b, double cut) {
+  Resection r;
+  std::vector<uint8_t> used(b.mesh.nodes.size(), 0);
+  std::vector<Tet> kept;
+  for (size_t e = 0; e < b.mesh.tets.size(); ++e) {
+    Vec3 c = Vec3::Zero();
+    for (int32_t i : b.mesh.tets[e]) c += b.mesh.nodes[size_t(i)] / 4;
+    if (c.x() > cut) continue;
+    kept.push_back(b.mesh.tets[e]);
+    r.change.tet_origin.push_back(int32_t(e));
+    for (int32_t i : b.mesh.tets[e]) used[size_t(i)] = 1;
+  }
+  std::vector<int32_t> index(used.size(), -1);
+  for (size_t i = 0; i < used.size(); ++i)
+    if (used[i]) {
+      index[i] = int32_t(r.mesh.nodes.size());
+      r.mesh.nodes.push_back(b.mesh.nodes[i]);
+      r.change.node_origin.push_back(int32_t(i));
+    }
+  for (Tet t : kept) {
+    for (int32_t& i : t) i = index[size_t(i)];
+    r.mesh.tets.push_back(t);
+  }
+  r.surface = extract_surface(r.mesh);
+  r.change.body = 7;
+  r.change.topology_version = 1;
+  return r;
+}
+
+// A bend of the nodes (not affine), so that each vertex's position depends on its own tet.
+Vec3List bent(const Vec3List& nodes) {
+  Vec3List x = nodes;
+  for (Vec3& p : x) p += Vec3(0, 0.3 * p.x() * p.x() + 0.1 * p.z() * p.x(), 0.2 * p.y() * p.x());
+  return x;
+}
+
+}  // namespace
+
+static void test_resection_keeps_the_vertices_of_kept_tets_and_binds_the_others_again(void**) {
+  const Box b = box();
+  const Mesh m = render_mesh(b);
+  Embedding e = embed(b, m);
+  const Vec3List x = bent(b.mesh.nodes);
+  std::vector<double> before(m.xyz.size(), 42.0), normals(m.xyz.size());
+  e.update(x, before.data(), normals.data());
+  std::vector<int32_t> old_tet(size_t(m.count()));
+  for (int32_t i = 0; i < m.count(); ++i) old_tet[size_t(i)] = e.tet(i);
+
+  const Resection r = resect(b, 0.01);  // the +x part of the box goes, the near vertices' tets with it
+  std::vector<uint8_t> kept(b.mesh.tets.size(), 0);
+  for (int32_t o : r.change.tet_origin) kept[size_t(o)] = 1;
+  const Embedding::FollowReport report = e.follow(r.change, r.mesh.nodes, r.mesh.tets, r.surface);
+  assert_int_equal(e.node_count(), int32_t(r.mesh.nodes.size()));
+  assert_true(e.topology_version() == 1);
+
+  Vec3List x_new(r.mesh.nodes.size());  // the same node positions, renumbered
+  for (size_t i = 0; i < x_new.size(); ++i) x_new[i] = x[size_t(r.change.node_origin[i])];
+  std::vector<double> after(m.xyz.size(), 42.0);
+  e.update(x_new, after.data(), normals.data());
+  std::vector<double> at_rest(m.xyz.size(), 42.0);
+  e.update(r.mesh.nodes, at_rest.data(), nullptr);
+  int32_t followed = 0, gone = 0, unbound = 0;
+  for (int32_t i = 0; i < m.count(); ++i) {
+    const int32_t t = old_tet[size_t(i)];
+    const int32_t kind = e.kinds()[size_t(i)];
+    if (t >= 0 && kept[size_t(t)]) {  // its tet stays: the same bits
+      ++followed;
+      assert_int_equal(r.change.tet_origin[size_t(e.tet(i))], t);
+      assert_memory_equal(&after[3 * size_t(i)], &before[3 * size_t(i)], 3 * sizeof(double));
+      continue;
+    }
+    if (t < 0) {  // unbound stays unbound, the host's value untouched
+      assert_int_equal(kind, int32_t(VertexKind::Unbound));
+      assert_true(after[3 * size_t(i)] == 42.0);
+      continue;
+    }
+    ++gone;
+    if (kind == int32_t(VertexKind::Unbound)) {
+      ++unbound;
+      assert_int_equal(e.tet(i), -1);
+      assert_true(after[3 * size_t(i)] == 42.0 && at_rest[3 * size_t(i)] == 42.0);
+      continue;
+    }
+    // Bound again, in a kept tet: at rest exactly where it was given.
+    assert_true(e.tet(i) >= 0);
+    const Vec3 p(at_rest[3 * size_t(i)], at_rest[3 * size_t(i) + 1], at_rest[3 * size_t(i) + 2]);
+    assert_near((p - m.vertex(i)).norm(), 0.0, 1e-12);
+  }
+  print_message("resection: %d vertices followed their tets, %d bound again (%d inside, %d projected, %d unbound)\n",
+                followed, gone, report.inside, report.projected, report.unbound);
+  assert_int_equal(report.followed, followed);
+  assert_int_equal(report.inside + report.projected + report.unbound, gone);
+  assert_int_equal(report.unbound, unbound);
+  assert_true(gone > 100 && report.inside > 0 && report.projected > 0 && report.unbound > 0);
+  // The counts are those of the kinds.
+  int32_t counted[3] = {0, 0, 0};
+  for (int32_t k : e.kinds()) ++counted[k];
+  for (int k = 0; k < 3; ++k) assert_int_equal(e.count(VertexKind(k)), counted[k]);
+}
+
+// A cut along the plane x = 0.01 (a plane of the box's nodes) as World::cut makes one: every tet stays, the tets on the +x side
+// take copies of the plane's nodes (appended after the old nodes). Moving the +x side's nodes
+// (copies included) by d moves exactly the vertices bound on that side.
+static void test_cut_vertices_follow_their_tets_copies(void**) {
+  const Box b = box();
+  const Mesh m = render_mesh(b);
+  Embedding e = embed(b, m);
+  TopologyChange change;
+  change.body = 7;
+  change.topology_version = 3;
+  TetMesh cut = b.mesh;
+  std::vector<int32_t> copy(b.mesh.nodes.size(), -1);
+  for (size_t i = 0; i < b.mesh.nodes.size(); ++i) change.node_origin.push_back(int32_t(i));
+  std::vector<uint8_t> plus(b.mesh.tets.size(), 0);
+  for (size_t t = 0; t < cut.tets.size(); ++t) {
+    change.tet_origin.push_back(int32_t(t));
+    Vec3 c = Vec3::Zero();
+    for (int32_t i : cut.tets[t]) c += b.mesh.nodes[size_t(i)] / 4;
+    if (c.x() < 0.01) continue;
+    plus[t] = 1;
+    for (int32_t& i : cut.tets[t]) {
+      if (std::abs(b.mesh.nodes[size_t(i)].x() - 0.01) > 1e-12) continue;
+      if (copy[size_t(i)] < 0) {
+        copy[size_t(i)] = int32_t(cut.nodes.size());
+        cut.nodes.push_back(b.mesh.nodes[size_t(i)]);
+        change.node_origin.push_back(i);
+      }
+      i = copy[size_t(i)];
+    }
+  }
+  assert_true(cut.nodes.size() > b.mesh.nodes.size());
+  const std::vector<Tri> surface = extract_surface(cut);
+  const int32_t bound = m.count() - e.count(VertexKind::Unbound);
+  const Embedding::FollowReport report = e.follow(change, cut.nodes, cut.tets, surface);
+  assert_int_equal(report.followed, bound);  // a cut removes no tet: nobody is bound again
+  assert_int_equal(report.inside + report.projected + report.unbound, 0);
+
+  const Vec3 d(0.01, -0.02, 0.005);
+  std::vector<uint8_t> moved(cut.nodes.size(), 0);
+  for (size_t t = 0; t < cut.tets.size(); ++t)
+    if (plus[t])
+      for (int32_t i : cut.tets[t]) moved[size_t(i)] = 1;
+  Vec3List x = cut.nodes;
+  for (size_t i = 0; i < x.size(); ++i)
+    if (moved[i]) x[i] += d;
+  std::vector<double> out(m.xyz.size(), 42.0);
+  e.update(x, out.data(), nullptr);
+  int32_t on_plus = 0;
+  for (int32_t i = 0; i < m.count(); ++i) {
+    if (e.tet(i) < 0) continue;
+    const Vec3 p(out[3 * size_t(i)], out[3 * size_t(i) + 1], out[3 * size_t(i) + 2]);
+    const Vec3 expected = m.vertex(i) + (plus[size_t(e.tet(i))] ? d : Vec3::Zero());
+    on_plus += plus[size_t(e.tet(i))];
+    if ((p - expected).norm() > 1e-12) fail_msg("vertex %d is %.3g m from where its side put it", i, (p - expected).norm());
+  }
+  assert_true(on_plus > 50 && on_plus < bound - 50);
+}
+
+static void test_a_change_that_does_not_fit_is_refused_and_changes_nothing(void**) {
+  const Box b = box();
+  const Mesh m = render_mesh(b);
+  Embedding e = embed(b, m);
+  Resection r = resect(b, 0.01);
+  const std::vector<int32_t> kinds = e.kinds();
+  r.change.tet_origin[3] = int32_t(b.mesh.tets.size());  // no such tet
+  try {
+    e.follow(r.change, r.mesh.nodes, r.mesh.tets, r.surface);
+    fail_msg("a change naming a tet the embedding never had was followed");
+  } catch (const Error& error) {
+    assert_int_equal(int(error.code()), int(Errc::InvalidArgument));
+    if (!std::strstr(error.what(), "new tet 3 comes from tet")) fail_msg("'%s'", error.what());
+  }
+  r.change.tet_origin.pop_back();
+  try {
+    e.follow(r.change, r.mesh.nodes, r.mesh.tets, r.surface);
+    fail_msg("a change of another tet count was followed");
+  } catch (const Error& error) {
+    assert_int_equal(int(error.code()), int(Errc::InvalidArgument));
+  }
+  assert_true(e.kinds() == kinds);
+  assert_int_equal(e.node_count(), int32_t(b.mesh.nodes.size()));
+  // What the C layer does when a follow fails: every vertex unbound, the update leaves them be.
+  e.unbind_all(int32_t(r.mesh.nodes.size()), 5);
+  assert_int_equal(e.count(VertexKind::Unbound), m.count());
+  std::vector<double> out(m.xyz.size(), 42.0), normals(m.xyz.size());
+  e.update(r.mesh.nodes, out.data(), normals.data());
+  for (double v : out) assert_true(v == 42.0);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_grid_finds_the_tet_a_scan_finds),
@@ -235,6 +437,9 @@ int main(void) {
       cmocka_unit_test(test_update_allocates_nothing),
       cmocka_unit_test(test_bad_input_is_refused_by_name),
       cmocka_unit_test(test_update_refuses_another_node_count),
+      cmocka_unit_test(test_resection_keeps_the_vertices_of_kept_tets_and_binds_the_others_again),
+      cmocka_unit_test(test_cut_vertices_follow_their_tets_copies),
+      cmocka_unit_test(test_a_change_that_does_not_fit_is_refused_and_changes_nothing),
   };
   return cmocka_run_group_tests(tests, nullptr, nullptr);
 }
