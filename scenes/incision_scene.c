@@ -5,6 +5,7 @@
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #define ENTRY_ABOVE 0.001   /* m: the tip starts this far above and behind the start point */
@@ -26,7 +27,7 @@ incision_scene_def incision_scene_def_default(void) {
   d.depth = 0.008;
   d.speed = 0.01;
   d.dt = 0.01;
-  d.cutting_resistance = 100;
+  d.cutting_resistance = 40;
   d.blade = 1;
   d.hook = 1;
   return d;
@@ -83,6 +84,9 @@ mica_status incision_scene_create(const incision_scene_def* def, incision_scene*
   pd.refactor_interval = def->refactor_interval;
   mica_status st = press_scene_create(&pd, &s->press);
   if (st < 0) return fail(s, st, "%s", s->press.error);
+  s->entry_steps = (int32_t)ceil((ENTRY_ABOVE + def->depth) * sqrt(2.0) / (def->speed * def->dt));
+  s->cut_steps = (int32_t)ceil(def->length / (def->speed * def->dt));
+  s->steps = s->entry_steps + s->cut_steps + s->cut_steps / 10;
   mica_world* w = s->press.world;
   memcpy(s->start, s->press.center, sizeof s->start);
   s->start[0] -= def->length / 2;
@@ -124,9 +128,6 @@ mica_status incision_scene_create(const incision_scene_def* def, incision_scene*
     st = mica_lpc_grab(w, s->press.body, s->hook_at, HOOK_RADIUS, MICA_NULL_ID, &s->hook);
     if (st < 0) goto failed;
   }
-  s->entry_steps = (int32_t)ceil((ENTRY_ABOVE + def->depth) * sqrt(2.0) / (def->speed * def->dt));
-  s->cut_steps = (int32_t)ceil(def->length / (def->speed * def->dt));
-  s->steps = s->entry_steps + s->cut_steps + s->cut_steps / 10;
   return MICA_OK;
 
 failed:

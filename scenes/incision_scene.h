@@ -43,7 +43,7 @@ typedef struct incision_scene_def {
   double depth;               /* m, the blade tip's depth below the surface; default 0.008 */
   double speed;               /* m/s; default 0.01 */
   double dt;                  /* s; default 0.01 */
-  double cutting_resistance;  /* N/m of edge; default 100 */
+  double cutting_resistance;  /* N/m of edge; default 40 */
   int32_t blade;              /* 1: the blade cuts; 0: the same capsule on the same path, not a blade */
   int32_t hook;               /* 1: the hook retracts one side; default 1 */
   int32_t forceps;            /* 1: the forceps tip rests beside the cut; default 0 */

@@ -112,8 +112,11 @@ void collide_tool(const Tool& tool, int32_t tool_index, uint64_t tool_key, const
   // The tool's own travel: its translation plus its turn at the far end of its bounds.
   const Aabb bounds = tool_bounds(tool, 0);
   const double lever = tool.shape == ToolShape::Plane ? 0 : 0.5 * bounds.size().norm();
-  const double margin = tool.margin + body.travel + h * (tool.velocity.norm() + tool.angular_velocity.norm() * lever);
-  const Aabb reach = tool_bounds(tool, margin);
+  const double tool_margin = tool.margin + h * (tool.velocity.norm() + tool.angular_velocity.norm() * lever);
+  const Aabb reach = tool_bounds(tool, tool_margin + body.travel);
+  // Each node's and triangle's own travel (h times its speed), not the body's fastest: a piece cut
+  // free and falling far away must not widen the margin of every node near the tool.
+  auto travel = [&](int32_t node) { return body.v ? h * (*body.v)[size_t(node)].norm() : body.travel; };
   // A plane has no far side to push a body through.
   const ToolSweep sweep(tool);
   const bool swept = sweep.moved() && tool.shape != ToolShape::Plane;
@@ -135,6 +138,7 @@ void collide_tool(const Tool& tool, int32_t tool_index, uint64_t tool_key, const
   passed_nodes.clear();
   for (int32_t node : *body.nodes) {
     if (!reach.contains(x[node])) continue;
+    const double margin = tool_margin + travel(node);
     const SurfacePoint s = closest_surface_point(tool, x[node]);
     if (s.distance >= margin) continue;
     SideContact side{s.normal, s.distance};
@@ -170,6 +174,7 @@ void collide_tool(const Tool& tool, int32_t tool_index, uint64_t tool_key, const
   };
   body.bvh->query(reach, [&](int32_t tri) {
     const Tri& t = (*body.triangles)[tri];
+    const double margin = tool_margin + std::max({travel(t[0]), travel(t[1]), travel(t[2])});
     // Edges from a node the tool went past to one beside its path (each edge once: from the
     // triangle that has it as (i, j), i < j).
     for (int k = 0; !passed_nodes.empty() && k < 3; ++k) {

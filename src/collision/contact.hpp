@@ -65,6 +65,7 @@ struct SurfaceView {
   const SurfacePseudoNormals* normals;  // of the triangles at x: which side of the surface a point is on
   double depth;                     // m, the deepest penetration looked for
   double travel;                    // m, how far a node may move this step (h times the top speed; 0 when static)
+  const Vec3List* v = nullptr;      // the nodes' velocities (null: every node may move `travel`)
 };
 
 // Tool against a body: a contact for each pair of a feature of the tool's rounded core and of

@@ -20,6 +20,7 @@ namespace {
 // What a blade put on one body in the step.
 struct BladePress {
   Vec3 force = Vec3::Zero();  // N, on the tissue
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;  // m, the contacts' extent along the edge
   double resistance = 0;      // N/m, the mean over the contacts of their nodes' tets' resistance
   int32_t contacts = 0;
 };
@@ -30,20 +31,6 @@ double node_resistance(const Body& b, int32_t i) {
   const int32_t first = fem.node_element_start[size_t(i)], last = fem.node_element_start[size_t(i) + 1];
   for (int32_t k = first; k < last; ++k) sum += b.cutting_resistance[size_t(fem.node_elements[size_t(k)])];
   return last > first ? sum / (last - first) : 0;
-}
-
-// The length of the blade's edge in the tissue: the extent along the edge of the body's surface
-// nodes within a surface edge of it (at least one surface edge).
-double edge_in_tissue(const Tool& t, const Vec3& axis, const Body& b) {
-  const double reach = t.radius + b.surface_edge;
-  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-  for (int32_t i : b.surface_node_list) {
-    const Vec3 r = b.x[size_t(i)] - t.position;
-    const double s = std::clamp(axis.dot(r), -t.half_length, t.half_length);
-    if ((r - axis * s).squaredNorm() > reach * reach) continue;
-    lo = std::min(lo, s), hi = std::max(hi, s);
-  }
-  return std::max(hi - lo, b.surface_edge);
 }
 
 }  // namespace
@@ -67,6 +54,8 @@ void World::cut_with_blades(const StepContext& ctx) {
       const Body& b = *ctx.dynamic[size_t(c.a.body)];
       BladePress& p = press[size_t(c.a.body)];
       p.force += rows.direction[r] * last_.lambda[r] / ctx.h;
+      const double s = axis.dot(c.point - t.position);
+      p.lo = std::min(p.lo, s), p.hi = std::max(p.hi, s);
       double resistance = 0;
       for (int32_t j = 0; j < c.a.count; ++j) resistance += c.a.weights[size_t(j)] * node_resistance(b, c.a.nodes[size_t(j)]);
       p.resistance += resistance;
@@ -77,7 +66,9 @@ void World::cut_with_blades(const StepContext& ctx) {
       if (p.contacts == 0) continue;
       const Body& b = *ctx.dynamic[i];
       const double along = blade.dot(p.force);  // what presses the edge into the tissue, in the blade's plane
-      if (!(std::abs(along) > p.resistance / p.contacts * edge_in_tissue(t, axis, b))) continue;
+      // The edge in the tissue: the contacts' extent along it, at least one surface edge.
+      const double edge = std::min(std::max(p.hi - p.lo, b.surface_edge), 2 * t.half_length);
+      if (!(std::abs(along) > p.resistance / p.contacts * edge)) continue;
       cuts.push_back({last_.bodies[i], t.position - axis * t.half_length, t.position + axis * t.half_length,
                       along > 0 ? blade : Vec3(-blade), t.radius, b.surface_edge});
     }

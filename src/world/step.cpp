@@ -336,7 +336,7 @@ void World::collide(StepContext& ctx) {
       for (int32_t i : b.surface_node_list) speed = std::max(speed, b.v[i].norm());
     }
     views.push_back(SurfaceView{index, id, &b.x, &b.surface, &b.surface_node_list, &b.bvh, &b.pseudo_normals,
-                                b.surface_edge, h * speed});
+                                b.surface_edge, h * speed, index >= 0 ? &b.v : nullptr});
   });
   tools_.for_each([&](Id tool_id, Tool& t) {
     ctx.tools.push_back(&t);
