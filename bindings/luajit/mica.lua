@@ -291,6 +291,43 @@ function World:remove_tets(body, tets)
   return removed[0]
 end
 
+-- The numbers of a (nested) Lua table in order: {x1, y1, z1, ...} stays as it is, a table of
+-- triangles {{{x, y, z}, {x, y, z}, {x, y, z}}, ...} or of rows of 9 is flattened.
+local function flatten(values, out)
+  for _, v in ipairs(values) do
+    if type(v) == "table" then flatten(v, out) else out[#out + 1] = v end
+  end
+  return out
+end
+
+-- Incision (since 0.8): separates the body along a cut surface, triangles in world space (m) where
+-- the body is now: a Lua table of 9 numbers a triangle (its three corners), flat or nested.
+-- Returns faces_cut, nodes_added; node copies are numbered after the body's nodes, tet indices
+-- stay (see topology_version).
+function World:cut(body, triangles)
+  local flat = flatten(triangles, {})
+  if #flat % 9 ~= 0 then
+    error(string.format("cut triangles: expected 9 values a triangle, got %d", #flat), 0)
+  end
+  local n = #flat / 9
+  local faces, added = ffi.new("int32_t[1]"), ffi.new("int32_t[1]")
+  self:check(C.mica_body_cut(self.ptr, body, n > 0 and ffi.new("double[?]", #flat, flat) or nil, n, faces, added))
+  return faces[0], added[0]
+end
+
+-- Each tet's cutting resistance (since 0.8), a Lua table of one value per tet: the force per metre
+-- of blade edge (N/m, >= 0) the tissue bears before a blade (tool_def blade = 1) parts it.
+function World:set_cutting_resistance(body, per_tet)
+  local counts = ffi.new("int32_t[2]")
+  self:check(C.mica_body_get_counts(self.ptr, body, counts, counts + 1, nil))
+  local tets = counts[1]
+  if type(per_tet) ~= "table" or #per_tet ~= tets then
+    error(string.format("cutting_resistance: one value per tet (%d), got %s", tets,
+                        type(per_tet) == "table" and #per_tet or "a " .. type(per_tet)), 0)
+  end
+  self:check(C.mica_body_set_cutting_resistance(self.ptr, body, ffi.new("double[?]", tets, per_tet), tets))
+end
+
 -- How many times the body's tets have changed (0 at creation), as a Lua number.
 function World:topology_version(body)
   local out = ffi.new("uint64_t[1]")

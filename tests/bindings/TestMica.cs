@@ -468,6 +468,80 @@ static class TestMica
         }
     }
 
+    // Incision: a 4 x 2 x 2 cell box cut through x = 0.02 (two triangles covering the section)
+    // gets a copy of each of the section's 3 x 3 nodes, its mass unchanged, its topology version 1.
+    static void CutAndBlades()
+    {
+        var wdef = Mica.WorldDef();
+        unsafe { wdef.gravity[1] = 0; }
+        using (var world = new World(wdef))
+        {
+            var bdef = Mica.BodyDef();
+            Expect(bdef.cutting_resistance == 200, "the default cutting resistance: " + bdef.cutting_resistance);
+            var box = world.CreateBox(new double[] { 0, 0, 0 }, new double[] { 0.04, 0.02, 0.02 }, new[] { 4, 2, 2 }, 5, bdef);
+            int nodes, tets, triangles;
+            box.GetCounts(out nodes, out tets, out triangles);
+            double mass = box.GetNodeMasses().Sum();
+            Expect(box.TopologyVersion == 0, "version 0 at creation");
+            double x = 0.02, y0 = -0.01, y1 = 0.03, z0 = -0.01, z1 = 0.03;
+            var section = new[] { x, y0, z0, x, y1, z0, x, y1, z1, x, y0, z0, x, y1, z1, x, y0, z1 };
+            int faces, added;
+            box.Cut(new double[0], out faces, out added);
+            Expect(faces == 0 && added == 0 && box.TopologyVersion == 0, "no triangles, no cut");
+            box.Cut(section, out faces, out added);
+            Expect(faces == 2 * 2 * 2, "faces cut: " + faces);
+            Expect(added == 3 * 3, "nodes added: " + added);
+            int nodesAfter, tetsAfter;
+            box.GetCounts(out nodesAfter, out tetsAfter, out triangles);
+            Expect(nodesAfter == nodes + 9 && tetsAfter == tets, "counts after the cut");
+            Expect(box.TopologyVersion == 1, "version 1 after the cut: " + box.TopologyVersion);
+            double after = box.GetNodeMasses().Sum();
+            Expect(Math.Abs(after - mass) <= 1e-12 * mass, "the mass stays: " + after + " vs " + mass);
+            try { box.Cut(new double[10], out faces, out added); Expect(false, "10 values are refused"); }
+            catch (ArgumentException e) { Expect(e.Message.Contains("9 values a triangle"), e.Message); }
+            var bad = (double[])section.Clone();
+            bad[12] = double.NaN;
+            try { box.Cut(bad, out faces, out added); Expect(false, "a corner not finite raises"); }
+            catch (MicaException e)
+            {
+                Expect(e.Status == MicaNative.MICA_ERR_INVALID_ARGUMENT && e.LibraryMessage.Contains("triangle 1"), "names triangle 1: " + e.LibraryMessage);
+            }
+            Expect(box.TopologyVersion == 1, "a refused cut changes nothing");
+
+            // Cutting resistance per tet: one value a tet, each finite and >= 0.
+            box.SetCuttingResistance(Enumerable.Repeat(500.0, tets).ToArray());
+            try { box.SetCuttingResistance(new[] { 500.0 }); Expect(false, "one value for many tets is refused"); }
+            catch (ArgumentException e) { Expect(e.Message.Contains("one value per tet (" + tets + ")"), e.Message); }
+            var negative = Enumerable.Repeat(500.0, tets).ToArray();
+            negative[7] = -1;
+            try { box.SetCuttingResistance(negative); Expect(false, "a negative resistance raises"); }
+            catch (MicaException e)
+            {
+                Expect(e.Status == MicaNative.MICA_ERR_INVALID_ARGUMENT && e.LibraryMessage.Contains("tet 7"), "names tet 7: " + e.LibraryMessage);
+            }
+
+            // A blade is a capsule: accepted as one, refused as a sphere.
+            var tdef = Mica.ToolDef();
+            Expect(tdef.blade == 0, "not a blade by default");
+            tdef.shape = MicaNative.MICA_TOOL_CAPSULE;
+            tdef.radius = 0.0005;
+            tdef.half_length = 0.02;
+            tdef.blade = 1;
+            var blade = world.CreateTool(tdef, new[] { 0.02, 0.05, 0.01 });
+            Expect(world.GetIds(MicaNative.MICA_OBJECT_TOOL).SequenceEqual(new[] { blade.Id }), "the blade was made");
+            var sdef = Mica.ToolDef();
+            sdef.shape = MicaNative.MICA_TOOL_SPHERE;
+            sdef.radius = 0.01;
+            sdef.blade = 1;
+            try { world.CreateTool(sdef); Expect(false, "a spherical blade is refused"); }
+            catch (MicaException e)
+            {
+                Expect(e.Status == MicaNative.MICA_ERR_INVALID_ARGUMENT && e.LibraryMessage.Contains("blade"), "a spherical blade: " + e.LibraryMessage);
+            }
+            Expect(world.GetIds(MicaNative.MICA_OBJECT_TOOL).Length == 1, "no tool from the refused def");
+        }
+    }
+
     // User code in its own assembly: a mesh from a file, and an id from the raw layer wrapped.
     static void LoaderAndRawIds()
     {
@@ -831,6 +905,7 @@ static class TestMica
         Test("a device driving a grasp", DeviceDrivesAGrasp);
         Test("a mesh file and raw ids, from another assembly", LoaderAndRawIds);
         Test("tissue regions, materials and fields", RegionsMaterialsAndFields);
+        Test("an incision, cutting resistance and blades", CutAndBlades);
         Test("System.Numerics Vector3 and Quaternion overloads", NumericsOverloads);
         Test("an embedded mesh follows its body", EmbeddedMesh);
         Test("a recorded session replays bit for bit, with the recorded ids", RecordAndReplay);

@@ -536,6 +536,71 @@ test("tissue regions, materials and fields", function()
   world:close()
 end)
 
+test("an incision, cutting resistance and blades (since 0.8)", function()
+  -- A 4 x 2 x 2 cell box cut through x = 0.02 by two triangles covering the section: a copy of each
+  -- of the section's 3 x 3 nodes, the mass unchanged, the topology version 1.
+  local world = mica.world{ gravity = { 0, 0, 0 } }
+  expect(mica.body_def().cutting_resistance == 200, "the default cutting resistance")
+  expect(mica.tool_def().blade == 0, "not a blade by default")
+  local box = world:create_box({ 0, 0, 0 }, { 0.04, 0.02, 0.02 }, { 4, 2, 2 }, 5)
+  local counts = ffi.new("int32_t[2]")
+  world:check(C.mica_body_get_counts(world.ptr, box, counts, counts + 1, nil))
+  local nodes, tets = counts[0], counts[1]
+  local function total_mass()
+    local m, n = world:node_masses(box)
+    local sum = 0
+    for i = 0, n - 1 do sum = sum + m[i] end
+    return sum
+  end
+  local mass = total_mass()
+  expect(world:topology_version(box) == 0, "version 0 at creation")
+  local x, y0, y1, z0, z1 = 0.02, -0.01, 0.03, -0.01, 0.03
+  local section = { { { x, y0, z0 }, { x, y1, z0 }, { x, y1, z1 } }, { { x, y0, z0 }, { x, y1, z1 }, { x, y0, z1 } } }
+  local faces, added = world:cut(box, {})
+  expect(faces == 0 and added == 0 and world:topology_version(box) == 0, "no triangles, no cut")
+  faces, added = world:cut(box, section)
+  expect(faces == 2 * 2 * 2, "faces cut: " .. faces)
+  expect(added == 3 * 3, "nodes added: " .. added)
+  world:check(C.mica_body_get_counts(world.ptr, box, counts, counts + 1, nil))
+  expect(counts[0] == nodes + 9 and counts[1] == tets, "counts after the cut")
+  expect(world:topology_version(box) == 1, "version 1 after the cut")
+  expect(math.abs(total_mass() - mass) <= 1e-12 * mass, "the mass stays")
+  -- The same section again, flat: nothing more to separate.
+  local flat = { x, y0, z0, x, y1, z0, x, y1, z1, x, y0, z0, x, y1, z1, x, y0, z1 }
+  faces, added = world:cut(box, flat)
+  expect(added == 0 and world:topology_version(box) == 1, "a second cut along the same faces adds nothing")
+  expect_refused("cut triangles: expected 9 values a triangle, got 10", world.cut, world, box,
+                 { 0, 0, 0, 0, 0, 0, 0, 0, 0, 0 })
+  flat[13] = 0 / 0
+  local err = expect_refused("triangle 1", world.cut, world, box, flat)
+  expect(err.status == C.MICA_ERR_INVALID_ARGUMENT, "a corner not finite: " .. tostring(err))
+  expect(world:topology_version(box) == 1, "a refused cut changes nothing")
+
+  -- Cutting resistance per tet: one value a tet, each finite and >= 0.
+  local resistance = {}
+  for e = 1, tets do resistance[e] = 500 end
+  world:set_cutting_resistance(box, resistance)
+  expect_refused("cutting_resistance: one value per tet (" .. tets .. "), got 1", world.set_cutting_resistance,
+                 world, box, { 500 })
+  resistance[8] = -1
+  err = expect_refused("tet 7", world.set_cutting_resistance, world, box, resistance)
+  expect(err.status == C.MICA_ERR_INVALID_ARGUMENT, tostring(err))
+  err = expect_refused("cutting_resistance", world.create_box, world, { 1, 0, 0 }, { 1.04, 0.02, 0.02 }, { 4, 2, 2 }, 5,
+                       { cutting_resistance = -1 })
+  expect(err.status == C.MICA_ERR_INVALID_ARGUMENT, tostring(err))
+
+  -- A blade is a capsule: accepted as one, refused as a sphere (no tool made).
+  local blade = world:create_tool{ shape = C.MICA_TOOL_CAPSULE, radius = 0.0005, half_length = 0.02, blade = 1,
+                                   position = { 0.02, 0.05, 0.01 } }
+  local ids, n = world:ids(C.MICA_OBJECT_TOOL)
+  expect(n == 1 and ids[0] == blade, "the blade was made")
+  err = expect_refused("blade", world.create_tool, world, { shape = C.MICA_TOOL_SPHERE, radius = 0.01, blade = 1 })
+  expect(err.status == C.MICA_ERR_INVALID_ARGUMENT, tostring(err))
+  ids, n = world:ids(C.MICA_OBJECT_TOOL)
+  expect(n == 1, "no tool from the refused def")
+  world:close()
+end)
+
 -- Recording and replay (since 0.6): a box on a fixed base pressed by a sphere, recorded, then
 -- replayed bit for bit; world:ids() gives the created ids; a changed fingerprint diverges.
 local RECORDED_STEPS = 20

@@ -525,6 +525,71 @@ class Behaviour(unittest.TestCase):
                 body.remove_tets([0, 0])
             self.assertIn("listed twice", e.exception.message)
 
+    def test_cut(self):
+        # Incision: a 4 x 2 x 2 cell box cut through x = 0.02 (two triangles covering the section)
+        # gets a copy of each of the section's 3 x 3 nodes; the mass stays, the version is bumped.
+        with mica.World(gravity=(0, 0, 0)) as world:
+            body = world.create_box((0, 0, 0), (0.04, 0.02, 0.02), (4, 2, 2), 5)
+            nodes, tets, _ = body.counts()
+            mass = body.node_masses().sum()
+            x, y0, y1, z0, z1 = 0.02, -0.01, 0.03, -0.01, 0.03
+            section = [[(x, y0, z0), (x, y1, z0), (x, y1, z1)], [(x, y0, z0), (x, y1, z1), (x, y0, z1)]]
+            self.assertEqual(body.cut([]), (0, 0), "no triangles: nothing cut")
+            self.assertEqual(body.topology_version(), 0)
+            faces, added = body.cut(section)
+            self.assertEqual((faces, added), (2 * 2 * 2, 3 * 3))
+            self.assertEqual(body.counts()[:2], (nodes + 9, tets))
+            self.assertEqual(body.topology_version(), 1)
+            self.assertLessEqual(abs(body.node_masses().sum() - mass), 1e-12 * mass)
+            # A cut along the same faces again separates nothing more (flat rows of 9 this time).
+            self.assertEqual(body.cut(np.reshape(section, (2, 9)))[1], 0)
+            self.assertEqual(body.topology_version(), 1)
+            with self.assertRaises(ValueError) as e:
+                body.cut(np.zeros((2, 3, 2)))
+            self.assertEqual(str(e.exception), "cut triangles: expected rows of 3 corners (k, 3, 3) or of 9 values, "
+                                               "got an array of shape (2, 3, 2)")
+            with self.assertRaises(ValueError):
+                body.cut(np.zeros(10))
+            bad = np.array(section, dtype=np.float64)
+            bad[1, 2, 0] = np.nan
+            with self.assertRaises(mica.MicaError) as e:
+                body.cut(bad)
+            self.assertEqual(e.exception.status, mica.MICA_ERR_INVALID_ARGUMENT)
+            self.assertIn("triangle 1", e.exception.message)
+            self.assertEqual(body.topology_version(), 1, "a refused cut changes nothing")
+
+    def test_cutting_resistance_and_blades(self):
+        self.assertEqual(mica.body_def().cutting_resistance, 200.0)
+        self.assertEqual(mica.tool_def().blade, 0)
+        with mica.World(gravity=(0, 0, 0)) as world:
+            body = world.create_box((0, 0, 0), (0.04, 0.02, 0.02), (4, 2, 2), 5, cutting_resistance=350)
+            tets = body.counts()[1]
+            body.set_cutting_resistance(np.full(tets, 500.0))
+            with self.assertRaises(ValueError) as e:
+                body.set_cutting_resistance([500.0])
+            self.assertEqual(str(e.exception), "cutting_resistance: one value per tet (%d), got 1" % tets)
+            bad = np.full(tets, 500.0)
+            bad[7] = -1
+            with self.assertRaises(mica.MicaError) as e:
+                body.set_cutting_resistance(bad)
+            self.assertEqual(e.exception.status, mica.MICA_ERR_INVALID_ARGUMENT)
+            self.assertIn("tet 7", e.exception.message)
+            with self.assertRaises(mica.MicaError) as e:
+                world.create_box((1, 0, 0), (1.04, 0.02, 0.02), (4, 2, 2), 5, cutting_resistance=-1)
+            self.assertEqual(e.exception.status, mica.MICA_ERR_INVALID_ARGUMENT)
+            self.assertIn("cutting_resistance", e.exception.message)
+            # A blade is a capsule: accepted as one, refused as a sphere (no tool made).
+            blade = world.create_tool(shape=mica.MICA_TOOL_CAPSULE, radius=0.0005, half_length=0.02, blade=1,
+                                      position=(0.02, 0.05, 0.01))
+            self.assertEqual(world.ids(mica.MICA_OBJECT_TOOL), [blade.id])
+            with self.assertRaises(mica.MicaError) as e:
+                world.create_tool(shape=mica.MICA_TOOL_SPHERE, radius=0.01, blade=1)
+            self.assertEqual(e.exception.status, mica.MICA_ERR_INVALID_ARGUMENT)
+            self.assertIn("blade", e.exception.message)
+            self.assertEqual(world.ids(mica.MICA_OBJECT_TOOL), [blade.id])
+            world.step(0.01)  # the blade above the body: nothing to cut
+            self.assertEqual(body.topology_version(), 0)
+
     def test_library_found_next_to_the_build_tree(self):
         # The package copied into <build>/bindings/python finds <build>/libmica without help.
         pkg = os.path.join(os.environ["MICA_BINDINGS_BUILD_DIR"], "python")

@@ -26,6 +26,10 @@
 #define DEVICE_0_5 END_OF(mica_device_def, hand_damping)
 /* The 0.3.0 world def ended with mica_sweep and reserved3 (now threads). */
 #define WORLD_0_3 END_OF(mica_world_def, threads)
+/* The 0.7.0 body def ended with velocity (cutting_resistance came in 0.8), its tool def with
+ * reserved0 (blade and reserved1 came in 0.8): both their 0.2.0 sizes. */
+#define BODY_0_7 END_OF(mica_body_def, velocity)
+#define TOOL_0_7 END_OF(mica_tool_def, reserved0)
 
 /* A world def with room past its end, so that a larger struct_size is safe to try. */
 typedef union {
@@ -44,6 +48,10 @@ static void test_first_sizes_are_the_released_ones(void** state) {
   assert_int_equal(FIRST_DEVICE, 200);
   assert_int_equal(DEVICE_0_5, 200);
   assert_int_equal(sizeof(mica_device_def), 208);
+  assert_int_equal(BODY_0_7, 104);
+  assert_int_equal(TOOL_0_7, 160);
+  assert_int_equal(sizeof(mica_body_def), 112);
+  assert_int_equal(sizeof(mica_tool_def), 168);
 }
 
 /* init at `size` into a buffer of 0xcd: returns the status; *written counts the bytes changed
@@ -194,6 +202,42 @@ static void test_device_from_0_5_header(void** state) {
   mica_world_destroy(world);
 }
 
+/* Body and tool defs from a 0.7 caller: only their 104 and 160 bytes are read, so what lies where
+ * 0.8 has cutting_resistance (bytes 0xcd: a negative double) and blade (0xcdcdcdcd, neither 0 nor
+ * 1) is not looked at; the same bytes read as 0.8 defs are refused. */
+static void test_body_and_tool_from_0_7_header(void** state) {
+  (void)state;
+  union {
+    mica_body_def d;
+    unsigned char bytes[sizeof(mica_body_def) + 16];
+  } body;
+  union {
+    mica_tool_def d;
+    unsigned char bytes[sizeof(mica_tool_def) + 16];
+  } tool;
+  memset(&body, 0xcd, sizeof body);
+  memset(&tool, 0xcd, sizeof tool);
+  assert_int_equal(mica_body_def_init(&body.d, BODY_0_7), MICA_OK);
+  assert_int_equal(mica_tool_def_init(&tool.d, TOOL_0_7), MICA_OK);
+  tool.d.shape = MICA_TOOL_SPHERE;
+  mica_world_def wd = mica_world_def_default();
+  mica_world* world = NULL;
+  assert_int_equal(mica_world_create(&wd, &world), MICA_OK);
+  const double lo[3] = {0, 0, 0}, hi[3] = {0.04, 0.02, 0.02};
+  const int32_t cells[3] = {4, 2, 2};
+  mica_body_id b = MICA_NULL_ID;
+  assert_int_equal(mica_body_create_box(world, &body.d, lo, hi, cells, 5, &b), MICA_OK);
+  mica_tool_id t = MICA_NULL_ID;
+  assert_int_equal(mica_tool_create(world, &tool.d, &t), MICA_OK);
+  body.d.struct_size = sizeof body.d;
+  tool.d.struct_size = sizeof tool.d;
+  assert_int_equal(mica_body_create_box(world, &body.d, lo, hi, cells, 5, &b), MICA_ERR_INVALID_ARGUMENT);
+  assert_non_null(strstr(mica_world_last_error(world), "cutting_resistance"));
+  assert_int_equal(mica_tool_create(world, &tool.d, &t), MICA_ERR_INVALID_ARGUMENT);
+  assert_non_null(strstr(mica_world_last_error(world), "blade"));
+  mica_world_destroy(world);
+}
+
 /* 0.3's reserved3 became threads in 0.4: a 0.3 def's value there is not a thread count. */
 static void test_world_0_3_reserved_slot(void** state) {
   (void)state;
@@ -253,6 +297,7 @@ int main(void) {
       cmocka_unit_test(test_world_from_an_older_header),
       cmocka_unit_test(test_world_0_3_reserved_slot),
       cmocka_unit_test(test_device_from_0_5_header),
+      cmocka_unit_test(test_body_and_tool_from_0_7_header),
       cmocka_unit_test(test_older_header_gets_the_library_defaults),
       cmocka_unit_test(test_header_versions),
       cmocka_unit_test(test_create_names_a_refused_size),

@@ -728,6 +728,34 @@ class Body(_Object):
                                                        byref(removed)), "mica_body_remove_tets")
         return removed.value
 
+    def cut(self, triangles: ArrayLike) -> Tuple[int, int]:
+        """Incision (since 0.8): separates the body along a cut surface, triangles in world space
+        (m) where the body is now: (k, 3, 3) corners, (k, 9) rows or a flat multiple of 9 values.
+        Returns (faces_cut, nodes_added); node copies are numbered after the body's nodes, tet
+        indices stay (see topology_version, which a cut that separates no node leaves alone)."""
+        t = np.ascontiguousarray(triangles, dtype=np.float64)
+        if not ((t.ndim == 3 and t.shape[1:] == (3, 3)) or (t.ndim == 2 and t.shape[1] == 9)
+                or (t.ndim == 1 and t.size % 9 == 0)):
+            raise ValueError("cut triangles: expected rows of 3 corners (k, 3, 3) or of 9 values, got an array "
+                             "of shape %s" % (t.shape,))
+        t = t.reshape(-1, 9)
+        faces, added = c_int32(0), c_int32(0)
+        self.world._check(native.mica_body_cut(self.world.handle, self.id,
+                                               t.ctypes.data_as(POINTER(c_double)) if len(t) else None, len(t),
+                                               byref(faces), byref(added)), "mica_body_cut")
+        return faces.value, added.value
+
+    def set_cutting_resistance(self, per_tet: ArrayLike) -> None:
+        """Each tet's cutting resistance (since 0.8): the force per metre of blade edge (N/m, >= 0)
+        the tissue bears before a blade (tool_def blade=1) parts it; one value per tet."""
+        tets = self.counts()[1]
+        a = np.ascontiguousarray(per_tet, dtype=np.float64).ravel()
+        if len(a) != tets:
+            raise ValueError(f"cutting_resistance: one value per tet ({tets}), got {len(a)}")
+        self.world._check(native.mica_body_set_cutting_resistance(self.world.handle, self.id,
+                                                                  a.ctypes.data_as(POINTER(c_double)), tets),
+                          "mica_body_set_cutting_resistance")
+
     def topology_version(self) -> int:
         """How many times the body's tets have changed (0 at creation)."""
         out = ctypes.c_uint64(0)

@@ -177,6 +177,7 @@ class mica_body_def(Structure):
         ("rayleigh_beta", c_double),
         ("translation", c_double * 3),
         ("velocity", c_double * 3),
+        ("cutting_resistance", c_double),  # since 0.8
     ]
 
 
@@ -204,6 +205,8 @@ class mica_tool_def(Structure):
         ("hull_points", POINTER(c_double)),
         ("hull_point_count", c_int32),
         ("reserved0", c_int32),
+        ("blade", c_int32),  # since 0.8
+        ("reserved1", c_int32),
     ]
 
 
@@ -394,6 +397,9 @@ PROTOTYPES = {
     "mica_body_set_materials": (mica_status, [mica_world_p, mica_body_id, _p(_d), _p(_d), _p(_d), _i]),
     # resection
     "mica_body_remove_tets": (mica_status, [mica_world_p, mica_body_id, _p(_i), _i, _p(_d)]),
+    # since 0.8: incision and cutting resistance
+    "mica_body_cut": (mica_status, [mica_world_p, mica_body_id, _p(_d), _i, _p(_i), _p(_i)]),
+    "mica_body_set_cutting_resistance": (mica_status, [mica_world_p, mica_body_id, _p(_d), _i]),
     "mica_body_get_topology_version": (mica_status, [mica_world_p, mica_body_id, _p(c_uint64)]),
     "mica_body_get_node_masses": (mica_status, [mica_world_p, mica_body_id, _p(_d), _i, _p(_i)]),
     "mica_body_get_strains": (mica_status, [mica_world_p, mica_body_id, _p(_d), _i, _p(_i)]),

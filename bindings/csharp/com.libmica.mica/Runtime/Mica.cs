@@ -561,6 +561,31 @@ namespace LibMica
             return removed;
         }
 
+        /// <summary>Incision (since 0.8): separates the body along a cut surface given as triangles
+        /// in world space (m) where the body is now, 9 values a triangle (its three corners).
+        /// facesCut: the faces the triangles crossed; nodesAdded: the node copies made, numbered
+        /// after the body's nodes (tet indices stay; see TopologyVersion).</summary>
+        public void Cut(double[] triangles, out int facesCut, out int nodesAdded)
+        {
+            if (triangles == null) throw new ArgumentNullException("triangles");
+            if (triangles.Length % 9 != 0)
+                throw new ArgumentException("triangles: 9 values a triangle, got " + triangles.Length);
+            World.Check(MicaNative.mica_body_cut(World.Handle, Id, triangles.Length > 0 ? triangles : null,
+                                                 triangles.Length / 9, out facesCut, out nodesAdded));
+        }
+
+        /// <summary>Each tet's cutting resistance (since 0.8): the force per metre of blade edge
+        /// (N/m, &gt;= 0) the tissue bears before a blade (mica_tool_def.blade = 1) parts it.</summary>
+        public void SetCuttingResistance(double[] perTet)
+        {
+            if (perTet == null) throw new ArgumentNullException("perTet");
+            int nodes, tets, triangles;
+            GetCounts(out nodes, out tets, out triangles);
+            if (perTet.Length != tets)
+                throw new ArgumentException("cutting resistance: one value per tet (" + tets + "), got " + perTet.Length);
+            World.Check(MicaNative.mica_body_set_cutting_resistance(World.Handle, Id, perTet, tets));
+        }
+
         /// <summary>How many times the body's tets have changed (0 at creation).</summary>
         public ulong TopologyVersion
         {

@@ -198,6 +198,7 @@ namespace LibMica
             public double rayleigh_beta;
             public fixed double translation[3];
             public fixed double velocity[3];
+            public double cutting_resistance; // since 0.8
         }
 
         [StructLayout(LayoutKind.Sequential)]
@@ -225,6 +226,8 @@ namespace LibMica
             public IntPtr hull_points; // const double*, copied by mica_tool_create
             public int hull_point_count;
             public int reserved0;
+            public int blade; // since 0.8
+            public int reserved1;
         }
 
         [StructLayout(LayoutKind.Sequential)]
@@ -472,6 +475,14 @@ namespace LibMica
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
         public static extern int mica_body_remove_tets(WorldHandle world, ulong body, int[] tets, int count,
                                                        out double out_removed_mass);
+
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern int mica_body_cut(WorldHandle world, ulong body, double[] triangles, int triangle_count,
+                                               out int out_faces_cut, out int out_nodes_added);
+
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern int mica_body_set_cutting_resistance(WorldHandle world, ulong body, double[] per_tet,
+                                                                  int tet_count);
 
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
         public static extern int mica_body_get_topology_version(WorldHandle world, ulong body, out ulong @out);
