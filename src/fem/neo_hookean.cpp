@@ -62,8 +62,9 @@ NeoHookean neo_hookean_parameters(const Lame& lame) {
 }
 
 double neo_hookean_energy_density(const NeoHookean& p, const Mat3& F) {
-  const double d = F.determinant() - p.alpha;
-  return 0.5 * p.mu * (F.squaredNorm() - 3) + 0.5 * p.lambda * d * d - 0.5 * p.mu * p.mu / p.lambda;
+  // lambda/2 (J - alpha)^2 - mu^2 / (2 lambda) = lambda/2 (J - 1)^2 - mu (J - 1): no constant to cancel.
+  const double j = F.determinant() - 1;
+  return 0.5 * p.mu * (F.squaredNorm() - 3) - p.mu * j + 0.5 * p.lambda * j * j;
 }
 
 Mat3 neo_hookean_stress(const NeoHookean& p, const Mat3& F) {

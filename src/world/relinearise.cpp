@@ -69,6 +69,7 @@ struct Eval {
   double scale = 0;   // J, the bodies' energy
   double phi = 0;     // J, the incremental potential (all dynamic bodies)
   double model_error = 0, model_scale = 0;  // J, neo-Hookean bodies: |U(x+) - U_L(x+)| and their energy
+  double model_floor = 0;                   // J, the round-off of model_error
 };
 
 // The step's end positions x + h v (next_end.x; its rotations are the caller's to compute).
@@ -144,6 +145,7 @@ Eval evaluate_neo_hookean(Body& b, const Vec3List& v, double h, const BodyTerms&
   out.phi = 0.5 * dvMdv + u.u_end - h * fv + 0.5 * h * (d.alpha * vMv + d.beta * u.vKv);
   out.model_error = std::fabs(u.u_end - u.u_lin_end);
   out.model_scale = std::max(b.relin.k_start + b.relin.u_start, 0.5 * vMv + u.u_end);
+  out.model_floor = b.relin.round_off;
   b.next_end.u = u.u_end;
   return out;
 }
@@ -151,9 +153,13 @@ Eval evaluate_neo_hookean(Body& b, const Vec3List& v, double h, const BodyTerms&
 // The first screen of a neo-Hookean body's solution b.v_next (linearised at the step's start x):
 // also fixes the start's energies, U(x) from the assembly's model.
 Eval screen_neo_hookean(Body& b, double h, const BodyTerms& d) {
-  double u_start = 0;
+  double u_start = 0, stiffness = 0;
   for (double u : b.neo_hookean.energy) u_start += u;
+  for (size_t e = 0; e < b.fem.elements.size(); ++e)
+    stiffness += (b.fem.lame[e].mu + b.fem.lame[e].lambda) * b.fem.elements[e].volume;
   b.relin.u_start = u_start;
+  // Energies near rest are differences of terms of order (mu + lambda) V: below this the error is round-off.
+  b.relin.round_off = 1e-12 * stiffness;
   b.relin.k_start = 0.5 * mass_dot(b.fem, b.v, b.v);
   return evaluate_neo_hookean(b, b.v_next, h, d);
 }
@@ -204,7 +210,7 @@ void World::relinearise(const StepContext& ctx, StageRunner& stage) {
     terms[k].loads = needs_loads(b);
   }
   auto passes = [&](const Eval& e) {
-    return debt + e.growth <= tol * e.scale && e.model_error <= tol * e.model_scale;
+    return debt + e.growth <= tol * e.scale && e.model_error <= tol * e.model_scale + e.model_floor;
   };
   // The screen: the rotation update U(x+) - U_R(x+) bounds the growth from above.
   Eval cur;
@@ -217,6 +223,7 @@ void World::relinearise(const StepContext& ctx, StageRunner& stage) {
         const Eval e = screen_neo_hookean(*b, h, terms[k]);
         cur.model_error += e.model_error;
         cur.model_scale += e.model_scale;
+        cur.model_floor += e.model_floor;
       }
       if (!b->settings.corotational()) continue;
       b->relin.modes.clear();
@@ -241,6 +248,7 @@ void World::relinearise(const StepContext& ctx, StageRunner& stage) {
         sum.phi += e.phi;
         sum.model_error += e.model_error;
         sum.model_scale += e.model_scale;
+        sum.model_floor += e.model_floor;
         continue;
       }
       const Eval e = evaluate(b, v, h, terms[k], b.relin.R_start);
