@@ -219,10 +219,14 @@ typedef struct mica_world_def {
   /** Co-rotational bodies: a step linearised at its start's rotations can gain energy when
    *  elements turn far within it. When a step gained more than this fraction of the bodies'
    *  energy beyond the work done on them, it is solved again by Newton iterations re-linearised at
-   *  the new rotations, with a line search (docs/stability.md, K1). Default 1e-3. */
+   *  the new rotations, with a line search (docs/stability.md, K1). Default 1e-3.
+   *  MICA_MODEL_NEO_HOOKEAN bodies (since 0.8): the Newton iterations of their step stop when the
+   *  quadratic model a solve used is within this fraction of the body's energy of the true energy
+   *  at its end; a step that misses in relinearise_max solves returns MICA_WARN_NOT_CONVERGED
+   *  (docs/materials.md). */
   double relinearise_tolerance;
   int32_t relinearise_max; /**< at most this many solves per step for that; < 2 turns the check off; default 8 */
-  /** MICA_SWEEP_FACTORED on co-rotational bodies: every this many solves (one per
+  /** MICA_SWEEP_FACTORED on co-rotational and (since 0.8) neo-Hookean bodies: every this many solves (one per
    *  step, more when a step is re-linearised) the factor is refreshed from the current system:
    *  copied, factored on a background thread (one per body, "mica-factor", made at its first
    *  refresh and kept until the world is destroyed) while the steps go on, and used from
