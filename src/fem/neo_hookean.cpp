@@ -115,47 +115,73 @@ Mat9 neo_hookean_hessian(const NeoHookean& p, const Mat3& F) {
   return H;
 }
 
-Mat9 neo_hookean_projected_hessian(const NeoHookean& p, const Mat3& F, Mat3* rotation) {
-  Mat3 U, V;
+NeoHookeanFrame neo_hookean_frame(const NeoHookean& p, const Mat3& F) {
+  NeoHookeanFrame f;
   Vec3 s;
-  rotation_variant_svd(F, U, s, V);
-  if (rotation) *rotation = U * V.transpose();
-  Mat9 H = neo_hookean_hessian(p, F);
-  const double J = s[0] * s[1] * s[2];
-  const double w = p.lambda * (J - p.alpha);
-  // Each negative eigenpair (value, U D V^T) is taken out: H -= value vec vec^T.
-  auto remove = [&](double value, const Mat3& D) {
-    if (value >= 0) return;
-    const Vec9 q = vec(U * D * V.transpose());
-    H.noalias() -= value * q * q.transpose();
-  };
-  // Twist and flip modes of the pair (i, j), k the third axis: mu + w s_k and mu - w s_k.
-  const double r = std::sqrt(0.5);
+  rotation_variant_svd(F, f.U, s, f.V);
+  const double w = p.lambda * (s[0] * s[1] * s[2] - p.alpha);
+  // The pairs: twist mu + w s_k and flip mu - w s_k, each clamped at zero, as the 2x2 they make.
   for (int k = 0; k < 3; ++k) {
-    const int i = (k + 1) % 3, j = (k + 2) % 3;
-    Mat3 twist = Mat3::Zero(), flip = Mat3::Zero();
-    twist(i, j) = r, twist(j, i) = -r;
-    flip(i, j) = r, flip(j, i) = r;
-    remove(p.mu + w * s[k], twist);
-    remove(p.mu - w * s[k], flip);
+    const double twist = std::max(p.mu + w * s[k], 0.0), flip = std::max(p.mu - w * s[k], 0.0);
+    f.d1[k] = 0.5 * (twist + flip);
+    f.d2[k] = 0.5 * (flip - twist);
   }
-  // Scaling modes: the 3x3 d^2 Psi / ds^2 = mu I + lambda g g^T + w d^2J/ds^2 in the singular values.
+  // The scaling block: d^2 Psi / ds^2 = mu I + lambda g g^T + w d^2J/ds^2 in the singular values.
   const Vec3 g(s[1] * s[2], s[0] * s[2], s[0] * s[1]);
-  Mat3 A = p.lambda * g * g.transpose();
+  Mat3& A = f.A;
+  A = p.lambda * g * g.transpose();
   A.diagonal().array() += p.mu;
   A(0, 1) += w * s[2], A(1, 0) += w * s[2];
   A(0, 2) += w * s[1], A(2, 0) += w * s[1];
   A(1, 2) += w * s[0], A(2, 1) += w * s[0];
+  // Positive definite by its leading minors (the common case): nothing to clamp, no eigensolve.
+  const double m2 = A(0, 0) * A(1, 1) - A(0, 1) * A(0, 1);
+  if (A(0, 0) > 0 && m2 > 0 && A.determinant() > 0) return f;
   Eigen::SelfAdjointEigenSolver<Mat3> eig;
   eig.computeDirect(A);
-  for (int m = 0; m < 3; ++m) remove(eig.eigenvalues()[m], eig.eigenvectors().col(m).asDiagonal());
+  A = eig.eigenvectors() * eig.eigenvalues().cwiseMax(0.0).asDiagonal() * eig.eigenvectors().transpose();
+  return f;
+}
+
+Mat3 NeoHookeanFrame::apply(const Mat3& dF) const {
+  const Mat3 X = U.transpose() * dF * V;
+  Mat3 Y;
+  Y.diagonal() = A * X.diagonal();
+  for (int k = 0; k < 3; ++k) {
+    const int i = (k + 1) % 3, j = (k + 2) % 3;
+    Y(i, j) = d1[k] * X(i, j) + d2[k] * X(j, i);
+    Y(j, i) = d2[k] * X(i, j) + d1[k] * X(j, i);
+  }
+  return U * Y * V.transpose();
+}
+
+double NeoHookeanFrame::quadratic(const Mat3& dF) const {
+  const Mat3 X = U.transpose() * dF * V;
+  const Vec3 x = X.diagonal();
+  double q = x.dot(A * x);
+  for (int k = 0; k < 3; ++k) {
+    const int i = (k + 1) % 3, j = (k + 2) % 3;
+    q += d1[k] * (X(i, j) * X(i, j) + X(j, i) * X(j, i)) + 2 * d2[k] * X(i, j) * X(j, i);
+  }
+  return q;
+}
+
+Mat9 neo_hookean_projected_hessian(const NeoHookean& p, const Mat3& F, Mat3* rotation) {
+  const NeoHookeanFrame f = neo_hookean_frame(p, F);
+  if (rotation) *rotation = f.U * f.V.transpose();
+  Mat9 H;
+  for (int c = 0; c < 9; ++c) {
+    Mat3 E = Mat3::Zero();
+    E(c % 3, c / 3) = 1;
+    H.col(c) = vec(f.apply(E));
+  }
   return H;
 }
 
 void NeoHookeanLinearisation::resize(size_t elements) {
   energy.resize(elements);
   stress.resize(elements);
-  hessian.resize(elements);
+  frame.resize(elements);
 }
 
 namespace {
@@ -167,34 +193,39 @@ void add_element(const FemModel& m, size_t e, const Vec3List& x, const NeoHookea
   const Mat3 F = deformation_gradient(el, x);
   const Mat3 P = neo_hookean_stress(p, F);
   const bool need_hessian = what.K || what.v_lin || what.R || what.lin;
-  Mat9 H;
-  if (need_hessian) H = neo_hookean_projected_hessian(p, F, what.R ? &(*what.R)[e] : nullptr);
+  NeoHookeanFrame H;
+  if (need_hessian) H = neo_hookean_frame(p, F);
+  if (what.R) (*what.R)[e] = H.U * H.V.transpose();
   // f_a = -V P g_a, and with v_lin + h V (H : F(v_lin)) g_a (F(v) = sum_b v_b g_b^T).
   Mat3 stress = -el.volume * P;
-  if (what.v_lin) {
-    const Mat3 Fv = deformation_gradient(el, *what.v_lin);
-    const Vec9 dP = H * vec(Fv);
-    stress += (what.h * el.volume) * Eigen::Map<const Mat3>(dP.data());
-  }
+  if (what.v_lin) stress += (what.h * el.volume) * H.apply(deformation_gradient(el, *what.v_lin));
   for (int a = 0; a < 4; ++a) f[el.nodes[a]] += stress * el.grad[a];
   if (what.lin) {
     what.lin->energy[e] = el.volume * neo_hookean_energy_density(p, F);
     what.lin->stress[e] = P;
-    what.lin->hessian[e] = H;
+    what.lin->frame[e] = H;
   }
   if (!what.K) return;
-  // K_ab(i, k) = s V sum_jl H(i + 3j, k + 3l) g_a[j] g_b[l]; C_b(:, k) = sum_l H(:, k + 3l) g_b[l].
-  const double s = what.k_scale * el.volume;
-  Eigen::Matrix<double, 9, 3> C[4];
-  for (int b = 0; b < 4; ++b)
-    for (int k = 0; k < 3; ++k)
-      C[b].col(k) = s * (H.col(k) * el.grad[b][0] + H.col(k + 3) * el.grad[b][1] + H.col(k + 6) * el.grad[b][2]);
+  // In the SVD frame (g^ = V^T g): K_ab = s V U M_ab U^T with M_ab = diag(g^_a) A diag(g^_b) plus the
+  // pairs' 2x2 blocks (neo_hookean.hpp, NeoHookeanFrame).
+  const double scale = what.k_scale * el.volume;
+  Vec3 gh[4];
+  for (int a = 0; a < 4; ++a) gh[a] = H.V.transpose() * el.grad[a];
   Mat3* blocks = what.K->data();
   for (int a = 0; a < 4; ++a)
-    for (int b = 0; b < 4; ++b) {
-      const Vec3& ga = el.grad[a];
-      blocks[m.slots[e][4 * a + b]] +=
-          ga[0] * C[b].block<3, 3>(0, 0) + ga[1] * C[b].block<3, 3>(3, 0) + ga[2] * C[b].block<3, 3>(6, 0);
+    for (int b = a; b < 4; ++b) {  // symmetric: K_ba = K_ab^T
+      const Vec3 &u = gh[a], &v = gh[b];
+      Mat3 M = u.asDiagonal() * H.A * v.asDiagonal();
+      for (int k = 0; k < 3; ++k) {
+        const int i = (k + 1) % 3, j = (k + 2) % 3;
+        M(i, i) += H.d1[k] * u[j] * v[j];
+        M(j, j) += H.d1[k] * u[i] * v[i];
+        M(i, j) += H.d2[k] * u[j] * v[i];
+        M(j, i) += H.d2[k] * u[i] * v[j];
+      }
+      const Mat3 k = scale * (H.U * M * H.U.transpose());
+      blocks[m.slots[e][4 * a + b]] += k;
+      if (b != a) blocks[m.slots[e][4 * b + a]] += k.transpose();
     }
 }
 
@@ -235,13 +266,10 @@ NeoHookeanModelEnergies neo_hookean_model_energies(const FemModel& m, const NeoH
     const TetElement& el = m.elements[e];
     const Mat3 F = deformation_gradient(el, x_end);
     const Mat3 dF = F - deformation_gradient(el, x_lin);
-    const Vec9 d = vec(dF);
     out.u_end += el.volume * neo_hookean_energy_density(neo_hookean_parameters(m.lame[e]), F);
-    out.u_lin_end += lin.energy[e] + el.volume * (lin.stress[e].cwiseProduct(dF).sum() + 0.5 * d.dot(lin.hessian[e] * d));
-    if (v) {
-      const Vec9 dv = vec(deformation_gradient(el, *v));
-      out.vKv += el.volume * dv.dot(lin.hessian[e] * dv);
-    }
+    out.u_lin_end +=
+        lin.energy[e] + el.volume * (lin.stress[e].cwiseProduct(dF).sum() + 0.5 * lin.frame[e].quadratic(dF));
+    if (v) out.vKv += el.volume * lin.frame[e].quadratic(deformation_gradient(el, *v));
   }
   return out;
 }

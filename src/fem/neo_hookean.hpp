@@ -39,9 +39,22 @@ Mat3 neo_hookean_stress(const NeoHookean& p, const Mat3& F);
 // Cauchy stress P F^T / J (Pa); for J <= 0 (a collapsed or inverted element) P F^T, the Kirchhoff
 // stress, so that a readout stays finite.
 Mat3 neo_hookean_cauchy(const NeoHookean& p, const Mat3& F);
-// d^2 Psi / dF^2 with its negative eigenvalues clamped to zero (the eigensystem in closed form:
-// three scaling modes from a 3x3, six twist and flip modes mu +- lambda (J - alpha) sigma_k).
-// With `rotation`, also R = U V^T of F's rotation-variant SVD (the co-rotated frame).
+// d^2 Psi / dF^2 with its negative eigenvalues clamped to zero, kept in the frame of F's
+// rotation-variant SVD F = U diag(s) V^T (det U det V = 1; an inverted F has s_2 < 0), where it is
+// block diagonal: on dF^ = U^T dF V, the diagonal entries meet the 3x3 scaling block A (mu I +
+// lambda g g^T + lambda (J - alpha) d^2J/ds^2, clamped through its eigensystem when it is not
+// definite), and each pair (i, j) = ((k + 1) % 3, (k + 2) % 3) the 2x2 [[d1, d2], [d2, d1]] on
+// (dF^_ij, dF^_ji) whose eigenvalues are the twist mu + lambda (J - alpha) s_k and the flip
+// mu - lambda (J - alpha) s_k, each clamped at zero.
+struct NeoHookeanFrame {
+  Mat3 U, V;
+  Mat3 A;
+  Vec3 d1, d2;
+  Mat3 apply(const Mat3& dF) const;       // H : dF
+  double quadratic(const Mat3& dF) const;  // dF : H : dF
+};
+NeoHookeanFrame neo_hookean_frame(const NeoHookean& p, const Mat3& F);
+// The same as a 9x9 on vec(F) (tests); with `rotation`, also R = U V^T (the co-rotated frame).
 Mat9 neo_hookean_projected_hessian(const NeoHookean& p, const Mat3& F, Mat3* rotation = nullptr);
 // The unprojected d^2 Psi / dF^2 (tests).
 Mat9 neo_hookean_hessian(const NeoHookean& p, const Mat3& F);
@@ -49,9 +62,9 @@ Mat9 neo_hookean_hessian(const NeoHookean& p, const Mat3& F);
 // What a step linearised at x_lin keeps per element: Psi V, P and the projected Hessian at x_lin,
 // the quadratic model the step solved (neo_hookean_model_energies reads it back).
 struct NeoHookeanLinearisation {
-  std::vector<double> energy;  // J
-  std::vector<Mat3> stress;    // P
-  std::vector<Mat9> hessian;   // projected d^2 Psi / dF^2
+  std::vector<double> energy;          // J
+  std::vector<Mat3> stress;            // P
+  std::vector<NeoHookeanFrame> frame;  // projected d^2 Psi / dF^2
   void resize(size_t elements);
 };
 

@@ -88,7 +88,6 @@ struct BodyScratch {
     std::vector<TwistModes> modes;    // the linearisation's twist stiffness (empty: none)
     Vec3List v_iter, v_lin, v_best, v_trial, scratch;
     Vec3List x_lin;                   // neo-Hookean: x + h v_lin, where the step is linearised
-    bool at_iterate = false;          // neo-Hookean: the elements stage linearises at x_lin, not x
     double round_off = 0;             // J, neo-Hookean: the model error's floor (relinearise.cpp)
     double u_start = 0, k_start = 0;  // J, elastic and kinetic energy at the step's start
     bool u_start_known = false;       // u_start is U(x) (x == the last step's end.x)

@@ -127,12 +127,12 @@ Eval evaluate(Body& b, const Vec3List& v, double h, const BodyTerms& d, const st
 }
 
 // A neo-Hookean body's velocities v against the quadratic model its system was assembled from
-// (at x_lin: x, or x + h v_lin when relin.at_iterate). Sets next_end.x and next_end.u.
+// (at relin.x_lin). Sets next_end.x and next_end.u.
 Eval evaluate_neo_hookean(Body& b, const Vec3List& v, double h, const BodyTerms& d) {
   const FemModel& m = b.fem;
   end_state(b, v, h);
   const NeoHookeanModelEnergies u =
-      neo_hookean_model_energies(m, b.neo_hookean, b.relin.at_iterate ? b.relin.x_lin : b.x, b.next_end.x, &v);
+      neo_hookean_model_energies(m, b.neo_hookean, b.relin.x_lin, b.next_end.x, &v);
   Vec3List& dv = b.relin.scratch;
   dv.resize(v.size());
   for (size_t i = 0; i < v.size(); ++i) dv[i] = v[i] - b.v[i];
@@ -150,11 +150,11 @@ Eval evaluate_neo_hookean(Body& b, const Vec3List& v, double h, const BodyTerms&
   return out;
 }
 
-// The first screen of a neo-Hookean body's solution b.v_next (linearised at the step's start x):
-// also fixes the start's energies, U(x) from the assembly's model.
+// The first screen of a neo-Hookean body's solution b.v_next (linearised at the predictor x + h v):
+// also fixes the start's energies, U(x) as the last step found it at its end when x is still there.
 Eval screen_neo_hookean(Body& b, double h, const BodyTerms& d) {
-  double u_start = 0, stiffness = 0;
-  for (double u : b.neo_hookean.energy) u_start += u;
+  const double u_start = !b.end.x.empty() && b.end.x == b.x ? b.end.u : neo_hookean_energy(b.fem, b.x);
+  double stiffness = 0;
   for (size_t e = 0; e < b.fem.elements.size(); ++e)
     stiffness += (b.fem.lame[e].mu + b.fem.lame[e].lambda) * b.fem.elements[e].volume;
   b.relin.u_start = u_start;
@@ -273,10 +273,8 @@ void World::relinearise(const StepContext& ctx, StageRunner& stage) {
   // the last evaluation was of the iterate) or at the step's start, and solve.
   auto linearise_and_solve = [&](bool at_start) {
     for (Body* b : dynamic) {
-      if (b->settings.neo_hookean()) {  // linearised at x + h v_iter (or at x)
-        b->relin.at_iterate = !at_start;
-        if (at_start) continue;
-        b->relin.v_lin = b->relin.v_iter;
+      if (b->settings.neo_hookean()) {  // linearised at x + h v_iter (at the start: the predictor v)
+        b->relin.v_lin = at_start ? b->v : b->relin.v_iter;
         for (size_t i = 0; i < b->x.size(); ++i) b->relin.x_lin[i] = b->x[i] + h * b->relin.v_lin[i];
         continue;
       }

@@ -111,7 +111,11 @@ void World::prepare_step(double h) {
   bodies_.for_each([&](Id id, Body& b) {
     b.step_index = b.is_dynamic() ? int32_t(ctx.dynamic.size()) : -1;
     if (!b.is_dynamic()) return;
-    b.relin.at_iterate = false;  // the step's first linearisation is at its start
+    if (b.settings.neo_hookean()) {
+      // The first Newton iterate is the explicit predictor v: the step linearises at x + h v.
+      b.relin.v_lin = b.v;
+      for (size_t i = 0; i < b.x.size(); ++i) b.relin.x_lin[i] = b.x[i] + h * b.v[i];
+    }
     ctx.dynamic.push_back(&b);
     next_.bodies.push_back(id);
   });
@@ -234,7 +238,7 @@ void World::assemble_elements(const StepContext& ctx, Body& b) const {
   const double alpha = damping ? b.settings.rayleigh_alpha : 0.0;
   const SystemKey key{h, alpha, beta};
   if (b.settings.neo_hookean()) {
-    // The projected Hessian at the linearisation point: x, or the Newton iterate x + h v_lin with
+    // The projected Hessian at the linearisation point, the Newton iterate x_lin = x + h v_lin, with
     // f_int = f(x_lin) + h H v_lin (relinearise.cpp). Its SVDs give the rotations the factored
     // sweep warps its lagged factor with.
     set_scaled_mass(b.fem, 1.0, b.A, ctx.pool);
@@ -243,11 +247,9 @@ void World::assemble_elements(const StepContext& ctx, Body& b) const {
     what.K = &b.A;
     what.R = &b.own_R;
     what.lin = &b.neo_hookean;
-    if (b.relin.at_iterate) {
-      what.v_lin = &b.relin.v_lin;
-      what.h = h;
-    }
-    assemble_neo_hookean(b.fem, b.relin.at_iterate ? b.relin.x_lin : b.x, what, b.f_int, &b.element_colours, ctx.pool);
+    what.v_lin = &b.relin.v_lin;
+    what.h = h;
+    assemble_neo_hookean(b.fem, b.relin.x_lin, what, b.f_int, &b.element_colours, ctx.pool);
     b.rotations_in = Body::RotationsIn::Own;
     b.matrix_key = key;
     b.matrix_current = false;
