@@ -41,7 +41,8 @@
 // Neo-Hookean bodies (fem/neo_hookean.hpp) take part in the same iterations. Their force is not
 // affine in y, so each solve is a Newton step on phi with the body's own energy U: linearised at
 // x_k = x + h v_k with the projected Hessian H_k, f(x_k) - H_k (y - x_k) is the assembly at x_k
-// plus h H_k v_k in f_int. Their check is the model's error at the solution: the quadratic model
+// plus h H_k v_k in f_int; the first iterate is the explicit predictor v_0 = v (World::prepare_step),
+// which took the nidus press from 1.54 to 1.44 solves per step against linearising at x. Their check is the model's error at the solution: the quadratic model
 // U_L the solve minimised, evaluated at x+, against U(x+); |U(x+) - U_L(x+)| <= tol times the
 // body's energy. It vanishes as the iterates converge (cubically in the step length) and is
 // small for a first solve whose strain changes little in the step. A step with neo-Hookean bodies
