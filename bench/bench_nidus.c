@@ -33,6 +33,11 @@
  *          the press with the default world as mica_world_def_default() gives it (tolerance 1e-8,
  *          cap 200; gravity off), then with solver DIRECT, then with MICA's Gauss-Seidel sweep (the
  *          0.4 defaults), `steps` timed steps each (default 110): total seconds and steps not converged
+ *        bench_nidus --neo-hookean [mesh] [steps] [refactor interval]
+ *          the press with a co-rotational body, then with a neo-Hookean one (MICA_MODEL_NEO_HOOKEAN),
+ *          in this one process: MICA's factored sweep at tolerance 1e-6, the factor refreshed in the
+ *          background every `refactor interval` steps (default 6), `steps` timed steps each (default
+ *          200); each one's figures, then the two medians and their ratio (goal: at most 2x)
  *        bench_nidus --scaling <out.csv> [max-tets] [factored|gauss-seidel]
  *          time per step against tets on box grids (MICA's factored sweep unless told otherwise): a 0.1 m cube of n^3 cubes x 6 tets
  *          (E = 2e4 Pa, alpha = 2, gravity, base fixed), a 2 cm sphere 6 mm deep +- 3 mm at
@@ -265,7 +270,8 @@ static int nidus(const char* path, const mica_world_def* wd, int steps, int warm
   printf("# E = %.3g Pa, nu = 0.4, rho = 1000, alpha = 2; forceps tip: sphere R = %.1f mm, 2 mm deep +- 1 mm at 1 Hz; "
 "%s tol %.0e (cap %d), dt = %g ms; %s body; %d warm-up steps, %d timed; %ld thread(s) in the process\n",
          E, 1e3 * R, solver, wd->tolerance, (int)wd->max_iterations, 1e3 * dt,
-         model == MICA_MODEL_LINEAR ? "linear" : "co-rotational", warmup, steps, threads);
+         model == MICA_MODEL_LINEAR ? "linear" : model == MICA_MODEL_NEO_HOOKEAN ? "neo-Hookean" : "co-rotational", warmup,
+         steps, threads);
   printf("total s (timed steps) %.2f\n", 1e-3 * fig.mean * steps);
   printf("median ms/step        %.3f\n", fig.median);
   printf("p95 ms/step           %.3f\n", fig.p95);
@@ -391,10 +397,31 @@ static int defaults(const char* path, int steps) {
   return 0;
 }
 
-static const char* const kOptions[] = {"--defaults", "--scaling", NULL};
+/* The material's cost: the same press with a co-rotational body, then a neo-Hookean one, both with
+ * the factored sweep and its background refresh, in one process (the same machine state). */
+static int neo_hookean(const char* path, int steps, int refactor) {
+  printf("# command: OMP_THREAD_LIMIT=1 OPENBLAS_NUM_THREADS=1 build/bench/bench_nidus --neo-hookean %s %d %d\n", path,
+         steps, refactor);
+  const int32_t models[2] = {MICA_MODEL_COROTATIONAL, MICA_MODEL_NEO_HOOKEAN};
+  const char* names[2] = {"co-rotational", "neo-Hookean"};
+  figures fig[2];
+  for (int k = 0; k < 2; ++k) {
+    const mica_world_def wd = bench_world(1e-6, MICA_SWEEP_FACTORED, refactor);
+    printf("\n## %s body, factored sweep, factor refreshed every %d steps\n", names[k], refactor);
+    if (nidus(path, &wd, steps, 40, 1e4, 0.01, models[k], &fig[k])) return 1;
+  }
+  printf("\nmedian ms/step: co-rotational %.2f, neo-Hookean %.2f: %.2fx (goal: at most 2x); solves/step %.2f and %.2f\n",
+         fig[0].median, fig[1].median, fig[1].median / fig[0].median, fig[0].solves, fig[1].solves);
+  printf("median CPU ms/step (less polluted by other load): co-rotational %.2f, neo-Hookean %.2f: %.2fx\n",
+         fig[0].cpu_median, fig[1].cpu_median, fig[1].cpu_median / fig[0].cpu_median);
+  return 0;
+}
+
+static const char* const kOptions[] = {"--defaults", "--neo-hookean", "--scaling", NULL};
 static const char kUsage[] =
     "usage: bench_nidus [mesh] [tolerance] [steps] [warm-up] [E] [dt] [gauss-seidel steps] [refactor interval] [linear]\n"
     "       bench_nidus --defaults [mesh] [steps]\n"
+    "       bench_nidus --neo-hookean [mesh] [steps] [refactor interval]\n"
     "       bench_nidus --scaling <out.csv> [max-tets] [factored|gauss-seidel]\n"
     "The nidus-scale scene (data/nidus/nidus.msh, 9668 tets) touched by a 2 mm forceps tip, timed per\n"
     "step on one core.\n"
@@ -404,6 +431,8 @@ static const char kUsage[] =
     "  --defaults   the default world as mica_world_def_default() gives it (tolerance 1e-8, cap\n"
     "               200), then solver DIRECT, then the Gauss-Seidel sweep: `steps` timed steps each\n"
     "               (default 110), total seconds and steps not converged\n"
+    "  --neo-hookean  the press with a co-rotational body, then a neo-Hookean one, in one run: the\n"
+    "               two medians and their ratio (factored sweep, refreshed every 6 steps; 200 steps)\n"
     "  --scaling    time per step against tets on box grids, 1k to 100k tets, into out.csv\n"
     "  --help       this text\n"
     "Run it as: OMP_THREAD_LIMIT=1 OPENBLAS_NUM_THREADS=1 build/bench/bench_nidus\n";
@@ -415,6 +444,13 @@ int main(int argc, char** argv) {
     int steps = 110;
     if (argc > 3 && !cli_int(argv[0], "steps", argv[3], 1, 1000000, &steps)) return 2;
     return defaults(argc > 2 ? argv[2] : "data/nidus/nidus.msh", steps);
+  }
+  if (argc > 1 && strcmp(argv[1], "--neo-hookean") == 0) {
+    int steps = 200, refactor = 6;
+    if ((argc > 3 && !cli_int(argv[0], "steps", argv[3], 1, 1000000, &steps)) ||
+        (argc > 4 && !cli_int(argv[0], "refactor interval", argv[4], 0, 1000000, &refactor)))
+      return 2;
+    return neo_hookean(argc > 2 ? argv[2] : "data/nidus/nidus.msh", steps, refactor);
   }
   if (argc > 1 && strcmp(argv[1], "--scaling") == 0) {
     if (argc < 3) {

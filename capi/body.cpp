@@ -29,8 +29,9 @@ struct BodyInput {
 
 BodyInput translate(const mica_body_def* def) {
   const mica_body_def d = read_def(def, body_defaults(), "def");
-  if (d.model != MICA_MODEL_COROTATIONAL && d.model != MICA_MODEL_LINEAR)
-    refuse(MICA_ERR_INVALID_ARGUMENT, "def->model is " + std::to_string(d.model) + ", not a MICA_MODEL_* value");
+  if (d.model != MICA_MODEL_COROTATIONAL && d.model != MICA_MODEL_LINEAR && d.model != MICA_MODEL_NEO_HOOKEAN)
+    refuse(MICA_ERR_INVALID_ARGUMENT, "def->model is " + std::to_string(d.model) +
+                                          ", not a MICA_MODEL_* value (COROTATIONAL 0, LINEAR 1, NEO_HOOKEAN 2)");
   if (d.mass != MICA_MASS_CONSISTENT && d.mass != MICA_MASS_LUMPED)
     refuse(MICA_ERR_INVALID_ARGUMENT, "def->mass is " + std::to_string(d.mass) + ", not a MICA_MASS_* value");
   if (d.is_static != 0 && d.is_static != 1) refuse(MICA_ERR_INVALID_ARGUMENT, "def->is_static must be 0 or 1");
@@ -39,7 +40,9 @@ BodyInput translate(const mica_body_def* def) {
   in.settings.rayleigh_alpha = d.rayleigh_alpha;
   in.settings.rayleigh_beta = d.rayleigh_beta;
   in.settings.mass = d.mass == MICA_MASS_LUMPED ? mica::MassKind::Lumped : mica::MassKind::Consistent;
-  in.settings.corotational = d.model == MICA_MODEL_COROTATIONAL;
+  in.settings.model = d.model == MICA_MODEL_COROTATIONAL ? mica::ElasticModel::Corotational
+                     : d.model == MICA_MODEL_LINEAR    ? mica::ElasticModel::Linear
+                                                       : mica::ElasticModel::NeoHookean;
   in.settings.is_static = d.is_static == 1;
   in.translation = vec3(d.translation, "def->translation");
   in.velocity = vec3(d.velocity, "def->velocity");
@@ -258,7 +261,7 @@ MICA_API mica_status mica_body_get_energy(const mica_world* world, mica_body_id 
     require(world, "world");
     const mica::Body& b = world->world.body(body);
     if (kinetic) *kinetic = mica::kinetic_energy(b.fem, b.v);
-    if (elastic) *elastic = mica::elastic_energy(b.fem, b.x, b.settings.corotational);
+    if (elastic) *elastic = mica::elastic_energy(b.fem, b.x, b.settings.model);
     if (potential) {
       double u = 0;
       for (size_t i = 0; i < b.x.size(); ++i) u -= b.fem.node_mass[i] * world->world.settings().gravity.dot(b.x[i]);
@@ -394,7 +397,7 @@ MICA_API mica_status mica_body_get_strains(const mica_world* world, mica_body_id
     const int32_t tets = int32_t(b.tets.size());
     if (!out || capacity < tets) return copy_out<double>(nullptr, tets, 6, out, capacity, out_count);
     std::vector<mica::Mat3> strain;
-    mica::element_strains(b.fem, b.x, b.settings.corotational, strain);
+    mica::element_strains(b.fem, b.x, b.settings.model, strain);
     std::vector<double> voigt(size_t(6) * size_t(tets));
     for (int32_t e = 0; e < tets; ++e) {  // xx yy zz yz xz xy, tensor (not engineering) shears
       const mica::Mat3& s = strain[e];
@@ -413,7 +416,7 @@ MICA_API mica_status mica_body_get_von_mises(const mica_world* world, mica_body_
     const int32_t tets = int32_t(b.tets.size());
     if (!out || capacity < tets) return copy_out<double>(nullptr, tets, 1, out, capacity, out_count);
     std::vector<double> stress;
-    mica::element_von_mises(b.fem, b.x, b.settings.corotational, stress);
+    mica::element_von_mises(b.fem, b.x, b.settings.model, stress);
     return copy_out(stress.data(), tets, 1, out, capacity, out_count);
   });
 }

@@ -109,7 +109,7 @@ mica::VtkPiece vtk_piece(const mica::Body& b, VtkStorage& storage) {
   mica::Vec3List& displacement = storage.vectors.emplace_back(b.x.size());
   for (size_t i = 0; i < b.x.size(); ++i) displacement[i] = b.x[i] - b.fem.rest[i];
   std::vector<double>& von_mises = storage.scalars.emplace_back();
-  mica::element_von_mises(b.fem, b.x, b.settings.corotational, von_mises);
+  mica::element_von_mises(b.fem, b.x, b.settings.model, von_mises);
   const std::vector<double>& region = storage.scalars.emplace_back(b.regions.begin(), b.regions.end());
   mica::VtkPiece piece;
   piece.positions = &b.x;

@@ -219,10 +219,14 @@ typedef struct mica_world_def {
   /** Co-rotational bodies: a step linearised at its start's rotations can gain energy when
    *  elements turn far within it. When a step gained more than this fraction of the bodies'
    *  energy beyond the work done on them, it is solved again by Newton iterations re-linearised at
-   *  the new rotations, with a line search (docs/stability.md, K1). Default 1e-3. */
+   *  the new rotations, with a line search (docs/stability.md, K1). Default 1e-3.
+   *  MICA_MODEL_NEO_HOOKEAN bodies (since 0.8): the Newton iterations of their step stop when the
+   *  quadratic model a solve used is within this fraction of the body's energy of the true energy
+   *  at its end; a step that misses in relinearise_max solves returns MICA_WARN_NOT_CONVERGED
+   *  (docs/materials.md). */
   double relinearise_tolerance;
   int32_t relinearise_max; /**< at most this many solves per step for that; < 2 turns the check off; default 8 */
-  /** MICA_SWEEP_FACTORED on co-rotational bodies: every this many solves (one per
+  /** MICA_SWEEP_FACTORED on co-rotational and (since 0.8) neo-Hookean bodies: every this many solves (one per
    *  step, more when a step is re-linearised) the factor is refreshed from the current system:
    *  copied, factored on a background thread (one per body, "mica-factor", made at its first
    *  refresh and kept until the world is destroyed) while the steps go on, and used from
@@ -329,6 +333,11 @@ MICA_API mica_status mica_world_set_gravity(mica_world* world, const double grav
  *  @{ */
 #define MICA_MODEL_COROTATIONAL 0 /**< co-rotational linear elasticity: large rotations, small strains */
 #define MICA_MODEL_LINEAR 1       /**< linear elasticity: constant stiffness, factored once */
+/** Since 0.8: stable neo-Hookean hyperelasticity (Smith, de Goes, Kim 2018): large strains,
+ *  nearly incompressible tissue (Poisson ratio up to 0.495 tested), inversion-safe; each step is
+ *  solved by Newton iterations with a line search (mica_world_def.relinearise_tolerance and
+ *  relinearise_max). See docs/materials.md for when to pick it and what it costs. */
+#define MICA_MODEL_NEO_HOOKEAN 2
 #define MICA_MASS_CONSISTENT 0    /**< consistent mass (rho V / 20)(1 + delta_ab) */
 #define MICA_MASS_LUMPED 1        /**< lumped mass rho V / 4 per node */
 
@@ -790,7 +799,8 @@ MICA_API mica_status mica_body_get_node_masses(const mica_world* world, mica_bod
  *  yz, xz, xy, with tensor shear components (half the engineering shear). It is the strain the
  *  model uses: co-rotational bodies eps = sym(R^T F) - I, with F the tet's deformation gradient
  *  and R its rotation, expressed in the tet's rest axes (a rigid rotation of the body gives 0);
- *  MICA_MODEL_LINEAR bodies the small strain sym(F) - I. Constant over each (linear) tet.
+ *  MICA_MODEL_LINEAR bodies the small strain sym(F) - I; MICA_MODEL_NEO_HOOKEAN bodies (since
+ *  0.8) the Green strain (F^T F - I) / 2. Constant over each (linear) tet.
  *  Buffer protocol as mica_body_get_positions(). The world's thread (the one thread using the
  *  world at a time).
  *  @param world the world (not changed).
@@ -807,7 +817,8 @@ MICA_API mica_status mica_body_get_strains(const mica_world* world, mica_body_id
 
 /** Von Mises stress of each tet at the current positions (Pa), 1 value per tet:
  *  sqrt(3/2 s:s), s the deviatoric part of the stress 2 mu eps + lambda tr(eps) I of the tet's
- *  own material and its strain as mica_body_get_strains() gives it. Buffer protocol as
+ *  own material and its strain as mica_body_get_strains() gives it; for MICA_MODEL_NEO_HOOKEAN
+ *  bodies (since 0.8) s is the deviatoric part of the tet's Cauchy stress. Buffer protocol as
  *  mica_body_get_positions(). The world's thread (the one thread using the world at a time).
  *  @param world the world (not changed).
  *  @param body the body.

@@ -6,6 +6,7 @@
 #include <numeric>
 
 #include "core/error.hpp"
+#include "fem/neo_hookean.hpp"
 #include "fem/rotation.hpp"
 
 namespace mica {
@@ -221,6 +222,11 @@ double elastic_energy(const FemModel& m, const Vec3List& x, bool corotational) {
     energy += elastic_energy(el, m.lame[e], corotational ? proper_rotation(F) : Mat3::Identity(), F);
   }
   return energy;
+}
+
+double elastic_energy(const FemModel& m, const Vec3List& x, ElasticModel model) {
+  if (model == ElasticModel::NeoHookean) return neo_hookean_energy(m, x);
+  return elastic_energy(m, x, model == ElasticModel::Corotational);
 }
 
 double kinetic_energy(const FemModel& m, const Vec3List& v) {

@@ -76,6 +76,8 @@ double mass_dot(const FemModel& m, const Vec3List& v, const Vec3List& w);
 
 // Strain energy at x; co-rotational uses each element's own rotation of x, linear R = I.
 double elastic_energy(const FemModel& m, const Vec3List& x, bool corotational);
+// Strain energy at x of the given model (neo-Hookean: fem/neo_hookean.hpp).
+double elastic_energy(const FemModel& m, const Vec3List& x, ElasticModel model);
 double kinetic_energy(const FemModel& m, const Vec3List& v);
 
 }  // namespace mica

@@ -29,6 +29,11 @@ BodyState::BodyState(const BodyModel& model) {
 BodyScratch::BodyScratch(const BodyModel& model) {
   const size_t n = model.fem.rest.size();
   own_R.assign(model.fem.elements.size(), Mat3::Identity());
+  if (model.settings.neo_hookean()) {
+    neo_hookean.resize(model.fem.elements.size());
+    relin.x_lin.resize(n);
+    relin.v_lin.resize(n);
+  }
   next_end.R.assign(model.fem.elements.size(), Mat3::Identity());
   A.assign(model.fem.pattern.block_count(), Mat3::Zero());
   for (Vec3List* w : {&f_int, &f_ext, &b, &v_next, &x_next, &contact_impulse}) w->assign(n, Vec3::Zero());

@@ -13,6 +13,7 @@
 #include "collision/pseudo_normals.hpp"
 #include "core/colouring.hpp"
 #include "fem/fem_model.hpp"
+#include "fem/neo_hookean.hpp"
 #include "fem/rotation_stiffness.hpp"
 #include "solver/projection.hpp"
 #include "solver/velocity_solver.hpp"
@@ -26,7 +27,9 @@ struct BodySettings {
   double rayleigh_alpha = 0;  // 1/s
   double rayleigh_beta = 0;   // s
   MassKind mass = MassKind::Consistent;
-  bool corotational = true;
+  ElasticModel model = ElasticModel::Corotational;
+  bool corotational() const { return model == ElasticModel::Corotational; }
+  bool neo_hookean() const { return model == ElasticModel::NeoHookean; }
   bool is_static = false;
 };
 
@@ -87,9 +90,14 @@ struct BodyScratch {
     std::vector<Mat3> R_start;        // the step's start rotations
     std::vector<TwistModes> modes;    // the linearisation's twist stiffness (empty: none)
     Vec3List v_iter, v_lin, v_best, v_trial, scratch;
+    Vec3List x_lin;                   // neo-Hookean: x + h v_lin, where the step is linearised
+    double round_off = 0;             // J, neo-Hookean: the model error's floor (relinearise.cpp)
     double u_start = 0, k_start = 0;  // J, elastic and kinetic energy at the step's start
     bool u_start_known = false;       // u_start is U(x) (x == the last step's end.x)
   } relin;
+  // Neo-Hookean bodies: the per-element quadratic model the step's system was assembled from (the
+  // re-linearisation's check reads it back).
+  NeoHookeanLinearisation neo_hookean;
   BlockValues A;               // M + h C + h^2 K
   Vec3List f_int, f_ext, b, v_next, x_next;
   Vec3List contact_impulse;    // G^T lambda of the step, N s

@@ -92,13 +92,15 @@ inline void take(ByteReader& in, TetMesh& m) { take(in, m.nodes), take(in, m.tet
 
 inline void put(ByteWriter& out, const BodySettings& s) {
   put(out, s.material), put(out, s.rayleigh_alpha), put(out, s.rayleigh_beta), put(out, int32_t(s.mass));
-  put(out, s.corotational), put(out, s.is_static);
+  put(out, uint8_t(s.model)), put(out, s.is_static);
 }
 inline void take(ByteReader& in, BodySettings& s) {
   int32_t mass = 0;
   take(in, s.material), take(in, s.rayleigh_alpha), take(in, s.rayleigh_beta), take(in, mass);
-  take(in, s.corotational), take(in, s.is_static);
+  uint8_t model = 0;  // 0 linear, 1 co-rotational (the flag before 0.8), 2 neo-Hookean
+  take(in, model), take(in, s.is_static);
   s.mass = MassKind(mass);
+  s.model = model == 2 ? ElasticModel::NeoHookean : model ? ElasticModel::Corotational : ElasticModel::Linear;
 }
 
 inline void put(ByteWriter& out, const LpcSpec& s) {

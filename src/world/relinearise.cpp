@@ -37,11 +37,23 @@
 // first solution that passes the check, or after relinearise_max solves with the one that gained
 // the least, so the kept velocities, impulses, A and b always belong to one solve (the LPC
 // reactions and tool forces come from them).
+//
+// Neo-Hookean bodies (fem/neo_hookean.hpp) take part in the same iterations. Their force is not
+// affine in y, so each solve is a Newton step on phi with the body's own energy U: linearised at
+// x_k = x + h v_k with the projected Hessian H_k, f(x_k) - H_k (y - x_k) is the assembly at x_k
+// plus h H_k v_k in f_int; the first iterate is the explicit predictor v_0 = v (World::prepare_step),
+// which took the nidus press from 1.54 to 1.44 solves per step against linearising at x. Their check is the model's error at the solution: the quadratic model
+// U_L the solve minimised, evaluated at x+, against U(x+); |U(x+) - U_L(x+)| <= tol times the
+// body's energy. It vanishes as the iterates converge (cubically in the step length) and is
+// small for a first solve whose strain changes little in the step. A step with neo-Hookean bodies
+// whose solves all miss the check keeps the best one and reports itself not converged
+// (WorldStats::converged; mica_step returns MICA_WARN_NOT_CONVERGED).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 
 #include "fem/linearisation.hpp"
+#include "fem/neo_hookean.hpp"
 #include "world/world.hpp"
 
 namespace mica {
@@ -57,6 +69,8 @@ struct Eval {
   double growth = 0;  // J gained beyond the work done on the bodies
   double scale = 0;   // J, the bodies' energy
   double phi = 0;     // J, the incremental potential (all dynamic bodies)
+  double model_error = 0, model_scale = 0;  // J, neo-Hookean bodies: |U(x+) - U_L(x+)| and their energy
+  double model_floor = 0;                   // J, the round-off of model_error
 };
 
 // The step's end positions x + h v (next_end.x; its rotations are the caller's to compute).
@@ -90,7 +104,7 @@ Eval evaluate(Body& b, const Vec3List& v, double h, const BodyTerms& d, const st
   const FemModel& m = b.fem;
   end_state(b, v, h);
   const LinearisationEnergies u =
-      linearisation_energies(m, b.x, b.next_end.x, v, b.settings.corotational ? &b.rotations() : nullptr, b.next_end.R, &R_start,
+      linearisation_energies(m, b.x, b.next_end.x, v, b.settings.corotational() ? &b.rotations() : nullptr, b.next_end.R, &R_start,
                              d.beta != 0, b.relin.modes, b.relin.v_lin);
   // The linearisation is backward Euler on U_L(y) = U_R(y) + (y - x_lin)^T G (y - x_lin) / 2.
   const double U1 = u.u_end, UL1 = u.u_lin_end + 0.5 * h * h * u.gdd, UL0 = u.u_lin_start + 0.5 * h * h * u.gll;
@@ -111,6 +125,44 @@ Eval evaluate(Body& b, const Vec3List& v, double h, const BodyTerms& d, const st
   out.phi = 0.5 * dvMdv + U1 - h * fv + 0.5 * h * (d.alpha * vMv + d.beta * u.vKv_start);
   b.next_end.u = U1;
   return out;
+}
+
+// A neo-Hookean body's velocities v against the quadratic model its system was assembled from
+// (at relin.x_lin). Sets next_end.x and next_end.u.
+Eval evaluate_neo_hookean(Body& b, const Vec3List& v, double h, const BodyTerms& d) {
+  const FemModel& m = b.fem;
+  end_state(b, v, h);
+  const NeoHookeanModelEnergies u =
+      neo_hookean_model_energies(m, b.neo_hookean, b.relin.x_lin, b.next_end.x, &v);
+  Vec3List& dv = b.relin.scratch;
+  dv.resize(v.size());
+  for (size_t i = 0; i < v.size(); ++i) dv[i] = v[i] - b.v[i];
+  const double dvMdv = mass_dot(m, dv, dv), vMv = mass_dot(m, v, v);
+  double fv = 0;
+  if (d.loads)
+    for (size_t i = 0; i < v.size(); ++i) fv += b.f_ext[i].dot(v[i]);
+  Eval out;
+  // The beta part of the damping with the linearisation's H (the co-rotational phi uses the start's K).
+  out.phi = 0.5 * dvMdv + u.u_end - h * fv + 0.5 * h * (d.alpha * vMv + d.beta * u.vKv);
+  out.model_error = std::fabs(u.u_end - u.u_lin_end);
+  out.model_scale = std::max(b.relin.k_start + b.relin.u_start, 0.5 * vMv + u.u_end);
+  out.model_floor = b.relin.round_off;
+  b.next_end.u = u.u_end;
+  return out;
+}
+
+// The first screen of a neo-Hookean body's solution b.v_next (linearised at the predictor x + h v):
+// also fixes the start's energies, U(x) as the last step found it at its end when x is still there.
+Eval screen_neo_hookean(Body& b, double h, const BodyTerms& d) {
+  const double u_start = !b.end.x.empty() && b.end.x == b.x ? b.end.u : neo_hookean_energy(b.fem, b.x);
+  double stiffness = 0;
+  for (size_t e = 0; e < b.fem.elements.size(); ++e)
+    stiffness += (b.fem.lame[e].mu + b.fem.lame[e].lambda) * b.fem.elements[e].volume;
+  b.relin.u_start = u_start;
+  // Energies near rest are differences of terms of order (mu + lambda) V: below this the error is round-off.
+  b.relin.round_off = 1e-12 * stiffness;
+  b.relin.k_start = 0.5 * mass_dot(b.fem, b.v, b.v);
+  return evaluate_neo_hookean(b, b.v_next, h, d);
 }
 
 // The linearisation at next_end.x = x + h v_iter (whose rotations b.rotations() are) gains the positive twist
@@ -151,36 +203,58 @@ void World::relinearise(const StepContext& ctx, StageRunner& stage) {
     s.ms_total += ms;
   };
 
+  thread_local std::vector<BodyTerms> terms;  // kept: a step allocates nothing here
+  terms.assign(dynamic.size(), BodyTerms{});
+  for (size_t k = 0; k < dynamic.size(); ++k) {
+    const Body& b = *dynamic[k];
+    if (needs_damping(b)) terms[k] = {b.settings.rayleigh_alpha, b.settings.rayleigh_beta, false};
+    terms[k].loads = needs_loads(b);
+  }
+  auto passes = [&](const Eval& e) {
+    return debt + e.growth <= tol * e.scale && e.model_error <= tol * e.model_scale + e.model_floor;
+  };
   // The screen: the rotation update U(x+) - U_R(x+) bounds the growth from above.
   Eval cur;
+  bool neo_hookean = false;
   time_rotations([&] {
-    for (Body* b : dynamic) {
-      if (!b->settings.corotational) continue;
+    for (size_t k = 0; k < dynamic.size(); ++k) {
+      Body* b = dynamic[k];
+      if (b->settings.neo_hookean()) {
+        neo_hookean = true;
+        const Eval e = screen_neo_hookean(*b, h, terms[k]);
+        cur.model_error += e.model_error;
+        cur.model_scale += e.model_scale;
+        cur.model_floor += e.model_floor;
+      }
+      if (!b->settings.corotational()) continue;
       b->relin.modes.clear();
       const Eval e = screen(*b, h);
       cur.growth += e.growth;
       cur.scale += e.scale;
     }
   });
-  if (debt + cur.growth <= tol * cur.scale) {
+  if (passes(cur)) {
     settle(cur.growth);
     return;
   }
 
   // The full check, with the step's dissipation.
-  std::vector<BodyTerms> terms(dynamic.size());
-  for (size_t k = 0; k < dynamic.size(); ++k) {
-    const Body& b = *dynamic[k];
-    if (needs_damping(b)) terms[k] = {b.settings.rayleigh_alpha, b.settings.rayleigh_beta, false};
-    terms[k].loads = needs_loads(b);
-  }
   auto evaluate_all = [&](bool trial) {  // v_next, or the line search's trial velocities
     Eval sum;
     for (size_t k = 0; k < dynamic.size(); ++k) {
       Body& b = *dynamic[k];
-      const Eval e = evaluate(b, trial ? b.relin.v_trial : b.v_next, h, terms[k], b.relin.R_start);
+      const Vec3List& v = trial ? b.relin.v_trial : b.v_next;
+      if (b.settings.neo_hookean()) {
+        const Eval e = evaluate_neo_hookean(b, v, h, terms[k]);
+        sum.phi += e.phi;
+        sum.model_error += e.model_error;
+        sum.model_scale += e.model_scale;
+        sum.model_floor += e.model_floor;
+        continue;
+      }
+      const Eval e = evaluate(b, v, h, terms[k], b.relin.R_start);
       sum.phi += e.phi;
-      if (!b.settings.corotational) continue;
+      if (!b.settings.corotational()) continue;
       sum.growth += e.growth;
       sum.scale += e.scale;
     }
@@ -191,7 +265,6 @@ void World::relinearise(const StepContext& ctx, StageRunner& stage) {
     b->relin.modes.clear();
   }
   time_rotations([&] { cur = evaluate_all(false); });
-  auto passes = [&](const Eval& e) { return debt + e.growth <= tol * e.scale; };
   if (passes(cur)) {
     settle(cur.growth);
     return;
@@ -201,22 +274,28 @@ void World::relinearise(const StepContext& ctx, StageRunner& stage) {
   // the last evaluation was of the iterate) or at the step's start, and solve.
   auto linearise_and_solve = [&](bool at_start) {
     for (Body* b : dynamic) {
-      if (!b->settings.corotational) continue;
+      if (b->settings.neo_hookean()) {  // linearised at x + h v_iter (at the start: the predictor v)
+        b->relin.v_lin = at_start ? b->v : b->relin.v_iter;
+        for (size_t i = 0; i < b->x.size(); ++i) b->relin.x_lin[i] = b->x[i] + h * b->relin.v_lin[i];
+        continue;
+      }
+      if (!b->settings.corotational()) continue;
       b->own_R = at_start ? b->relin.R_start : b->next_end.R;
       b->rotations_in = Body::RotationsIn::Own;
       b->relin.modes.clear();
     }
+    auto relinearised = [](const Body* b) { return b->settings.corotational() || b->settings.neo_hookean(); };
     stage.run(Stage::Elements, true, [&] {
       for (Body* b : dynamic) {
-        if (!b->settings.corotational) continue;  // the others' A and forces do not change
+        if (!relinearised(b)) continue;  // the others' A and forces do not change
         assemble_elements(ctx, *b);
-        if (!at_start) add_twist_stiffness(*b, h);
+        if (!at_start && b->settings.corotational()) add_twist_stiffness(*b, h);
       }
     });
     stage.run(Stage::Damping, std::any_of(dynamic.begin(), dynamic.end(), [&](Body* b) { return needs_damping(*b); }),
               [&] {
                 for (Body* b : dynamic)
-                  if (b->settings.corotational && needs_damping(*b)) add_damping(ctx, *b);
+                  if (relinearised(b) && needs_damping(*b)) add_damping(ctx, *b);
               });
     // The statistics report the solve whose solution the step keeps; iterations add up.
     next_.stats.solver_residual = 0;
@@ -224,7 +303,8 @@ void World::relinearise(const StepContext& ctx, StageRunner& stage) {
     stage.run(Stage::Solve, true, [&] { solve(ctx); });
   };
   for (Body* b : dynamic) b->relin.v_iter = b->v_next;
-  double phi_iter = cur.phi, best = cur.growth;
+  // The best solve gained the least (co-rotational) and missed its model the least (neo-Hookean).
+  double phi_iter = cur.phi, best = cur.growth + cur.model_error;
   int32_t best_solve = 1, solves = 1;
   bool solution_evaluated = true;  // the last evaluation was of v_next
   while (solves < max_solves) {
@@ -236,8 +316,8 @@ void World::relinearise(const StepContext& ctx, StageRunner& stage) {
       settle(cur.growth);
       return;
     }
-    if (cur.growth < best) {
-      best = cur.growth;
+    if (cur.growth + cur.model_error < best) {
+      best = cur.growth + cur.model_error;
       best_solve = solves;
       for (Body* b : dynamic) b->relin.v_best = b->relin.v_iter;  // the linearisation point
     }
@@ -274,7 +354,7 @@ void World::relinearise(const StepContext& ctx, StageRunner& stage) {
       for (Body* b : dynamic) {
         b->relin.v_iter = b->relin.v_best;
         end_state(*b, b->relin.v_iter, h);
-        if (b->settings.corotational) {
+        if (b->settings.corotational()) {
           compute_rotations(b->fem, b->next_end.x, b->next_end.R, ctx.pool);
         }
       }
@@ -284,6 +364,9 @@ void World::relinearise(const StepContext& ctx, StageRunner& stage) {
   }
   // Whatever is kept, next_end must be of its end positions (the next step's start).
   if (!solution_evaluated) time_rotations([&] { cur = evaluate_all(false); });
+  // Neo-Hookean bodies: the step did not converge to its tolerance (co-rotational bodies keep their
+  // best solve silently, with its growth in the debt).
+  if (neo_hookean && !passes(cur)) next_.stats.converged = false;
   settle(cur.growth);
 }
 

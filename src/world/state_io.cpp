@@ -54,7 +54,7 @@ constexpr size_t kHeaderSize = sizeof(Header);
 struct StateShape {
   struct BodyShape {
     int32_t nodes, tets;
-    uint8_t is_static, corotational;
+    uint8_t is_static, model;  // ElasticModel (0 and 1: the co-rotational flag before 0.8)
     uint8_t unused[2] = {};
   };
   std::vector<BodyShape> bodies;
@@ -101,8 +101,8 @@ std::string shape_difference(const Shape& saved, const Shape& here) {
       return refuse + "its body " + std::to_string(k) + " (in creation order) has " + std::to_string(a.nodes) +
              " nodes and " + std::to_string(a.tets) + " tets, this world's " + std::to_string(b.nodes) + " and " +
              std::to_string(b.tets);
-    if (a.is_static != b.is_static || a.corotational != b.corotational)
-      return refuse + "its body " + std::to_string(k) + " is of another kind (static or dynamic, co-rotational or linear)";
+    if (a.is_static != b.is_static || a.model != b.model)
+      return refuse + "its body " + std::to_string(k) + " is of another kind (static or dynamic, co-rotational, linear or neo-Hookean)";
   }
   if (saved.tools != here.tools)
     return refuse + "it has " + count_text(saved.tools.size(), "tool", "tools") + ", this world " +
@@ -280,7 +280,7 @@ void World::state_shape(StateShape& s) const {
   bodies_.for_each([&](Id id, const Body& b) {
     body_ids.push_back(id);
     s.bodies.push_back({b.fem.node_count(), int32_t(b.tets.size()), uint8_t(b.settings.is_static),
-                        uint8_t(b.settings.corotational)});
+                        uint8_t(b.settings.model)});
   });
   tools_.for_each([&](Id, const Tool& t) { s.tools.push_back(int32_t(t.shape)); });
   lpcs_.for_each([&](Id, const Lpc& c) {

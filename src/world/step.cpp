@@ -36,7 +36,8 @@ Plan World::plan() const {
     if (!b.is_dynamic()) return;
     p.elements = p.solve = p.integrate = true;
     p.loads = p.loads || needs_loads(b);
-    p.rotations = p.rotations || b.settings.corotational;
+    p.rotations = p.rotations || b.settings.corotational();
+    p.newton = p.newton || b.settings.corotational() || b.settings.neo_hookean();
     p.damping = p.damping || needs_damping(b);
   });
   lpcs_.for_each([&](Id, const Lpc& c) { p.constraints = p.constraints || bodies_.get(c.body, "body").is_dynamic(); });
@@ -110,6 +111,11 @@ void World::prepare_step(double h) {
   bodies_.for_each([&](Id id, Body& b) {
     b.step_index = b.is_dynamic() ? int32_t(ctx.dynamic.size()) : -1;
     if (!b.is_dynamic()) return;
+    if (b.settings.neo_hookean()) {
+      // The first Newton iterate is the explicit predictor v: the step linearises at x + h v.
+      b.relin.v_lin = b.v;
+      for (size_t i = 0; i < b.x.size(); ++i) b.relin.x_lin[i] = b.x[i] + h * b.v[i];
+    }
     ctx.dynamic.push_back(&b);
     next_.bodies.push_back(id);
   });
@@ -138,7 +144,7 @@ void World::advance(double h) {
   });
   stage.run(Stage::Rotations, plan.rotations, [&] {
     for (Body* b : ctx.dynamic)
-      if (b->settings.corotational) start_rotations(ctx, *b);
+      if (b->settings.corotational()) start_rotations(ctx, *b);
   });
   stage.run(Stage::Elements, plan.elements, [&] {
     for (Body* b : ctx.dynamic) assemble_elements(ctx, *b);
@@ -152,7 +158,7 @@ void World::advance(double h) {
   });
   const int64_t factored_before = factorizations(ctx);
   stage.run(Stage::Solve, plan.solve, [&] { solve(ctx); });
-  if (plan.rotations && plan.solve) relinearise(ctx, stage);
+  if (plan.newton && plan.solve) relinearise(ctx, stage);
   stats.factorizations = int32_t(factorizations(ctx) - factored_before);
   stage.run(Stage::Integrate, plan.integrate, [&] {
     for (Body* b : ctx.dynamic)
@@ -232,14 +238,35 @@ void World::assemble_elements(const StepContext& ctx, Body& b) const {
   const double beta = damping ? b.settings.rayleigh_beta : 0.0;
   const double alpha = damping ? b.settings.rayleigh_alpha : 0.0;
   const SystemKey key{h, alpha, beta};
+  if (b.settings.neo_hookean()) {
+    // The projected Hessian at the linearisation point, the Newton iterate x_lin = x + h v_lin, with
+    // f_int = f(x_lin) + h H v_lin (relinearise.cpp). Its SVDs give the rotations the factored
+    // sweep warps its lagged factor with.
+    set_scaled_mass(b.fem, 1.0, b.A, ctx.pool);
+    NeoHookeanAssembly what;
+    what.k_scale = h * h + h * beta;
+    what.K = &b.A;
+    what.R = &b.own_R;
+    what.lin = &b.neo_hookean;
+    what.v_lin = &b.relin.v_lin;
+    what.h = h;
+    assemble_neo_hookean(b.fem, b.relin.x_lin, what, b.f_int, &b.element_colours, ctx.pool);
+    b.rotations_in = Body::RotationsIn::Own;
+    b.matrix_key = key;
+    b.matrix_current = false;
+    ++b.matrix_version;
+    b.matrix_rebuilt = true;
+    add_contact_stiffness(ctx, b);
+    return;
+  }
   // A linear body keeps A while h and the damping stay: only its forces are recomputed.
-  const bool rebuild = b.settings.corotational || !b.matrix_current || !(key == b.matrix_key);
-  const std::vector<Mat3>* R = b.settings.corotational ? &b.rotations() : nullptr;
+  const bool rebuild = b.settings.corotational() || !b.matrix_current || !(key == b.matrix_key);
+  const std::vector<Mat3>* R = b.settings.corotational() ? &b.rotations() : nullptr;
   if (rebuild) set_scaled_mass(b.fem, 1.0, b.A, ctx.pool);
   assemble_elastic(b.fem, b.x, R, h * h + h * beta, rebuild ? &b.A : nullptr, b.f_int, &b.element_colours, ctx.pool);
   if (rebuild) {
     b.matrix_key = key;
-    b.matrix_current = !b.settings.corotational;
+    b.matrix_current = !b.settings.corotational();
     ++b.matrix_version;
   }
   b.matrix_rebuilt = rebuild;
@@ -374,7 +401,9 @@ void World::solve(const StepContext& ctx) {
     sb.v = &b.v_next;
     sb.contact_impulse = &b.contact_impulse;
     sb.colours = ctx.pool && !b.node_colours.empty() ? &b.node_colours : nullptr;
-    sb.rotation = b.settings.corotational ? &b.rotations() : nullptr;
+    // Neo-Hookean bodies too: their rotations warp the factored sweep's lagged factor, and mark A as
+    // changing from step to step (its factor is refreshed every refactor_interval solves).
+    sb.rotation = b.settings.corotational() || b.settings.neo_hookean() ? &b.rotations() : nullptr;
     sb.extra_stiffness = &b.curvature_stiffness;
     sb.system = b.matrix_key;
     sb.matrix_version = b.matrix_version;

@@ -17,6 +17,7 @@ struct Plan {
   bool loads = false, rotations = false, elements = false, damping = false;
   bool constraints = false, solve = false, integrate = false;
   bool collide = false, forces = false;
+  bool newton = false;  // a body's step may be re-linearised (co-rotational, neo-Hookean): relinearise.cpp
 };
 
 struct StepContext : SolveContext {

@@ -516,9 +516,9 @@ static void test_free_fall(void** state) {
   const int steps = 10;
   const double drop = g * h * h * steps * (steps + 1) / 2.0;
   const double speed = g * steps * h;
-  const int32_t models[2] = {MICA_MODEL_COROTATIONAL, MICA_MODEL_LINEAR};
+  const int32_t models[3] = {MICA_MODEL_COROTATIONAL, MICA_MODEL_LINEAR, MICA_MODEL_NEO_HOOKEAN};
   const int32_t masses[2] = {MICA_MASS_CONSISTENT, MICA_MASS_LUMPED};
-  for (int m = 0; m < 2; ++m)
+  for (int m = 0; m < 3; ++m)
     for (int k = 0; k < 2; ++k)
       for (int32_t tpc = 5; tpc <= 6; ++tpc) {
         mica_world* w = make_world(0, 0, g, MICA_SOLVER_DIRECT);

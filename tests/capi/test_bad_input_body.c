@@ -296,7 +296,7 @@ static void beta_negative(mica_body_def* d, int i) {
   (void)i;
   d->rayleigh_beta = -1e-3;
 }
-static const int32_t kBadModel[] = {7, -1, 2};
+static const int32_t kBadModel[] = {7, -1, 3}; /* 2 is MICA_MODEL_NEO_HOOKEAN since 0.8 */
 static void model(mica_body_def* d, int i) { d->model = kBadModel[i]; }
 static const int32_t kBadMass[] = {-1, 2, 100};
 static void mass(mica_body_def* d, int i) { d->mass = kBadMass[i]; }

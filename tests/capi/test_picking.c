@@ -16,6 +16,9 @@ typedef struct {
   int32_t nodes;
 } scene;
 
+/* The body's model: co-rotational, or neo-Hookean for the _neo_hookean variants. */
+static int32_t g_model = MICA_MODEL_COROTATIONAL;
+
 /* A 0.1 m soft cube fixed at y = 0, no gravity, MICA solver. */
 static scene make_scene(void) {
   scene s = {NULL, 0, 0};
@@ -28,6 +31,7 @@ static scene make_scene(void) {
   assert_int_equal(mica_world_create(&wd, &s.world), MICA_OK);
   mica_body_def bd = mica_body_def_default();
   bd.youngs_modulus = 2e4;
+  bd.model = g_model;
   const double lo[3] = {0, 0, 0}, hi[3] = {0.1, 0.1, 0.1};
   const int32_t cells[3] = {4, 4, 4};
   assert_int_equal(mica_body_create_box(s.world, &bd, lo, hi, cells, 6, &s.body), MICA_OK);
@@ -83,6 +87,13 @@ static void test_grab_drag_release(void** state) {
   position_of(&s, held[0], x);
   assert_true(x[0] < start[0][0] + 0.01 - 1e-4); /* released: it moved back toward rest */
   mica_world_destroy(s.world);
+}
+
+/* The same grasp on a neo-Hookean body (MICA_MODEL_NEO_HOOKEAN). */
+static void test_grab_drag_release_neo_hookean(void** state) {
+  g_model = MICA_MODEL_NEO_HOOKEAN;
+  test_grab_drag_release(state);
+  g_model = MICA_MODEL_COROTATIONAL;
 }
 
 /* A grab that follows a tool (forceps): moving the tool carries the held nodes; a rotation of
@@ -150,6 +161,7 @@ static void test_targets_and_velocity(void** state) {
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_grab_drag_release),
+      cmocka_unit_test(test_grab_drag_release_neo_hookean),
       cmocka_unit_test(test_grab_follows_tool),
       cmocka_unit_test(test_targets_and_velocity),
   };

@@ -34,6 +34,9 @@ static const solver_case kCases[] = {
     {"MICA factored, linear", MICA_SOLVER_MICA, MICA_SWEEP_FACTORED, MICA_MODEL_LINEAR, 0},
     {"exact, linear", MICA_SOLVER_DIRECT, MICA_SWEEP_FACTORED, MICA_MODEL_LINEAR, 0},
     {"MICA factored, two bodies", MICA_SOLVER_MICA, MICA_SWEEP_FACTORED, MICA_MODEL_COROTATIONAL, 1},
+    {"MICA factored, neo-Hookean", MICA_SOLVER_MICA, MICA_SWEEP_FACTORED, MICA_MODEL_NEO_HOOKEAN, 0},
+    {"MICA Gauss-Seidel, neo-Hookean", MICA_SOLVER_MICA, MICA_SWEEP_GAUSS_SEIDEL, MICA_MODEL_NEO_HOOKEAN, 0},
+    {"exact, neo-Hookean", MICA_SOLVER_DIRECT, MICA_SWEEP_FACTORED, MICA_MODEL_NEO_HOOKEAN, 0},
 };
 
 typedef struct scene {

@@ -53,7 +53,7 @@ Slide slide(const SolverCase& solver, double theta, double phi) {
   BodySettings bs;
   bs.material = {1e9, 0.3, 1000};
   bs.mass = MassKind::Lumped;
-  bs.corotational = false;
+  bs.model = ElasticModel::Linear;
   const Id body = world.add_body(make_box_grid(Vec3(-0.01, -0.01, 0), Vec3(0.01, 0.01, 0.02), {1, 1, 1}, 6), bs,
                                  Vec3::Zero(), Vec3::Zero());
   const Vec3 n(0, 0, 1), t1 = n.unitOrthogonal(), t2 = n.cross(t1);  // the rows' tangents (contact_rows.cpp)

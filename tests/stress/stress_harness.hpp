@@ -151,7 +151,7 @@ struct Energy {
 inline Energy body_energy(const Body& b, const Vec3& g) {
   Energy e;
   e.kinetic = kinetic_energy(b.fem, b.v);
-  e.elastic = elastic_energy(b.fem, b.x, b.settings.corotational);
+  e.elastic = elastic_energy(b.fem, b.x, b.settings.model);
   for (size_t i = 0; i < b.x.size(); ++i) e.potential -= b.fem.node_mass[i] * g.dot(b.x[i]);
   return e;
 }
@@ -477,7 +477,7 @@ class Monitor {
       kin_el += en.kinetic + en.elastic;
       pe += en.potential;
       e += en.total();
-      if (b.settings.corotational) {
+      if (b.settings.corotational()) {
         double frozen = 0;
         for (size_t q = 0; q < b.fem.elements.size(); ++q) {
           const TetElement& el = b.fem.elements[q];

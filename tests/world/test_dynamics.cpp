@@ -17,7 +17,7 @@ std::vector<int32_t> nodes_where(const Body& b, double (*coord)(const Vec3&), do
 double x_of(const Vec3& p) { return p.x(); }
 
 double total_energy(const Body& b) {
-  return kinetic_energy(b.fem, b.v) + elastic_energy(b.fem, b.x, b.settings.corotational);
+  return kinetic_energy(b.fem, b.v) + elastic_energy(b.fem, b.x, b.settings.model);
 }
 
 }  // namespace
@@ -33,7 +33,7 @@ static double cantilever_ratio(int32_t nx, int32_t nyz) {
   World world(ws);
   BodySettings bs;
   bs.material = {E, 0.3, 100};
-  bs.corotational = false;
+  bs.model = ElasticModel::Linear;
   const Id id = world.add_body(make_box_grid(Vec3(0, 0, 0), Vec3(L, H, H), {nx, nyz, nyz}, 5), bs, Vec3::Zero(),
                                Vec3::Zero());
   Body& beam = world.body(id);
@@ -69,7 +69,7 @@ static double run_plucked_beam(bool corotational, double alpha, std::vector<doub
   World world(ws);
   BodySettings bs;
   bs.material = {1e7, 0.3, 1000};  // first bending mode ~10 rad/s
-  bs.corotational = corotational;
+  bs.model = corotational ? ElasticModel::Corotational : ElasticModel::Linear;
   bs.rayleigh_alpha = alpha;
   const Id id = world.add_body(make_box_grid(Vec3(0, 0, 0), Vec3(1, 0.1, 0.1), {20, 2, 2}, 6), bs, Vec3::Zero(),
                                Vec3::Zero());
@@ -119,7 +119,7 @@ static void test_free_fall(void**) {
     ws.gravity = Vec3(0, 0, -9.81);
     World world(ws);
     BodySettings bs;
-    bs.corotational = corot;
+    bs.model = corot ? ElasticModel::Corotational : ElasticModel::Linear;
     const Id id = world.add_body(make_box_grid(Vec3(0, 0, 0), Vec3(0.2, 0.1, 0.1), {4, 2, 2}, 5), bs, Vec3::Zero(),
                                  Vec3::Zero());
     const int n = 100;

@@ -17,7 +17,7 @@ struct Scene {
 void build(Scene& s, bool corotational) {
   BodySettings bs;
   bs.material = {5e4, 0.35, 1000};
-  bs.corotational = corotational;
+  bs.model = corotational ? ElasticModel::Corotational : ElasticModel::Linear;
   s.body = s.world.add_body(make_box_grid(Vec3(0, 0, 0), Vec3(0.4, 0.2, 0.2), {6, 3, 3}, 6), bs, Vec3::Zero(),
                             Vec3::Zero());
   Body& b = s.world.body(s.body);

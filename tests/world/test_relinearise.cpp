@@ -82,7 +82,7 @@ struct Cantilever {
 void build_cantilever(Cantilever& c, bool corotational = true) {
   BodySettings bs;
   bs.material = {1e7, 0.3, 100};
-  bs.corotational = corotational;
+  bs.model = corotational ? ElasticModel::Corotational : ElasticModel::Linear;
   c.body = c.world.add_body(make_box_grid(Vec3(0, 0, 0), Vec3(1, 0.1, 0.1), {20, 2, 2}, 5), bs, Vec3::Zero(),
                             Vec3::Zero());
   const Body& b = c.world.body(c.body);

@@ -58,6 +58,7 @@ namespace LibMica
 
         public const int MICA_MODEL_COROTATIONAL = 0;
         public const int MICA_MODEL_LINEAR = 1;
+        public const int MICA_MODEL_NEO_HOOKEAN = 2; // since 0.8
         public const int MICA_MASS_CONSISTENT = 0;
         public const int MICA_MASS_LUMPED = 1;
 
