@@ -492,6 +492,7 @@ class Program {
         break;
       case 20: case 21: poll(); break;
       case 22: readers(); break;
+      case 23: cut(); break;
       case 24: remove_tets(); break;
       default: select(); break;
     }
@@ -600,6 +601,20 @@ class Program {
     double mass = 0;
     both("mica_body_remove_tets", [&](mica_world* w, int) {
       return mica_body_remove_tets(w, body, null_tets ? nullptr : tets, n > 6 ? 6 : n, null_mass ? nullptr : &mass);
+    });
+  }
+
+  // Incision: one or two triangles, mostly across a box of a few centimetres, sometimes absurd.
+  void cut() {
+    const uint64_t body = pick_id(pools_.bodies);
+    const int32_t n = in_.count(2);
+    double t[18];
+    for (double& v : t) v = in_.u8() < 230 ? 0.005 * double(in_.u8() % 9) - 0.005 : in_.d();
+    const bool null_triangles = in_.u8() > 250, null_out = in_.coin();
+    int32_t faces = 0, added = 0;
+    both("mica_body_cut", [&](mica_world* w, int) {
+      return mica_body_cut(w, body, null_triangles ? nullptr : t, n > 2 ? 2 : n, null_out ? nullptr : &faces,
+                           null_out ? nullptr : &added);
     });
   }
 

@@ -9,6 +9,8 @@
 #   2. cantilever_sag: a block clamped at one end sags under its own weight.
 #   3. haptic_loop: a 60 Hz simulation thread and a 1 kHz servo thread.
 #   4. nidus_press: the nidus (a lesion-like blob) pressed by a forceps tip, drawn as it is at the end.
+#   5. incision: a blade cuts 3 cm into the cube while a hook draws one side back; the blade force
+#      along the cut and the opened cut.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 out="$root/out/demo"
@@ -33,9 +35,14 @@ mkdir -p "$out"
   --vtk "$out/nidus_press.vtk" --elev 45 --azim -60 \
   --title "A forceps tip presses the nidus, held by its lowest fifth (libmica, MICA solver)"
 
+"$root/build/examples_c/incision" "$out"
+/usr/bin/python3 "$root/scripts/plot_incision.py" "$out/incision.csv" "$out/incision.vtk" "$out/incision.png" \
+  --title "A blade cuts 3 cm into a soft cube while a hook draws one side back (libmica)"
+
 echo "demo: pictures in $out"
 echo "  sphere_indent.png  (tool force over time and against depth; sphere_indent_*.vtk open in ParaView)"
 echo "  cantilever.png     (tip deflection against Euler-Bernoulli; cantilever_*.vtk open in ParaView)"
 echo "  haptic_loop.png    (raw and rendered device force at 1 kHz over a press and release)"
 echo "  sphere_indent_tissue.png  (the cube at the sphere's deepest, cut through it, von Mises stress)"
 echo "  nidus_press.png    (the nidus under the forceps tip, von Mises stress; nidus_press.vtk opens in ParaView)"
+echo "  incision.png       (the blade force along a 3 cm incision, and the opened cut; incision.vtk opens in ParaView)"

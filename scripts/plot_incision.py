@@ -86,7 +86,7 @@ def main():
     half = np.array([0.5 * np.ptp(tip[:, 0]) + 0.01, 0.012, 0.015])
     window = (middle - half, middle + np.array([half[0], 0.01, half[2]]))
     ax3 = fig.add_subplot(grid[1], projection="3d")
-    draw_cut(ax3, fig.add_subplot(grid[2]), nodes, tets, von_mises, window, elev=50, azim=-65)
+    draw_cut(ax3, fig.add_subplot(grid[2]), nodes, tets, von_mises, window, elev=62, azim=-75)
     if args.title:
         fig.suptitle(args.title)
     fig.savefig(args.png, dpi=110, bbox_inches="tight")

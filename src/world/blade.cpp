@@ -4,8 +4,9 @@
 // scalpel's. After a step, where the force a blade put on a body along its local x exceeds the
 // body's cutting resistance (N per m of edge, per tet; Okamura, Simone and O'Leary 2004's cutting
 // force per unit length) times the length of edge in the tissue, the body is cut in the blade's
-// plane from the edge to one surface edge ahead of it, or as far as it takes (up to three) to
-// part a node (World::cut_body): the tissue resists, then gives. The decision reads only the step's results, so a replayed step cuts
+// plane, along the part of the edge that touches it, from the edge to one surface edge ahead of
+// it, or as far as it takes (up to three) to part a node (World::cut_body): the tissue resists,
+// then gives. The decision reads only the step's results, so a replayed step cuts
 // where the recorded one did.
 #include <algorithm>
 #include <cmath>
@@ -69,8 +70,10 @@ void World::cut_with_blades(const StepContext& ctx) {
       // The edge in the tissue: the contacts' extent along it, at least one surface edge.
       const double edge = std::min(std::max(p.hi - p.lo, b.surface_edge), 2 * t.half_length);
       if (!(std::abs(along) > p.resistance / p.contacts * edge)) continue;
-      cuts.push_back({last_.bodies[i], t.position - axis * t.half_length, t.position + axis * t.half_length,
-                      along > 0 ? blade : Vec3(-blade), t.radius, b.surface_edge});
+      // The part of the edge that touches the tissue, and a surface edge either side, cuts.
+      const double from = std::max(p.lo - b.surface_edge, -t.half_length), to = std::min(p.hi + b.surface_edge, t.half_length);
+      cuts.push_back({last_.bodies[i], t.position + axis * from, t.position + axis * to, along > 0 ? blade : Vec3(-blade),
+                      t.radius, b.surface_edge});
     }
   }
   // The cut reaches one surface edge ahead of the edge, or, where the tissue is wedged open ahead
