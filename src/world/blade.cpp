@@ -48,7 +48,8 @@ void World::cut_with_blades(const StepContext& ctx) {
     const Tool& t = *ctx.tools[k];
     if (!t.blade) continue;
     const Vec3 axis = t.orientation * Vec3::UnitZ(), blade = t.orientation * Vec3::UnitX();
-    std::vector<BladePress> press(ctx.dynamic.size());
+    thread_local std::vector<BladePress> press;  // kept: a step that cuts nothing allocates nothing here
+    press.assign(ctx.dynamic.size(), BladePress{});
     for (size_t r = 0; r < rows.size(); ++r) {
       const Contact& c = last_.contacts[size_t(rows.contact[r])];
       if (c.tool != int32_t(k) || rows.normal_of[r] >= 0 || !(last_.lambda[r] > 0)) continue;
