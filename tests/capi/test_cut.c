@@ -204,35 +204,12 @@ static void check_cut_steps_as_fresh(int32_t solver, int32_t threads) {
   OK(a, cut_at(a, cut, 0.062, 1, NULL, NULL));
 
   mica_world* b = make_world(solver, threads);
-  mesh m = get_mesh(a, cut);
   mica_body_def bd = mica_body_def_default();
   bd.youngs_modulus = 1e5;
   bd.rayleigh_beta = 0.1;
-  mica_body_id fresh = 0;
-  OK(b, mica_body_create(b, &bd, m.rest, m.nodes, m.tet, m.tets, &fresh));
-  int32_t n = 0;
-  double* x = get_positions(a, cut, &n);
-  double* v = malloc(sizeof(double) * 3 * (size_t)n);
-  OK(a, mica_body_get_velocities(a, cut, v, n, NULL));
-  OK(b, mica_body_set_positions(b, fresh, x, n));
-  OK(b, mica_body_set_velocities(b, fresh, v, n));
-  int32_t nodes[64], held = 0;
-  OK(a, mica_lpc_get_nodes(a, fixed, nodes, 64, &held));
-  const mica_lpc_def def = mica_lpc_def_default();
-  mica_lpc_id again = 0;
-  OK(b, mica_add_lpc(b, fresh, nodes, held, &def, &again));
-
-  step_n(a, 1);
-  step_n(b, 1);
-  int32_t na = 0, nb = 0;
-  double* xa = get_positions(a, cut, &na);
-  double* xb = get_positions(b, fresh, &nb);
-  assert_int_equal(na, nb);
-  double worst = 0;
-  for (int32_t i = 0; i < 3 * na; ++i) worst = fmax(worst, fabs(xa[i] - xb[i]) / L);
+  int32_t held = 0;
+  const double worst = step_against_fresh(a, cut, fixed, b, &bd, 0.01, L, &held);
   if (worst > 1e-9) fail_msg("solver %d, %d threads: the cut body differs from a fresh one by %g (relative)", solver, threads, worst);
-  free(xa), free(xb), free(x), free(v);
-  free_mesh(&m);
   mica_world_destroy(a);
   mica_world_destroy(b);
 }

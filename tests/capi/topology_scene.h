@@ -96,4 +96,38 @@ static inline int32_t find_pieces(const mesh* m, int32_t* piece) {
   return count;
 }
 
+/* A changed body against a fresh one: makes, in world b (as world a was made), a body of `bd` from
+ * the exported mesh of a's `body`, with its positions and velocities and the nodes of a's `fixed`
+ * group fixed (their count in *held), steps both worlds once by `dt` and returns the largest
+ * difference of their positions over `scale`: 0 when nothing the world kept of the old topology
+ * (factors, warm starts, scratch, colourings) is left. */
+static inline double step_against_fresh(mica_world* a, mica_body_id body, mica_lpc_id fixed, mica_world* b,
+                                        const mica_body_def* bd, double dt, double scale, int32_t* held) {
+  mesh m = get_mesh(a, body);
+  mica_body_id fresh = 0;
+  OK(b, mica_body_create(b, bd, m.rest, m.nodes, m.tet, m.tets, &fresh));
+  int32_t n = 0;
+  double* x = get_positions(a, body, &n);
+  double* v = malloc(sizeof(double) * 3 * (size_t)n);
+  OK(a, mica_body_get_velocities(a, body, v, n, NULL));
+  OK(b, mica_body_set_positions(b, fresh, x, n));
+  OK(b, mica_body_set_velocities(b, fresh, v, n));
+  int32_t nodes[256];
+  OK(a, mica_lpc_get_nodes(a, fixed, nodes, 256, held));
+  const mica_lpc_def def = mica_lpc_def_default();
+  mica_lpc_id again = 0;
+  OK(b, mica_add_lpc(b, fresh, nodes, *held, &def, &again));
+  OK(a, mica_step(a, dt));
+  OK(b, mica_step(b, dt));
+  int32_t na = 0, nb = 0;
+  double* xa = get_positions(a, body, &na);
+  double* xb = get_positions(b, fresh, &nb);
+  assert_int_equal(na, nb);
+  double worst = 0;
+  for (int32_t i = 0; i < 3 * na; ++i) worst = fmax(worst, fabs(xa[i] - xb[i]) / scale);
+  free(xa), free(xb), free(x), free(v);
+  free_mesh(&m);
+  return worst;
+}
+
 #endif
