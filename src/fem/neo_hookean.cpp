@@ -4,9 +4,11 @@
 #include <cmath>
 
 #include <Eigen/Eigenvalues>
-#include <Eigen/SVD>
 
 #include "fem/fem_model.hpp"
+#include "fem/neo_hookean_elements4.hpp"
+#include "fem/neo_hookean_energies4.hpp"
+#include "fem/rotation_variant_svd.hpp"
 
 namespace mica {
 
@@ -30,48 +32,6 @@ Mat3 cofactor(const Mat3& F) {
 }
 
 Vec9 vec(const Mat3& m) { return Eigen::Map<const Vec9>(m.data()); }
-
-// F = U diag(s) V^T with det U det V = 1, so det F = s0 s1 s2 and U V^T is a rotation: an inverted
-// F has s[2] < 0 (Irving et al. 2004).
-#if defined(__GNUC__) && !defined(__clang__)
-#pragma GCC diagnostic push  // GCC 12 sees JacobiSVD's singular values as maybe uninitialised when inlined
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#endif
-void jacobi_svd(const Mat3& F, Mat3& U, Vec3& s, Mat3& V) {
-  Eigen::JacobiSVD<Mat3> svd(F, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  U = svd.matrixU();
-  V = svd.matrixV();
-  s = svd.singularValues();
-  if (U.determinant() * V.determinant() < 0) {
-    U.col(2) = -U.col(2);
-    s(2) = -s(2);
-  }
-}
-#if defined(__GNUC__) && !defined(__clang__)
-#pragma GCC diagnostic pop
-#endif
-
-// The same from the closed-form eigensystem of F^T F (several times faster than Jacobi): V its
-// eigenvectors, u_k = F v_k / s_k for the two largest, u_2 = u_0 x u_1 and s_2 = u_2 . F v_2 (signed).
-// Where F is far from well conditioned (s_1 < 1e-3 s_0: nearly flat or a needle) F^T F has lost the
-// small singular values' digits: Jacobi there.
-void rotation_variant_svd(const Mat3& F, Mat3& U, Vec3& s, Mat3& V) {
-  Eigen::SelfAdjointEigenSolver<Mat3> eig;
-  eig.computeDirect(F.transpose() * F);
-  const Vec3& l = eig.eigenvalues();  // ascending
-  const double s0 = std::sqrt(std::max(l[2], 0.0)), s1 = std::sqrt(std::max(l[1], 0.0));
-  if (!(s1 > 1e-3 * s0)) return jacobi_svd(F, U, s, V);
-  V.col(0) = eig.eigenvectors().col(2);
-  V.col(1) = eig.eigenvectors().col(1);
-  V.col(2) = V.col(0).cross(V.col(1));  // det V = +1
-  U.col(0) = F * V.col(0) / s0;
-  U.col(1) = F * V.col(1) / s1;
-  U.col(1) -= U.col(1).dot(U.col(0)) * U.col(0);  // orthonormal to round-off
-  U.col(1).normalize();
-  U.col(0).normalize();
-  U.col(2) = U.col(0).cross(U.col(1));
-  s = Vec3(s0, s1, U.col(2).dot(F * V.col(2)));
-}
 
 }  // namespace
 
@@ -116,9 +76,16 @@ Mat9 neo_hookean_hessian(const NeoHookean& p, const Mat3& F) {
 }
 
 NeoHookeanFrame neo_hookean_frame(const NeoHookean& p, const Mat3& F) {
-  NeoHookeanFrame f;
+  Mat3 U, V;
   Vec3 s;
-  rotation_variant_svd(F, f.U, s, f.V);
+  rotation_variant_svd(F, U, s, V);
+  return neo_hookean_frame(p, U, s, V);
+}
+
+NeoHookeanFrame neo_hookean_frame(const NeoHookean& p, const Mat3& U, const Vec3& s, const Mat3& V) {
+  NeoHookeanFrame f;
+  f.U = U;
+  f.V = V;
   const double w = p.lambda * (s[0] * s[1] * s[2] - p.alpha);
   // The pairs: twist mu + w s_k and flip mu - w s_k, each clamped at zero, as the 2x2 they make.
   for (int k = 0; k < 3; ++k) {
@@ -184,10 +151,8 @@ void NeoHookeanLinearisation::resize(size_t elements) {
   frame.resize(elements);
 }
 
-namespace {
-
-// One element's share (assemble_neo_hookean).
-void add_element(const FemModel& m, size_t e, const Vec3List& x, const NeoHookeanAssembly& what, Vec3List& f) {
+void add_neo_hookean_element(const FemModel& m, int32_t e, const Vec3List& x, const NeoHookeanAssembly& what,
+                             Vec3List& f) {
   const TetElement& el = m.elements[e];
   const NeoHookean p = neo_hookean_parameters(m.lame[e]);
   const Mat3 F = deformation_gradient(el, x);
@@ -229,15 +194,18 @@ void add_element(const FemModel& m, size_t e, const Vec3List& x, const NeoHookea
     }
 }
 
-}  // namespace
-
 void assemble_neo_hookean(const FemModel& m, const Vec3List& x_lin, const NeoHookeanAssembly& what, Vec3List& f_int,
                           const Colouring* element_colours, ThreadPool* pool) {
   const bool coloured = pool && element_colours && !element_colours->empty();
   for (Vec3& f : f_int) f.setZero();
   if (what.lin) what.lin->resize(m.elements.size());  // sized at the first step: no allocation after
-  auto elements = [&](int32_t first, int32_t last) {
-    for (int32_t e = first; e < last; ++e) add_element(m, size_t(e), x_lin, what, f_int);
+  auto elements = [&](int32_t first, int32_t last) {  // four at a time, then one by one
+    int32_t e = first;
+    for (; e + 3 < last; e += 4) {
+      const int32_t four[4] = {e, e + 1, e + 2, e + 3};
+      add_neo_hookean_elements4(m, four, x_lin, what, f_int);
+    }
+    for (; e < last; ++e) add_neo_hookean_element(m, e, x_lin, what, f_int);
   };
   if (!coloured) {
     elements(0, int32_t(m.elements.size()));
@@ -258,19 +226,24 @@ double neo_hookean_energy(const FemModel& m, const Vec3List& x) {
   return u;
 }
 
+void add_neo_hookean_model_energies(const FemModel& m, int32_t e, const NeoHookeanLinearisation& lin,
+                                    const Vec3List& x_lin, const Vec3List& x_end, const Vec3List* v,
+                                    NeoHookeanModelEnergies& out) {
+  const TetElement& el = m.elements[e];
+  const Mat3 F = deformation_gradient(el, x_end);
+  const Mat3 dF = F - deformation_gradient(el, x_lin);
+  out.u_end += el.volume * neo_hookean_energy_density(neo_hookean_parameters(m.lame[e]), F);
+  out.u_lin_end +=
+      lin.energy[e] + el.volume * (lin.stress[e].cwiseProduct(dF).sum() + 0.5 * lin.frame[e].quadratic(dF));
+  if (v) out.vKv += el.volume * lin.frame[e].quadratic(deformation_gradient(el, *v));
+}
+
 NeoHookeanModelEnergies neo_hookean_model_energies(const FemModel& m, const NeoHookeanLinearisation& lin,
                                                    const Vec3List& x_lin, const Vec3List& x_end,
                                                    const Vec3List* v) {
   NeoHookeanModelEnergies out;
-  for (size_t e = 0; e < m.elements.size(); ++e) {
-    const TetElement& el = m.elements[e];
-    const Mat3 F = deformation_gradient(el, x_end);
-    const Mat3 dF = F - deformation_gradient(el, x_lin);
-    out.u_end += el.volume * neo_hookean_energy_density(neo_hookean_parameters(m.lame[e]), F);
-    out.u_lin_end +=
-        lin.energy[e] + el.volume * (lin.stress[e].cwiseProduct(dF).sum() + 0.5 * lin.frame[e].quadratic(dF));
-    if (v) out.vKv += el.volume * lin.frame[e].quadratic(deformation_gradient(el, *v));
-  }
+  int32_t e = add_neo_hookean_model_energies4(m, lin, x_lin, x_end, v, out);  // four at a time, as far as it can
+  for (; e < int32_t(m.elements.size()); ++e) add_neo_hookean_model_energies(m, e, lin, x_lin, x_end, v, out);
   return out;
 }
 

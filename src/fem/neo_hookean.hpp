@@ -54,6 +54,8 @@ struct NeoHookeanFrame {
   double quadratic(const Mat3& dF) const;  // dF : H : dF
 };
 NeoHookeanFrame neo_hookean_frame(const NeoHookean& p, const Mat3& F);
+// The same from F's rotation-variant SVD F = U diag(s) V^T (fem/rotation_variant_svd.hpp).
+NeoHookeanFrame neo_hookean_frame(const NeoHookean& p, const Mat3& U, const Vec3& s, const Mat3& V);
 // The same as a 9x9 on vec(F) (tests); with `rotation`, also R = U V^T (the co-rotated frame).
 Mat9 neo_hookean_projected_hessian(const NeoHookean& p, const Mat3& F, Mat3* rotation = nullptr);
 // The unprojected d^2 Psi / dF^2 (tests).
@@ -83,6 +85,11 @@ struct NeoHookeanAssembly {
 };
 void assemble_neo_hookean(const FemModel& m, const Vec3List& x_lin, const NeoHookeanAssembly& what, Vec3List& f_int,
                           const Colouring* element_colours = nullptr, ThreadPool* pool = nullptr);
+// Element e's share of it: f_int (sized, not cleared) gains its forces, K its blocks, and R and lin
+// (sized) its entries. The plain reference of the four-wide kernel (fem/neo_hookean_elements4.hpp),
+// which assemble_neo_hookean runs on all but the last few elements of each range.
+void add_neo_hookean_element(const FemModel& m, int32_t e, const Vec3List& x_lin, const NeoHookeanAssembly& what,
+                             Vec3List& f_int);
 
 // U(x), J.
 double neo_hookean_energy(const FemModel& m, const Vec3List& x);
@@ -98,5 +105,10 @@ struct NeoHookeanModelEnergies {
 NeoHookeanModelEnergies neo_hookean_model_energies(const FemModel& m, const NeoHookeanLinearisation& lin,
                                                    const Vec3List& x_lin, const Vec3List& x_end,
                                                    const Vec3List* v = nullptr);
+// Element e's terms of those sums, added to out: the plain reference of the four-wide
+// add_neo_hookean_model_energies4 (fem/neo_hookean_energies4.hpp), which takes all but the last few.
+void add_neo_hookean_model_energies(const FemModel& m, int32_t e, const NeoHookeanLinearisation& lin,
+                                    const Vec3List& x_lin, const Vec3List& x_end, const Vec3List* v,
+                                    NeoHookeanModelEnergies& out);
 
 }  // namespace mica

@@ -5,9 +5,7 @@
 
 #include <Eigen/LU>
 
-#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
-#include <immintrin.h>
-#endif
+#include "fem/lanes4.hpp"
 
 namespace mica {
 
@@ -167,97 +165,10 @@ void add_elements(const TetElement* const e[2], const Lame* const m[2], const Ma
 
 namespace {
 
-#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
-#define MICA_ELEMENTS_AVX2 1
-#define MICA_AVX2 __attribute__((target("avx2,fma")))
+#ifdef MICA_LANES4
+using namespace lanes4;
 
-bool avx2_supported() {
-  static const bool supported = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
-  return supported;
-}
-
-// The 4x4 transpose of rows v[0..3]: afterwards v[i] holds the old rows' entries i.
-MICA_AVX2 inline void transpose4(__m256d v[4]) {
-  const __m256d t0 = _mm256_unpacklo_pd(v[0], v[1]), t1 = _mm256_unpackhi_pd(v[0], v[1]);
-  const __m256d t2 = _mm256_unpacklo_pd(v[2], v[3]), t3 = _mm256_unpackhi_pd(v[2], v[3]);
-  v[0] = _mm256_permute2f128_pd(t0, t2, 0x20);
-  v[1] = _mm256_permute2f128_pd(t1, t3, 0x20);
-  v[2] = _mm256_permute2f128_pd(t0, t2, 0x31);
-  v[3] = _mm256_permute2f128_pd(t1, t3, 0x31);
-}
-
-// out[i] = (p[0][i], p[1][i], p[2][i], p[3][i]) for i < 4.
-MICA_AVX2 inline void load_lanes4(const double* const p[4], __m256d out[4]) {
-  for (int l = 0; l < 4; ++l) out[l] = _mm256_loadu_pd(p[l]);
-  transpose4(out);
-}
-
-// Four 3x3 matrices as lanes: out[3j + i] holds their entries (i, j) (Mat3 is column-major).
-MICA_AVX2 inline void load_matrices(const Mat3* const M[4], __m256d out[9]) {
-  const double* p[4] = {M[0]->data(), M[1]->data(), M[2]->data(), M[3]->data()};
-  load_lanes4(p, out);
-  for (int l = 0; l < 4; ++l) p[l] += 4;
-  load_lanes4(p, out + 4);
-  out[8] = _mm256_setr_pd((*M[0])(8), (*M[1])(8), (*M[2])(8), (*M[3])(8));
-}
-
-// Four 3-vectors, (x, y) in xy[l] and z in z[l], as lanes: out[i] holds their entries i.
-MICA_AVX2 inline void vectors_to_lanes(const __m128d xy[4], const double z[4], __m256d out[3]) {
-  const __m256d v02 = _mm256_insertf128_pd(_mm256_castpd128_pd256(xy[0]), xy[2], 1);
-  const __m256d v13 = _mm256_insertf128_pd(_mm256_castpd128_pd256(xy[1]), xy[3], 1);
-  out[0] = _mm256_unpacklo_pd(v02, v13);
-  out[1] = _mm256_unpackhi_pd(v02, v13);
-  out[2] = _mm256_setr_pd(z[0], z[1], z[2], z[3]);
-}
-
-// *v[l] += lane l of the 3-vector in lanes s, one after the other (two may be the same vector).
-MICA_AVX2 inline void add_vectors(Vec3* const v[4], const __m256d s[3]) {
-  const __m256d lo = _mm256_unpacklo_pd(s[0], s[1]), hi = _mm256_unpackhi_pd(s[0], s[1]);
-  const __m128d xy[4] = {_mm256_castpd256_pd128(lo), _mm256_castpd256_pd128(hi), _mm256_extractf128_pd(lo, 1),
-                         _mm256_extractf128_pd(hi, 1)};
-  alignas(32) double z[4];
-  _mm256_store_pd(z, s[2]);
-  for (int l = 0; l < 4; ++l) {
-    double* out = v[l]->data();
-    _mm_storeu_pd(out, _mm_add_pd(_mm_loadu_pd(out), xy[l]));
-    out[2] += z[l];
-  }
-}
-
-// *block[l] += lane l of the column-major entries k[0..8], one block after the other (two may be the
-// same block: no lane's sum is read before the previous lane's is stored).
-MICA_AVX2 inline void add_blocks(Mat3* const block[4], const __m256d (&k)[9]) {
-  __m256d lo[4] = {k[0], k[1], k[2], k[3]}, hi[4] = {k[4], k[5], k[6], k[7]};
-  transpose4(lo);  // lo[l]: element l's entries 0-3
-  transpose4(hi);
-  alignas(32) double last[4];
-  _mm256_store_pd(last, k[8]);
-  for (int l = 0; l < 4; ++l) {
-    double* out = block[l]->data();
-    _mm256_storeu_pd(out, _mm256_add_pd(_mm256_loadu_pd(out), lo[l]));
-    _mm256_storeu_pd(out + 4, _mm256_add_pd(_mm256_loadu_pd(out + 4), hi[l]));
-    out[8] += last[l];
-  }
-}
-
-// Entry (i, j) of A B, and of A^T B, for 3x3 matrices in lanes (column-major).
-MICA_AVX2 inline __m256d product(const __m256d* A, const __m256d* B, int i, int j) {
-  const __m256d s = _mm256_fmadd_pd(A[3 + i], B[3 * j + 1], _mm256_mul_pd(A[i], B[3 * j]));
-  return _mm256_fmadd_pd(A[6 + i], B[3 * j + 2], s);
-}
-MICA_AVX2 inline __m256d transposed_product(const __m256d* A, const __m256d* B, int i, int j) {
-  const __m256d s = _mm256_fmadd_pd(A[3 * i + 1], B[3 * j + 1], _mm256_mul_pd(A[3 * i], B[3 * j]));
-  return _mm256_fmadd_pd(A[3 * i + 2], B[3 * j + 2], s);
-}
-// A v for a 3x3 matrix and a 3-vector in lanes.
-MICA_AVX2 inline void apply(const __m256d* A, const __m256d* v, __m256d* out) {
-  for (int i = 0; i < 3; ++i)
-    out[i] = _mm256_fmadd_pd(A[6 + i], v[2], _mm256_fmadd_pd(A[3 + i], v[1], _mm256_mul_pd(A[i], v[0])));
-}
-
-// add_elements' steps four lanes wide; written by hand for the reason half_products.hpp gives (the
-// library is built for any x86-64). Matrices are lane vectors in column-major order: M[3j + i] is
-// entry (i, j).
+// add_elements' steps four lanes wide (lanes4.hpp).
 MICA_AVX2 void add_elements4_avx2(const TetElement* const e[4], const Lame* const m[4], const Mat3* const R[4],
                                    const Vec3List& x, double scale, const std::array<int32_t, 16>* const slots[4],
                                    Mat3* K, Vec3List& f) {
@@ -352,8 +263,8 @@ MICA_AVX2 void add_elements4_avx2(const TetElement* const e[4], const Lame* cons
 
 void add_elements4(const TetElement* const e[4], const Lame* const m[4], const Mat3* const R[4], const Vec3List& x,
                    double scale, const std::array<int32_t, 16>* const slots[4], Mat3* K, Vec3List& f) {
-#ifdef MICA_ELEMENTS_AVX2
-  if (avx2_supported()) return add_elements4_avx2(e, m, R, x, scale, slots, K, f);
+#ifdef MICA_LANES4
+  if (lanes4::supported()) return add_elements4_avx2(e, m, R, x, scale, slots, K, f);
 #endif
   add_elements(e, m, R, x, scale, slots, K, f);
   add_elements(e + 2, m + 2, R + 2, x, scale, slots + 2, K, f);
