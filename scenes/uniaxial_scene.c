@@ -70,7 +70,8 @@ mica_status uniaxial_scene_measure(mica_world* world, const uniaxial_scene* s, d
   if (st < 0) return st;
   if (stretch) *stretch = height / s->side;
   if (lateral) *lateral = width / s->side;
-  if (nominal) *nominal = -f[2] / (s->side * s->side); /* the reaction holds the body down: the body pushes the plate up */
+  /* The body pushes the plate up: the reaction on the body points down. */
+  if (nominal) *nominal = -f[2] / (s->side * s->side);
   return MICA_OK;
 }
 
