@@ -135,16 +135,35 @@ Separation least_separation(const CorePolytope& core, const Vec3& a, const Vec3&
 
 // --- libccd's view of the tool inflated by the margin (object 1) and of the triangle (object 2)
 
+// libccd's MPR bounds only its last phase (ccd_t::max_iterations); its portal discovery and
+// refinement loop until their own tests pass, which on degenerate input they may never do: a
+// triangle with a corner at 1e73 m (a body blown up by a grab handle posed 1e64 m away) against a
+// 1 cm box cycled in the discovery, and the step never returned. So the support functions count
+// their calls, and past kMprSupportCalls they describe shapes that are apart: the Minkowski
+// difference's support lies behind the origin along whatever direction is asked, which every
+// phase of MPR tests on each new support point, so MPR ends at its next one; the caller then
+// discards its answer. An MPR that settles makes at most max_iterations + 2 calls for the depth
+// after a few to find and refine its portal (fewer than 60 throughout the tests).
+constexpr int32_t kMprMaxIterations = 200;
+constexpr int32_t kMprSupportCalls = 4 * kMprMaxIterations;
+
+struct MprBudget {
+  int32_t calls = 0;
+  bool spent() const { return calls > kMprSupportCalls; }
+};
+
 struct ToolObject {
   const Tool* tool;
   Mat3 R;          // tool frame to world
   double inflate;  // m, the margin: the tool is rounded by this radius
   Vec3 centre;     // a point strictly inside the tool, world
+  MprBudget* budget = nullptr;  // set for MPR (penetration_contact)
 };
 
 struct TriangleObject {
   Vec3 v[3];
   Vec3 centre;  // any point of the triangle
+  const MprBudget* budget = nullptr;  // set for MPR (penetration_contact)
 };
 
 Vec3 from_ccd(const ccd_vec3_t* v) { return {v->v[0], v->v[1], v->v[2]}; }
@@ -162,9 +181,15 @@ Vec3 unit_or_x(const Vec3& d) {
   return n > 0 ? Vec3(d / n) : Vec3::UnitX();
 }
 
+// libccd asks object 1 (the tool) first, then object 2 for the opposite direction; their
+// difference is the support point of the Minkowski difference.
 void tool_support(const void* object, const ccd_vec3_t* dir, ccd_vec3_t* out) {
   const ToolObject& o = *static_cast<const ToolObject*>(object);
   const Vec3 d = unit_or_x(from_ccd(dir));
+  if (o.budget && (++o.budget->calls, o.budget->spent())) {
+    to_ccd(-d, out);  // the triangle's is then the origin: the difference is 1 m behind it along d
+    return;
+  }
   const Vec3 core = o.tool->position + o.R * core_support(*o.tool, o.R.transpose() * d);
   to_ccd(core + (rounding(*o.tool) + o.inflate) * d, out);
 }
@@ -172,7 +197,12 @@ void tool_support(const void* object, const ccd_vec3_t* dir, ccd_vec3_t* out) {
 void tool_centre(const void* object, ccd_vec3_t* out) { to_ccd(static_cast<const ToolObject*>(object)->centre, out); }
 
 void triangle_support_ccd(const void* object, const ccd_vec3_t* dir, ccd_vec3_t* out) {
-  to_ccd(triangle_support(*static_cast<const TriangleObject*>(object), from_ccd(dir)), out);
+  const TriangleObject& t = *static_cast<const TriangleObject*>(object);
+  if (t.budget && t.budget->spent()) {
+    to_ccd(Vec3::Zero(), out);
+    return;
+  }
+  to_ccd(triangle_support(t, from_ccd(dir)), out);
 }
 
 void triangle_centre(const void* object, ccd_vec3_t* out) {
@@ -184,24 +214,28 @@ void triangle_centre(const void* object, ccd_vec3_t* out) {
 // the ray from the tool's centre leaves through, which is not always the shallowest one (a few
 // percent of shallow contacts come out up to twice too deep), so the depth and normal come from
 // the separating axes instead: exact for these polytope cores.
-bool penetration_contact(const ToolObject& t, const Vec3& a, const Vec3& b, const Vec3& c, double margin,
+bool penetration_contact(ToolObject t, const Vec3& a, const Vec3& b, const Vec3& c, double margin,
                          TriangleHit& hit) {
   const Tool& tool = *t.tool;
-  const TriangleObject tri{{a, b, c}, closest_on_triangle(t.centre, a, b, c).point};
+  MprBudget budget;
+  t.budget = &budget;
+  const TriangleObject tri{{a, b, c}, closest_on_triangle(t.centre, a, b, c).point, &budget};
   ccd_t ccd;
   CCD_INIT(&ccd);
   ccd.support1 = tool_support;
   ccd.center1 = tool_centre;
   ccd.support2 = triangle_support_ccd;
   ccd.center2 = triangle_centre;
-  ccd.max_iterations = 200;
+  ccd.max_iterations = kMprMaxIterations;
   // libccd's tolerance is absolute (in metres here): scale it to the shapes.
   const double size = tool_bounds(tool, margin).size().norm() + longest_edge(a, b, c);
   ccd.mpr_tolerance = 1e-10 * size;
   ccd_real_t depth = 0;
   ccd_vec3_t dir, pos;
+  const int met = ccdMPRPenetration(&t, &tri, &ccd, &depth, &dir, &pos);
+  if (budget.spent()) return false;  // MPR did not settle (degenerate shapes): no contact found
   // Depth 0 or no direction: the shapes merely touch, which is no contact at a zero margin.
-  if (ccdMPRPenetration(&t, &tri, &ccd, &depth, &dir, &pos) != 0 || !(depth > 0)) return false;
+  if (met != 0 || !(depth > 0)) return false;
 
   const Separation least = least_separation(core_polytope(tool, t.R), a, b, c);
   const double gap = -(least.depth + rounding(tool));

@@ -21,7 +21,7 @@ void FactoredMicaSolver::prepare(const std::vector<SolverBody>& bodies, const Co
   }
   lambda.resize(rows.size(), 0.0);
   start_compliance(bodies, rows, lambda);
-  small_.lemke_failed = false;
+  small_.lemke_failed = small_.lemke_ray = false;
 }
 
 void FactoredMicaSolver::update_factors(const std::vector<SolverBody>& bodies) {
@@ -306,6 +306,7 @@ void FactoredMicaSolver::solve_small_lcp(const ContactRows& rows, double toleran
       return;
     }
     sp.lemke_failed = true;
+    sp.lemke_ray = sol.ray;
   }
   // With friction (or if pivoting failed): block Gauss-Seidel over the contacts with the exact
   // local Coulomb solve, from lambda, to well below the tolerance.
@@ -330,7 +331,12 @@ void FactoredMicaSolver::solve_small_lcp(const ContactRows& rows, double toleran
   // per round took 350 ms a step.
   constexpr double kSweepWork = 256.0 * 120 * 120;
   fs.max_sweeps = int32_t(std::clamp(kSweepWork / (double(n) * double(n)), 16.0, 256.0));
-  fs.max_newton_rows = 120;
+  // Frictionless rows on which Lemke ended on a ray have no solution (W is positive semidefinite,
+  // hence copositive-plus), so no Newton step can converge to one: after a ray the sweeps alone
+  // give the rounds their prediction. A box tool teleported into a 27-node box, 110 rows, took
+  // 1933 Newton steps (110 x 110 factorizations) in the 113 rounds of one step: 0.84 s, 0.47 s
+  // without them; 386 -> 14 ms at 20 iterations (found_box_enclosed_110_rows).
+  fs.max_newton_rows = sp.lemke_ray ? 0 : 120;
   fs.deadline = deadline;
   FrictionalSolution& sol = sp.solution;
   solve_frictional_contact(sp.M, sp.q, sp.mu, sp.normal, sp.start, fs, sp.workspace, sol);

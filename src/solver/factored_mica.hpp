@@ -161,6 +161,7 @@ class FactoredMicaSolver : public CachingVelocitySolver<FactoredBodyCache> {
   struct SmallProblem {
     std::vector<double> lambda_next;  // per row: its solution
     bool lemke_failed = false;        // Lemke's pivoting found no solution this solve (solve_small_lcp)
+    bool lemke_ray = false;           // ... because it ended on a ray: the rows have none
     std::vector<int32_t> live, live_at;  // per live row its row; per row its live row or -1
     Eigen::MatrixXd M;                   // W on the live rows, n x n
     Eigen::VectorXd q, mu, start;

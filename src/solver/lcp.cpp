@@ -203,6 +203,7 @@ LcpSolution solve_lcp_lemke(const Eigen::MatrixXd& M, const Eigen::VectorXd& q, 
     }
     const int32_t row = tableau.leaving_row(entering);
     if (row < 0) {
+      s.ray = true;
       const std::string name = (entering < n ? "w_" : "z_") + std::to_string(entering % n);
       s.message = "ray termination after " + std::to_string(s.pivots) + " pivots (" + name +
                   " can grow without bound): the LCP has no solution, or M is not in a class Lemke's "

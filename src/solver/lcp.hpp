@@ -18,6 +18,7 @@ namespace mica {
 struct LcpSolution {
   Eigen::VectorXd z, w;  // the unknowns and w = M z + q, both of size n
   bool solved = false;   // false: ray termination, pivot or sweep limit, numerical breakdown
+  bool ray = false;      // Lemke ended on a ray: for a copositive-plus M (positive semidefinite) the LCP has no solution
   int32_t pivots = 0;    // Lemke: pivots done (0 in the trivial case q >= 0); PGS: sweeps done
   std::string message;   // what happened, for a person to read
 };

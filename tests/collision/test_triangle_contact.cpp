@@ -266,6 +266,23 @@ static void test_random_contacts(void**) {
   }
 }
 
+// A triangle of a body blown up by a grab handle posed 1e64 m away (fuzz/corpus/recording/
+// found_mpr_cycling_body_at_1e73_m), under a 1 cm box: libccd's MPR cycled in its portal
+// discovery, which has no iteration cap, and the step never returned. With its support calls
+// counted the query returns, and a pair MPR cannot settle gives no contact.
+static void test_degenerate_triangle_returns(void**) {
+  Tool box;
+  box.shape = ToolShape::Box;
+  box.half_extents = Vec3::Constant(0.01);
+  box.position = Vec3(0.10015, 0, 0);
+  prepare_tool_shape(box);
+  const Vec3 a(1.4877236944454553e+72, -1.1624127265189352e+73, -3.5724952235689926e+72);
+  const Vec3 b(-0.049960000000000018, -0.10000000000000001, 0.050000000000000003);
+  const Vec3 c(0.050040000000000001, 2.6735502617500154e+64, 0.050000000000000003);
+  TriangleHit hit;
+  assert_false(collide_triangle(box, a, b, c, 4.003999999999837e-05, hit));
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_sphere_over_interior),
@@ -277,6 +294,7 @@ int main(void) {
       cmocka_unit_test(test_box_corner_into_triangle),
       cmocka_unit_test(test_capsule),
       cmocka_unit_test(test_random_contacts),
+      cmocka_unit_test(test_degenerate_triangle_returns),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -181,12 +181,14 @@ static void test_no_solution_is_reported(void**) {
   for (int n : {1, 2, 5}) {  // w = q - z < 0 for every z >= 0
     const LcpSolution s = solve_lcp_lemke(-Eigen::MatrixXd::Identity(n, n), -Eigen::VectorXd::Ones(n));
     assert_false(s.solved);
+    assert_true(s.ray);
     assert_non_null(std::strstr(s.message.c_str(), "ray"));
     assert_le(s.pivots, 50 * n);
   }
   {  // skew-symmetric (copositive-plus), infeasible: w_0 = -z_1 - 1 < 0
     const LcpSolution s = solve_lcp_lemke(mat(2, 2, {0, -1, 1, 0}), vec({-1, -1}));
     assert_false(s.solved);
+    assert_true(s.ray);
     assert_non_null(std::strstr(s.message.c_str(), "ray"));
   }
   {  // M = 0 with a negative q
@@ -198,6 +200,7 @@ static void test_no_solution_is_reported(void**) {
     const LcpSolution s = solve_lcp_lemke(p.M, p.q, 3);
     assert_false(s.solved);
     assert_int_equal(s.pivots, 3);
+    assert_false(s.ray);  // which says nothing of a solution
     assert_non_null(std::strstr(s.message.c_str(), "pivot limit"));
   }
 }
