@@ -14,10 +14,12 @@ the run's block of the same name and reports, per block, whether it is the same,
 the largest relative change among its numbers (milliseconds move from run to run; iteration
 counts and bytes should not).
 
-usage: study_docs.py <study-folder> [--docs DIR] [--update]
+usage: study_docs.py <study-folder> [--docs DIR] [--update [--only NAME,...]]
   (no option)  report; exit 1 when a block in the docs differs from the run's
   --update     copy the run's blocks into the docs (the blocks only: the prose around them is
                the author's to check against the new figures)
+  --only       with --update: copy only these blocks (comma-separated names), when a run is to
+               update some tables and the prose of the others still quotes an earlier run
 scripts/study.sh runs the report at its end.
 """
 import argparse
@@ -57,12 +59,18 @@ def main():
     ap.add_argument("folder", help="the study's output folder (out/study)")
     ap.add_argument("--docs", default=os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "docs"))
     ap.add_argument("--update", action="store_true", help="copy the run's blocks into the docs")
+    ap.add_argument("--only", default="", help="with --update: copy only these blocks (comma-separated names)")
     args = ap.parse_args()
+    only = {n for n in args.only.split(",") if n}
+    if only and not args.update:
+        sys.exit("--only goes with --update")
     tables = os.path.join(args.folder, "tables.md")
     if not os.path.exists(tables):
         sys.exit(f"{tables}: not found (run scripts/study.sh first)")
     with open(tables) as f:
         run = blocks(f.read())
+    for n in sorted(only - set(run)):
+        print(f"--only {n}: no such block in this run")
     differ = 0
     for page in sorted(glob.glob(os.path.join(args.docs, "*.md"))):
         with open(page) as f:
@@ -86,8 +94,12 @@ def main():
             else:
                 print(f"{name}: {key}: differs, the largest change {100 * d[0]:.0f} % ({d[1]})")
         if args.update:
-            new_text = BLOCK.sub(lambda m: (f"<!-- study:begin {m.group(1)} -->\n{run.get(m.group(1), m.group(2))}"
-                                            f"<!-- study:end {m.group(1)} -->"), text)
+            def copy(m):
+                keep = only and m.group(1) not in only
+                body = m.group(2) if keep else run.get(m.group(1), m.group(2))
+                return f"<!-- study:begin {m.group(1)} -->\n{body}<!-- study:end {m.group(1)} -->"
+
+            new_text = BLOCK.sub(copy, text)
             if new_text != text:
                 with open(page, "w") as f:
                     f.write(new_text)

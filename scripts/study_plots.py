@@ -17,6 +17,10 @@ scripts/study_docs.py compares them with (or copies them into) the docs.
                              stopping norm: error against ms per step
   anchors.png                Hertz and Euler-Bernoulli: error against element size (log-log), and
                              the Hertz force against depth
+  material.png               the material axis: uniaxial compression of a cube against the
+                             neo-Hookean closed form (stress and error against strain, each
+                             model's CPU ms per step), and the press scene's CPU ms per step and
+                             difference from the co-rotational body per model and solver
   scaling.png                ms per step, iterations and ms per iteration against tets
 and, in tables.md only, the force quality of a held tool and of loading (contact.csv, from
 bench/bench_contact.c), and the performance tables (perf-*) from the benchmarks' output the study
@@ -359,7 +363,8 @@ def anchors(rows, curve, out):
     labels = []
     for test, model, colour, marker in (("hertz", "linear", "tab:red", "o"),
                                         ("cantilever", "linear", "tab:blue", "s"),
-                                        ("cantilever", "corotational", "tab:cyan", "^")):
+                                        ("cantilever", "corotational", "tab:cyan", "^"),
+                                        ("cantilever", "neo-hookean", "tab:purple", "v")):
         pts = sorted((num(r["h_m"]), abs(num(r["rel_error"])), num(r["rel_error"])) for r in rows
                      if r["test"] == test and r["model"] == model)
         pts = [p for p in pts if fin(p[1])]
@@ -399,6 +404,86 @@ def anchors(rows, curve, out):
     ax_f.legend(fontsize=7)
     fig.tight_layout()
     fig.savefig(os.path.join(out, "anchors.png"))
+    plt.close(fig)
+
+
+MODELS = (("linear", "tab:gray", "s", "linear"), ("corotational", "tab:blue", "o", "co-rotational"),
+          ("neo-hookean", "tab:red", "^", "neo-Hookean"))
+
+
+def material(rows, uni, out):
+    """The material axis: uniaxial compression (uniaxial.csv) and the press scene's model group
+    (sweep.csv)."""
+    press = [r for r in rows if r["group"] == "model"]
+    if not uni and not press:
+        return
+    fig, axes = plt.subplots(2, 2, figsize=(13, 9), dpi=100)
+    (ax_p, ax_e), (ax_u, ax_c) = axes
+    if uni:
+        # The closed forms at the measured strains (uniaxial.csv has them per row), from the origin.
+        ref = sorted({(num(r["strain"]), -num(r["nominal_neo_hookean_Pa"]), -num(r["nominal_hooke_Pa"]))
+                      for r in uni if r["model"] == "neo-hookean"})
+        if ref:
+            ax_p.plot([0] + [100 * p[0] for p in ref], [0] + [p[1] for p in ref], "k-", lw=1.5,
+                      label="neo-Hookean closed form (at the measured stretch)")
+            ax_p.plot([0] + [100 * p[0] for p in ref], [0] + [p[2] for p in ref], "k--", lw=1,
+                      label="Hooke: E (1 - s)")
+        for model, colour, marker, name in MODELS:
+            pts = sorted((100 * num(r["strain"]), -num(r["nominal_fem_Pa"]), 100 * num(r["rel_error"]),
+                          num(r["load_cpu_ms"]), num(r["cpu_ms_median"]), num(r["load_solves"]))
+                         for r in uni if r["model"] == model)
+            if not pts:
+                continue
+            ms = 9 if model == "linear" else 6  # linear and co-rotational coincide here: linear drawn larger
+            ax_p.plot([p[0] for p in pts], [p[1] for p in pts], marker, color=colour, ms=ms, mfc="none", label=name)
+            ax_e.plot([p[0] for p in pts], [p[2] for p in pts], marker + "-", color=colour, ms=ms, mfc="none",
+                      label=name)
+            ax_u.plot([p[0] for p in pts], [p[3] for p in pts], marker + "-", color=colour, ms=ms, mfc="none",
+                      label=f"{name}: the loading step")
+            ax_u.plot([p[0] for p in pts], [p[4] for p in pts], marker + ":", color=colour, ms=ms - 2, mfc="none",
+                      label=f"{name}: median of the increment's 7 steps")
+            for x, _, _, y, _, n in pts:
+                ax_u.annotate(f"{n:.0f}", (x, y), fontsize=6, color=colour, xytext=(2, 3), textcoords="offset points")
+        cells = uni[0]["cells"]
+        ax_p.set_title(f"Uniaxial compression, frictionless ends ({cells}^3 cells x 6 tets, E = 10 kPa, nu = 0.45)",
+                       fontsize=9)
+        ax_p.set_xlabel("compression (%)")
+        ax_p.set_ylabel("nominal stress -P_zz (Pa)")
+        ax_e.set_title("Error against the neo-Hookean closed form", fontsize=9)
+        ax_e.set_xlabel("compression (%)")
+        ax_e.set_ylabel("(FEM - closed form) / closed form (%)")
+        ax_e.axhline(0, color="k", lw=0.8)
+        ax_u.set_title("Uniaxial: CPU ms per step (exact solver; labels: solves of the loading step;\n"
+                       "the first step also analyses the matrix)", fontsize=9)
+        ax_u.set_xlabel("compression (%)")
+        ax_u.set_ylabel("stepping thread's CPU ms")
+        for ax in (ax_p, ax_e, ax_u):
+            ax.grid(alpha=0.3)
+            ax.legend(fontsize=7)
+    if press:
+        solvers = [s for s in ("exact", "MICA", "MICA-F", "PCG") if any(r["solver"] == s for r in press)]
+        width, labelled = 0.8 / len(MODELS), set()
+        for i, solver in enumerate(solvers):
+            here = [(m, next(r for r in press if r["model"] == m[0] and r["solver"] == solver)) for m in MODELS
+                    if any(r["model"] == m[0] and r["solver"] == solver for r in press)]
+            for k, ((_, colour, _, name), r) in enumerate(here):
+                x, y = i + (k - (len(here) - 1) / 2) * width, num(r["cpu_ms_median"])  # centred on the solver
+                ax_c.bar(x, y, width, color=colour, label=None if name in labelled else name)
+                labelled.add(name)
+                ax_c.annotate(f"{y:.2f}", (x, y), fontsize=7, ha="center", xytext=(0, 2), textcoords="offset points")
+        ax_c.set_xticks(range(len(solvers)))
+        ax_c.set_xticklabels([s if s == "exact" else f"{s}, tol 1e-6" for s in solvers])
+        ax_c.set_ylabel("median CPU ms per step (stepping thread)")
+        ax_c.set_yscale("log")
+        ax_c.set_title("Press scene (3072 tets, 10 ms steps): median CPU ms per step\n"
+                       "(the models' differences in position and force: the accuracy-material table)", fontsize=9)
+        ax_c.grid(alpha=0.3, axis="y", which="both")
+        ax_c.legend(fontsize=7)
+    else:
+        ax_c.axis("off")
+    fig.suptitle("Material axis: linear, co-rotational and neo-Hookean bodies")
+    fig.tight_layout()
+    fig.savefig(os.path.join(out, "material.png"))
     plt.close(fig)
 
 
@@ -484,7 +569,46 @@ def sweep_tables(rows, w):
     w("<!-- study:end accuracy-drift -->")
 
 
-def tables(rows, anchor_rows, filt, scal, comments, out, contact=()):
+def pct(v):
+    """A relative error in percent, 3 significant digits (round-off shows as such, not as 0.00 %)."""
+    x = num(v)
+    return "-" if not fin(x) else f"{100 * x:+.3g}%"
+
+
+def material_tables(rows, uni, w):
+    """The material axis: the press scene's model group (sweep.csv) and uniaxial compression
+    (uniaxial.csv)."""
+    press = [r for r in rows if r["group"] == "model"]
+    if press:
+        w("\n### Material: the press scene per model\n")
+        w("<!-- study:begin accuracy-material -->")
+        w("| solver | model | median CPU ms | p95 CPU ms | median wall ms | iters/step | solves/step "
+          "| pos. RMS err vs exact, same model (m) | pos. RMS diff. vs exact co-rotational (m) "
+          "| force diff. vs exact co-rotational (N) | peak force (N) | status |")
+        w("|---|---|---|---|---|---|---|---|---|---|---|---|")
+        for r in press:
+            tol = "" if r["solver"] == "exact" else f", tol {num(r['tol']):.0e}"
+            w(f"| {r['solver']}{tol} | {r['model']} | {g(r['cpu_ms_median'])} | {g(r['cpu_ms_p95'])} | "
+              f"{g(r['ms_median'])} | {g(r['iters_mean'], '{:.1f}')} | {g(r['solves_mean'], '{:.2f}')} | "
+              f"{g(r['disp_rms_err_m'])} | {g(r['model_disp_rms_err_m'])} | {g(r['model_force_err_N'])} | "
+              f"{g(r['peak_force_N'], '{:.3f}')} | {r['status']} |")
+        w("<!-- study:end accuracy-material -->")
+    if uni:
+        w("\n### Material: uniaxial compression against the neo-Hookean closed form\n")
+        w("<!-- study:begin accuracy-uniaxial -->")
+        w("| model | compression | P FEM (Pa) | P neo-Hookean (Pa) | error | P Hooke (Pa) | error vs Hooke "
+          "| lateral stretch FEM | neo-Hookean | solves, loading step | CPU ms, loading step | CPU ms/step, median |")
+        w("|---|---|---|---|---|---|---|---|---|---|---|---|")
+        for r in uni:
+            w(f"| {r['model']} | {100 * num(r['strain']):.0f}% | {g(r['nominal_fem_Pa'], '{:.1f}')} | "
+              f"{g(r['nominal_neo_hookean_Pa'], '{:.1f}')} | {pct(r['rel_error'])} | "
+              f"{g(r['nominal_hooke_Pa'], '{:.1f}')} | {pct(r['rel_error_hooke'])} | "
+              f"{g(r['lateral_fem'], '{:.4f}')} | {g(r['lateral_neo_hookean'], '{:.4f}')} | {r['load_solves']} | "
+              f"{g(r['load_cpu_ms'], '{:.2f}')} | {g(r['cpu_ms_median'], '{:.2f}')} |")
+        w("<!-- study:end accuracy-uniaxial -->")
+
+
+def tables(rows, anchor_rows, filt, scal, comments, out, contact=(), uni=()):
     lines = []
     w = lines.append
     w("<!-- written by scripts/study_plots.py -->")
@@ -526,6 +650,7 @@ def tables(rows, anchor_rows, filt, scal, comments, out, contact=()):
             w(f"| {r['test']} | {r['model']} | {g(r['h_m'])} | {r['nodes']} | {r['tets']} | {g(r['fem'], '{:.5g}')} | "
               f"{g(r['theory'], '{:.5g}')} | {g(r['rel_error'], '{:+.2%}')} | {extra} | {g(r['ms'], '{:.0f}')} |")
         w("<!-- study:end accuracy-anchors -->")
+    material_tables(rows, uni, w)
     if filt:
         w("\n### Filter window (device side)\n")
         w("<!-- study:begin accuracy-filter -->")
@@ -880,6 +1005,7 @@ def main(folder):
     samples, _ = read(os.path.join(folder, "filter_samples.csv"))
     scal, c_scal = read(os.path.join(folder, "scaling.csv"))
     contact, c_contact = read(os.path.join(folder, "contact.csv"))
+    uni, c_uni = read(os.path.join(folder, "uniaxial.csv"))
     if rows:
         error_vs_time(rows, folder)
         iterations_vs_tolerance(rows, folder)
@@ -887,10 +1013,11 @@ def main(folder):
         knobs(rows, folder)
     figure1(samples, filt, folder)
     anchors(anchor_rows, curve, folder)
+    material(rows, uni, folder)
     scaling(scal, folder)
     tables(rows, anchor_rows, filt, scal,
-           {"sweep": c_sweep, "anchors": c_anchor, "filter": c_filter, "scaling": c_scal, "contact": c_contact}, folder,
-           contact)
+           {"sweep": c_sweep, "anchors": c_anchor, "filter": c_filter, "scaling": c_scal, "contact": c_contact,
+            "uniaxial": c_uni}, folder, contact, uni)
     extra = perf_lines(folder)
     if extra:
         with open(os.path.join(folder, "tables.md"), "a") as f:

@@ -22,11 +22,22 @@
  * rho = 1000, clamped (all nodes of x = 0 fixed), under gravity; the tip deflection (mean over
  * the nodes of the end face) against w = q L^4 / (8 E I), q = rho g H^2 (Timoshenko's shear
  * term, q L^2 / (2 k G A) with k = 5/6, is printed beside it: about +1%). Box meshes of
- * 10 n x n x n cubes x 6 tets, n = 1 ... 8.
+ * 10 n x n x n cubes x 6 tets, n = 1 ... 8; linear, co-rotational and neo-Hookean bodies.
+ *
+ * Uniaxial compression (the material axis at large strain): the cube of scenes/uniaxial_scene.h
+ * (0.1 m, 8^3 cubes x 6 tets, E = 1e4 Pa, nu = 0.45) on frictionless ends, pressed by its top
+ * plate in 5 % increments to 40 %, each increment one step of h = 1 s that moves the plate and 6
+ * steps that hold it (the static answer: the mass term is some 1e-3 of the stiffness). The
+ * deformation is homogeneous, which linear tets represent exactly, so the plate's reaction over the
+ * rest area differs from a closed form only by the model: against the stable neo-Hookean closed
+ * form (uniaxial_neo_hookean_nominal_stress) and Hooke's E (s - 1), which the linear and the
+ * co-rotational bodies are here (no rotation). Per increment: the stepping thread's CPU ms of the
+ * loading step and its velocity solves (the Newton re-solves of a large step), and the median CPU
+ * ms of the increment's 7 steps. Linear, co-rotational and neo-Hookean bodies, one after the other.
  *
  * usage: study_anchors <out-dir> [quick]
- * Writes <out-dir>/anchors.csv (one row per mesh) and <out-dir>/hertz_curve.csv (F against d
- * on every Hertz level).
+ * Writes <out-dir>/anchors.csv (one row per mesh), <out-dir>/hertz_curve.csv (F against d
+ * on every Hertz level) and <out-dir>/uniaxial.csv (one row per model and increment).
  */
 #include <math.h>
 #include <stdio.h>
@@ -37,6 +48,7 @@
 
 #include "node_selection.h"
 #include "study_common.h"
+#include "uniaxial_scene.h"
 #include "cli.h"
 
 #define HERTZ_R 0.01
@@ -195,6 +207,12 @@ static level_result hertz_level(int cells, FILE* curve) {
   return r;
 }
 
+static const int32_t kModels[3] = {MICA_MODEL_LINEAR, MICA_MODEL_COROTATIONAL, MICA_MODEL_NEO_HOOKEAN};
+
+static const char* model_name(int32_t model) {
+  return model == MICA_MODEL_LINEAR ? "linear" : model == MICA_MODEL_NEO_HOOKEAN ? "neo-hookean" : "corotational";
+}
+
 static level_result beam_level(int n, int model) {
   level_result r;
   memset(&r, 0, sizeof r);
@@ -251,11 +269,78 @@ static level_result beam_level(int n, int model) {
   return r;
 }
 
+#define UNIAXIAL_INCREMENTS 8 /* of 5 %: to 40 % */
+#define UNIAXIAL_HOLD 6
+
+/* The uniaxial compression of one model: a row of uniaxial.csv per increment. Returns the
+ * largest |error| against the neo-Hookean closed form, NAN when a step failed. */
+static double uniaxial_run(int32_t model, int32_t cells, FILE* csv) {
+  mica_world_def wd = mica_world_def_default();
+  wd.gravity[0] = wd.gravity[1] = wd.gravity[2] = 0;
+  wd.solver = MICA_SOLVER_DIRECT;
+  mica_world* w = NULL;
+  mica_world_create(&wd, &w);
+  uniaxial_scene_def def = uniaxial_scene_def_default();
+  def.body.model = model;
+  def.cells = cells;
+  const double E = def.body.youngs_modulus, nu = def.body.poisson_ratio, h = 1.0;
+  uniaxial_scene sc;
+  if (uniaxial_scene_create(w, &def, &sc) != MICA_OK) {
+    fprintf(stderr, "uniaxial: %s\n", mica_world_last_error(w));
+    mica_world_destroy(w);
+    return NAN;
+  }
+  double worst = 0;
+  for (int inc = 1; inc <= UNIAXIAL_INCREMENTS; ++inc) {
+    double cpu[1 + UNIAXIAL_HOLD];
+    int32_t load_solves = 0, warned = 0;
+    for (int k = 0; k <= UNIAXIAL_HOLD; ++k) {
+      const double v[3] = {0, 0, k == 0 ? -0.05 * def.side / h : 0};
+      mica_lpc_set_velocity(w, sc.plate, v);
+      const double c0 = study_cpu_ms();
+      const mica_status st = mica_step(w, h);
+      cpu[k] = study_cpu_ms() - c0;
+      if (st < 0) {
+        fprintf(stderr, "uniaxial %s, increment %d: %s\n", model_name(model), inc, mica_world_last_error(w));
+        mica_world_destroy(w);
+        return NAN;
+      }
+      warned += st == MICA_WARN_NOT_CONVERGED;
+      if (k == 0) {
+        mica_world_stats stats;
+        memset(&stats, 0, sizeof stats);
+        stats.struct_size = sizeof stats;
+        mica_world_get_stats(w, &stats);
+        load_solves = stats.solves;
+      }
+    }
+    const double load_cpu = cpu[0];
+    const double median_cpu = study_quantile(cpu, 1 + UNIAXIAL_HOLD, 0.5);
+    double s = 0, lateral = 0, got = 0, t_nh = 0, t_hooke = 0;
+    uniaxial_scene_measure(w, &sc, &s, &lateral, &got);
+    const double nh = uniaxial_neo_hookean_nominal_stress(E, nu, s, &t_nh);
+    const double hooke = uniaxial_hooke_nominal_stress(E, nu, s, &t_hooke);
+    const double err = (got - nh) / nh, err_hooke = (got - hooke) / hooke;
+    worst = fmax(worst, fabs(err));
+    fprintf(csv, "%s,%d,%d,%d,%.6g,%.9g,%.9g,%.9g,%.6g,%.9g,%.6g,%.9g,%.9g,%.9g,%d,%.4f,%.4f,%d\n", model_name(model),
+            cells, sc.nodes, sc.tets, 1 - s, s, got, nh, err, hooke, err_hooke, lateral, t_nh, t_hooke, load_solves,
+            load_cpu, median_cpu, warned);
+    printf("%-8s %-12s %6.0f%% %12.2f %12.2f %+9.2f%% %12.2f %+9.2f%% %9.5f %9.5f %7d %9.2f %9.2f%s\n", "uniaxial",
+           model_name(model), 100 * (1 - s), got, nh, 100 * err, hooke, 100 * err_hooke, lateral, t_nh, load_solves,
+           load_cpu, median_cpu, warned ? "  (a step did not converge)" : "");
+    fflush(stdout);
+  }
+  mica_world_destroy(w);
+  return worst;
+}
+
 static const char kUsage[] =
     "usage: study_anchors <out-dir> [quick]\n"
     "Mesh convergence toward the analytic anchors: Hertz (a sphere indenting a deep block) and\n"
-    "Euler-Bernoulli (a cantilever under its own weight), linear bodies, MICA_SOLVER_DIRECT. Writes\n"
-    "<out-dir>/anchors.csv and <out-dir>/hertz_curve.csv.\n"
+    "Euler-Bernoulli (a cantilever under its own weight; linear, co-rotational and neo-Hookean\n"
+    "bodies), and uniaxial compression of a cube to 40 % against the neo-Hookean closed form (every\n"
+    "model), MICA_SOLVER_DIRECT. Writes <out-dir>/anchors.csv, <out-dir>/hertz_curve.csv and\n"
+    "<out-dir>/uniaxial.csv.\n"
     "  out-dir  where the CSV files go (made if missing)\n"
     "  quick    the coarser meshes only (a smoke test)\n"
     "  --help   this text\n";
@@ -296,11 +381,12 @@ int main(int argc, char** argv) {
   const double a = sqrt(HERTZ_R * HERTZ_D);
   const int divisors[] = {8, 12, 16, 20, 24};
   const int beams[] = {1, 2, 3, 4, 6, 8};
-  const int nh = quick ? 2 : 5, nbm = quick ? 3 : 6;
+  const int nh = quick ? 2 : 5, nbm = quick ? 3 : 6, uniaxial_cells = quick ? 4 : 8;
   /* progress weights: roughly the cost of each level */
   double total = 0, done = 0;
   for (int k = 0; k < nh; ++k) total += pow(divisors[k] / 8.0, 4);
-  for (int k = 0; k < nbm; ++k) total += 2 * 0.2 * pow(beams[k], 3);
+  for (int k = 0; k < nbm; ++k) total += 3 * 0.2 * pow(beams[k], 3);
+  total += 3 * pow(uniaxial_cells / 8.0, 3);
   printf("# Hertz: sphere R = %.3f m to d = %.4f m (a = %.4f m) on a graded quarter block; E = %.0f Pa, nu = %.2f\n",
          HERTZ_R, HERTZ_D, a, HERTZ_E, HERTZ_NU);
   printf("%-6s %-12s %10s %8s %8s %12s %12s %10s %9s\n", "test", "model", "h (m)", "nodes", "tets", "FEM", "theory",
@@ -317,21 +403,42 @@ int main(int argc, char** argv) {
     done += pow(divisors[k] / 8.0, 4);
     study_progress(done, total);
   }
-  for (int m = 0; m < 2; ++m)
+  for (int m = 0; m < 3; ++m)
     for (int k = 0; k < nbm; ++k) {
-      const int model = m == 0 ? MICA_MODEL_LINEAR : MICA_MODEL_COROTATIONAL;
+      const int32_t model = kModels[m];
       const level_result r = beam_level(beams[k], model);
       const double err = (r.value - r.theory) / r.theory, errt = (r.value - r.timoshenko) / r.timoshenko;
-      fprintf(csv, "cantilever,%s,%.6g,%d,%d,%.9g,%.9g,%.6g,%.9g,%.6g,%.1f,\n", m == 0 ? "linear" : "corotational",
-              r.h, r.nodes, r.tets, r.value, r.theory, r.ok ? err : NAN, r.timoshenko, r.ok ? errt : NAN, r.ms);
+      fprintf(csv, "cantilever,%s,%.6g,%d,%d,%.9g,%.9g,%.6g,%.9g,%.6g,%.1f,\n", model_name(model), r.h, r.nodes,
+              r.tets, r.value, r.theory, r.ok ? err : NAN, r.timoshenko, r.ok ? errt : NAN, r.ms);
       printf("%-6s %-12s %10.3e %8d %8d %12.5g %12.5g %10.4f %9.0f  (Timoshenko %.5g: %+.4f)\n", "beam",
-             m == 0 ? "linear" : "corotational", r.h, r.nodes, r.tets, r.value, r.theory, err, r.ms, r.timoshenko,
-             errt);
+             model_name(model), r.h, r.nodes, r.tets, r.value, r.theory, err, r.ms, r.timoshenko, errt);
       fflush(stdout);
       done += 0.2 * pow(beams[k], 3);
       study_progress(done, total);
     }
   fclose(csv);
   fclose(curve);
-  return 0;
+  snprintf(path, sizeof path, "%s/uniaxial.csv", argv[1]);
+  FILE* uni = fopen(path, "w");
+  if (!uni) {
+    fprintf(stderr, "cannot write into %s\n", argv[1]);
+    return 1;
+  }
+  fprintf(uni, "# study_anchors: %s; libmica %d\n", machine, mica_version());
+  fprintf(uni, "model,cells,nodes,tets,strain,stretch,nominal_fem_Pa,nominal_neo_hookean_Pa,rel_error,nominal_hooke_Pa,"
+               "rel_error_hooke,lateral_fem,lateral_neo_hookean,lateral_hooke,load_solves,load_cpu_ms,cpu_ms_median,"
+               "steps_not_converged\n");
+  printf("# uniaxial compression: %d^3 cells x 6 tets, frictionless ends, 5 %% a step of 1 s, held 6 steps\n",
+         uniaxial_cells);
+  printf("%-8s %-12s %7s %12s %12s %10s %12s %10s %9s %9s %7s %9s %9s\n", "test", "model", "strain", "P FEM", "P neoH",
+         "err", "P Hooke", "err", "lateral", "neoH", "solves", "load cpu", "med cpu");
+  int failed = 0;
+  for (int m = 0; m < 3; ++m) {
+    failed += isnan(uniaxial_run(kModels[m], uniaxial_cells, uni));
+    fflush(uni);
+    done += pow(uniaxial_cells / 8.0, 3);
+    study_progress(done, total);
+  }
+  fclose(uni);
+  return failed ? 1 : 0;
 }

@@ -9,7 +9,9 @@
  * then holds it. 1 s of simulated time (100 steps of 10 ms by default).
  *
  * Per configuration: wall-clock ms of each mica_step (median and p95 over the steps after a
- * warm-up of a tenth of the run), solver iterations per step, and, against the exact solver
+ * warm-up of a tenth of the run) and the stepping thread's CPU ms (median and p95 alike: what
+ * the step cost when other processes share the core), solver iterations and velocity solves per
+ * step, and, against the exact solver
  * (MICA_SOLVER_DIRECT: CHOLMOD + the exact Delassus LCP) run on the identical scene:
  * position error (RMS over nodes, worst step, and max over nodes and steps), tool force error
  * (worst step), the deepest penetration of a surface node into the sphere, and the error of
@@ -27,8 +29,11 @@
  *               exact run at 5 ms (at the same simulated times)
  *   mesh        cells per side 4 ... 10: MICA tol 1e-6 and exact; "model" error = tool force
  *               against the exact run on the finest mesh
- *   model       linear (R = I) against co-rotational (MICA, exact; PCG on the linear body);
- *               "model" error against exact co-rotational
+ *   model       the material axis: co-rotational, linear (R = I) and neo-Hookean bodies, each
+ *               exact, MICA and MICA-F (PCG on the linear body too), each solver on the three
+ *               bodies one after the other;
+ *               "model" error against exact co-rotational (quick: exact and MICA-F,
+ *               co-rotational and neo-Hookean)
  *   mass        lumped against consistent (MICA, exact); "model" error against exact consistent
  *   stiffness   E = 1e3 ... 1e7 Pa (nu = 0.3), MICA tol 1e-8, PCG tol 1e-8, exact; 0.5 s;
  *               per-step iterations in stiffness_steps.csv (the paper's Figure 2)
@@ -91,7 +96,8 @@ typedef struct {
   char error[200];
   int steps, nodes, tets;
   double ms_median, ms_p95, ms_mean;
-  double iters_mean, iters_max;
+  double cpu_median, cpu_p95; /* the stepping thread's CPU ms */
+  double iters_mean, iters_max, solves_mean;
   int not_converged;
   double disp_rms, disp_rms_rel, disp_max, force_err, force_err_rel, energy_err, penetration;
   double model_disp_rms, model_force_err, model_force_err_rel;
@@ -202,6 +208,7 @@ static void run(const cfg* c, traj* rec, const traj* ref, const traj* model_ref,
   const int steps = steps_of(c), warm = steps / 10 > 2 ? steps / 10 : 2;
   res->steps = steps;
   double* ms = malloc(sizeof(double) * (size_t)steps);
+  double* cpu = malloc(sizeof(double) * (size_t)steps);
   double* x = malloc(sizeof(double) * 3 * (size_t)nodes);
   double* x0 = malloc(sizeof(double) * 3 * (size_t)nodes);
   mica_body_get_rest_positions(w, body, x0, nodes, NULL);
@@ -215,7 +222,7 @@ static void run(const cfg* c, traj* rec, const traj* ref, const traj* model_ref,
     rec->energy = malloc(sizeof(double) * (size_t)steps);
   }
   double worst_rms = 0, worst_max = 0, worst_f = 0, worst_e = 0, worst_pen = 0, worst_mrms = 0, worst_mf = 0;
-  double sum_ms = 0, sum_it = 0, max_it = 0, e_start = NAN, e_end = NAN, peak_f = 0;
+  double sum_ms = 0, sum_it = 0, sum_solves = 0, max_it = 0, e_start = NAN, e_end = NAN, peak_f = 0;
   int timed = 0, compared = 0, mcompared_x = 0, mcompared_f = 0;
   for (int k = 0; k < steps; ++k) {
     const double t = (k + 1) * c->dt;
@@ -237,9 +244,9 @@ static void run(const cfg* c, traj* rec, const traj* ref, const traj* model_ref,
       free(f);
       free(sel);
     }
-    const double t0 = study_now_ms();
+    const double t0 = study_now_ms(), c0 = study_cpu_ms();
     const mica_status s = mica_step(w, c->dt);
-    const double elapsed = study_now_ms() - t0;
+    const double elapsed = study_now_ms() - t0, elapsed_cpu = study_cpu_ms() - c0;
     if (s < 0) {
       res->ok = 0;
       res->failed_step = k;
@@ -251,9 +258,11 @@ static void run(const cfg* c, traj* rec, const traj* ref, const traj* model_ref,
     st.struct_size = sizeof st;
     mica_world_get_stats(w, &st);
     if (k >= warm) {
+      cpu[timed] = elapsed_cpu;
       ms[timed++] = elapsed;
       sum_ms += elapsed;
       sum_it += st.solver_iterations;
+      sum_solves += st.solves;
       if (st.solver_iterations > max_it) max_it = st.solver_iterations;
       if (!st.converged) res->not_converged++;
     }
@@ -329,7 +338,10 @@ static void run(const cfg* c, traj* rec, const traj* ref, const traj* model_ref,
   res->ms_median = study_quantile(ms, timed, 0.5);
   res->ms_p95 = study_quantile(ms, timed, 0.95);
   res->ms_mean = timed ? sum_ms / timed : NAN;
+  res->cpu_median = study_quantile(cpu, timed, 0.5);
+  res->cpu_p95 = study_quantile(cpu, timed, 0.95);
   res->iters_mean = timed ? sum_it / timed : NAN;
+  res->solves_mean = timed ? sum_solves / timed : NAN;
   res->iters_max = max_it;
   res->penetration = worst_pen;
   res->peak_force = peak_f;
@@ -352,6 +364,7 @@ static void run(const cfg* c, traj* rec, const traj* ref, const traj* model_ref,
   }
   if (res->ok && c->scene == 1) res->energy_ratio = e_end / e_start;
   free(ms);
+  free(cpu);
   free(x);
   free(x0);
   free(surf);
@@ -430,6 +443,19 @@ static void make_plan(int quick) {
       c.cap = caps[k];
       add(c);
     }
+  /* The material axis: co-rotational, linear and (0.8) neo-Hookean, error and ms per step; each
+   * solver runs the three bodies one after the other, so that they are timed close together
+   * (quick: co-rotational and neo-Hookean, exact and MICA-F). */
+  for (int s = 0; s < 4; ++s)
+    for (int m = 0; m < 3; ++m) {
+      c = base_cfg();
+      c.group = "model";
+      c.model = m == 0 ? MICA_MODEL_COROTATIONAL : m == 1 ? MICA_MODEL_LINEAR : MICA_MODEL_NEO_HOOKEAN;
+      if (s == 3 && m != 1) continue; /* PCG only where it differs: the linear body */
+      c.solver = s == 0 ? MICA_SOLVER_DIRECT : s == 1 ? MICA_SOLVER_MICA : s == 2 ? STUDY_MICA_FACTORED : MICA_SOLVER_PCG;
+      if (quick && (m == 1 || s == 1 || s == 3)) continue;
+      add(c);
+    }
   if (quick) return;
   for (int p = 2; p <= 8; p *= 2) {
     c = base_cfg();
@@ -471,16 +497,6 @@ static void make_plan(int quick) {
       c.group = "mesh";
       c.cells = meshes[k];
       c.solver = s == 0 ? MICA_SOLVER_DIRECT : MICA_SOLVER_MICA;
-      add(c);
-    }
-  /* The material axis: co-rotational, linear and (0.8) neo-Hookean, error and ms per step. */
-  for (int m = 0; m < 3; ++m)
-    for (int s = 0; s < 3; ++s) {
-      c = base_cfg();
-      c.group = "model";
-      c.model = m == 0 ? MICA_MODEL_COROTATIONAL : m == 1 ? MICA_MODEL_LINEAR : MICA_MODEL_NEO_HOOKEAN;
-      if (s == 2 && m != 1) continue; /* PCG only where it differs: the linear body */
-      c.solver = s == 0 ? MICA_SOLVER_DIRECT : s == 1 ? MICA_SOLVER_MICA : MICA_SOLVER_PCG;
       add(c);
     }
   for (int m = 0; m < 2; ++m)
@@ -544,6 +560,10 @@ static const traj* find_model_ref(const cfg* c) {
   return find_ref(&m);
 }
 
+static const char* model_name(int32_t model) {
+  return model == MICA_MODEL_LINEAR ? "linear" : model == MICA_MODEL_NEO_HOOKEAN ? "neo-hookean" : "corotational";
+}
+
 static void fmt(FILE* f, double v) {
   if (isnan(v)) fprintf(f, ",");
   else fprintf(f, ",%.6g", v);
@@ -581,7 +601,8 @@ int main(int argc, char** argv) {
   fprintf(csv, "# study_sweep: %s; libmica %d\n", machine, mica_version());
   fprintf(csv,
           "group,solver,tol,cap,dt_s,cells,nodes,tets,model,mass,warm_start,pgs_sweeps,paper_norm,E_Pa,steps,"
-          "ms_median,ms_p95,ms_mean,iters_mean,iters_max,steps_not_converged,disp_rms_err_m,disp_rms_err_rel,"
+          "ms_median,ms_p95,ms_mean,cpu_ms_median,cpu_ms_p95,iters_mean,iters_max,solves_mean,steps_not_converged,"
+          "disp_rms_err_m,disp_rms_err_rel,"
           "disp_max_err_m,force_err_N,force_err_rel,energy_err_rel,penetration_m,peak_force_N,model_disp_rms_err_m,"
           "model_force_err_N,model_force_err_rel,energy_ratio_end,status\n");
   fprintf(steps_csv, "E_Pa,solver,step,iterations,converged,ms\n");
@@ -589,8 +610,8 @@ int main(int argc, char** argv) {
 #ifndef MICA_STUDY_HAVE_WARM_START
   printf("# this libmica's mica_world_def has no warm_start: the warm-start axis is skipped\n");
 #endif
-  printf("%-10s %-5s %8s %6s %6s %3s %8s %8s %8s %8s %10s %10s %9s  %s\n", "group", "solver", "tol", "cap", "dt",
-         "n", "E", "med ms", "p95 ms", "iters", "rms err m", "F err N", "pen mm", "status");
+  printf("%-10s %-6s %-12s %8s %6s %6s %3s %8s %8s %8s %8s %8s %10s %10s %9s  %s\n", "group", "solver", "model", "tol",
+         "cap", "dt", "n", "E", "med ms", "p95 ms", "cpu ms", "iters", "rms err m", "F err N", "pen mm", "status");
   double total = 0, done = 0;
   for (int i = 0; i < nplan; ++i) total += cost(&plan[i]);
   for (int i = 0; i < nplan; ++i) {
@@ -622,13 +643,16 @@ int main(int argc, char** argv) {
     fprintf(csv, "%s,%s,%.3g,%d,%.4g,%d,%d,%d,%s,%s,%d,%d,%d,%.3g,%d", c->group, SOLVER_NAME(c->solver),
             c->solver == MICA_SOLVER_DIRECT ? 0.0 : c->tol, c->solver == MICA_SOLVER_DIRECT ? 0 : c->cap, c->dt,
             c->cells, res.nodes, res.tets,
-            c->model == MICA_MODEL_LINEAR ? "linear" : c->model == MICA_MODEL_NEO_HOOKEAN ? "neo-hookean" : "corotational",
+            model_name(c->model),
             c->mass == MICA_MASS_LUMPED ? "lumped" : "consistent", c->warm, c->pgs, c->paper, c->E, res.steps);
     fmt(csv, res.ms_median);
     fmt(csv, res.ms_p95);
     fmt(csv, res.ms_mean);
+    fmt(csv, res.cpu_median);
+    fmt(csv, res.cpu_p95);
     fmt(csv, res.iters_mean);
     fmt(csv, res.iters_max);
+    fmt(csv, res.solves_mean);
     fprintf(csv, ",%d", res.not_converged);
     fmt(csv, res.disp_rms);
     fmt(csv, res.disp_rms_rel);
@@ -644,10 +668,10 @@ int main(int argc, char** argv) {
     fmt(csv, res.energy_ratio);
     fprintf(csv, ",%s\n", status);
     fflush(csv);
-    printf("%-10s %-5s %8.0e %6d %6.4f %3d %8.0e %8.3f %8.3f %8.1f %10.3g %10.3g %9.4f  %s\n", c->group,
-           SOLVER_NAME(c->solver), c->solver == MICA_SOLVER_DIRECT ? 0.0 : c->tol,
+    printf("%-10s %-6s %-12s %8.0e %6d %6.4f %3d %8.0e %8.3f %8.3f %8.3f %8.1f %10.3g %10.3g %9.4f  %s\n", c->group,
+           SOLVER_NAME(c->solver), model_name(c->model), c->solver == MICA_SOLVER_DIRECT ? 0.0 : c->tol,
            c->solver == MICA_SOLVER_DIRECT ? 0 : c->cap, c->dt, c->cells, c->E, res.ms_median, res.ms_p95,
-           res.iters_mean, res.disp_rms, res.force_err, 1e3 * res.penetration, status);
+           res.cpu_median, res.iters_mean, res.disp_rms, res.force_err, 1e3 * res.penetration, status);
     fflush(stdout);
     done += cost(c);
     study_progress(done, total);

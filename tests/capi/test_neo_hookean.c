@@ -17,6 +17,7 @@
 
 #include "capi_ok.h"
 #include "node_selection.h"
+#include "uniaxial_scene.h"
 
 /* ------------------------------------------------------------------------------------------ */
 /* Helpers                                                                                     */
@@ -83,64 +84,23 @@ static mica_lpc_id add_plane_lpc(mica_world* w, mica_body_id b, const double poi
   return id;
 }
 
-/* The stable neo-Hookean parameters of E and nu (src/fem/neo_hookean.hpp): mu = mu_L,
- * lambda = lambda_L + mu_L, alpha = 1 + mu / lambda. */
-typedef struct snh {
-  double mu, lambda, alpha;
-} snh;
-
-static snh snh_of(double E, double nu) {
-  snh p;
-  const double lame = E * nu / ((1 + nu) * (1 - 2 * nu));
-  p.mu = E / (2 * (1 + nu));
-  p.lambda = lame + p.mu;
-  p.alpha = 1 + p.mu / p.lambda;
-  return p;
-}
-
-/* Uniaxial stress at axial stretch s: F = diag(t, t, s), J = t^2 s, P = mu F + lambda (J - alpha)
- * cof F with cof F = diag(t s, t s, t^2). The lateral stretch t solves P_xx = mu t + lambda (t^2 s
- * - alpha) t s = 0 by a 1D Newton iteration; returns the nominal stress P_zz (Pa). */
-static double uniaxial_nominal_stress(const snh* p, double s, double* lateral) {
-  double t = 1;
-  for (int it = 0; it < 50; ++it) {
-    const double g = p->mu * t + p->lambda * (t * t * s - p->alpha) * t * s;
-    const double dg = p->mu + p->lambda * (3 * t * t * s - p->alpha) * s;
-    const double step = g / dg;
-    t -= step;
-    if (fabs(step) < 1e-15) break;
-  }
-  if (lateral) *lateral = t;
-  return p->mu * s + p->lambda * (t * t * s - p->alpha) * t * t;
-}
-
 /* ------------------------------------------------------------------------------------------ */
 /* Uniaxial compression                                                                        */
 
-/* A cube of side L on frictionless ends (the base and the top slide in their planes; the planes
- * x = 0 and y = 0 are symmetry planes), compressed by its top plate in 5 % increments to 30 %,
- * each held until the body is at rest (h = 1 s: the mass is 1e-3 of the stiffness, so each step
- * is a Newton step of the static problem). The deformation is homogeneous, which linear tets
- * represent exactly: the plate's reaction over the rest area must be the closed-form nominal
- * stress, at every increment, on a coarse and a fine mesh. */
+/* A cube of side L on frictionless ends (scenes/uniaxial_scene.h: the base and the top slide in
+ * their planes; the planes x = 0 and y = 0 are symmetry planes), compressed by its top plate in
+ * 5 % increments to 30 %, each held until the body is at rest (h = 1 s: the mass is 1e-3 of the
+ * stiffness, so each step is a Newton step of the static problem). The deformation is
+ * homogeneous, which linear tets represent exactly: the plate's reaction over the rest area must
+ * be the closed-form nominal stress, at every increment, on a coarse and a fine mesh. */
 static void compress_cube(int32_t cells, int32_t solver, double* worst_error) {
-  const double L = 0.1, E = 1e4, nu = 0.45;
   mica_world* w = make_world(solver);
-  mica_body_def bd = mica_body_def_default();
-  bd.model = MICA_MODEL_NEO_HOOKEAN;
-  bd.youngs_modulus = E;
-  bd.poisson_ratio = nu;
-  const double lo[3] = {0, 0, 0}, hi[3] = {L, L, L};
-  const int32_t c[3] = {cells, cells, cells};
-  mica_body_id b = MICA_NULL_ID;
-  OK(w, mica_body_create_box(w, &bd, lo, hi, c, 6, &b));
-  const double o[3] = {0, 0, 0}, ex[3] = {1, 0, 0}, ey[3] = {0, 1, 0}, ez[3] = {0, 0, 1}, top[3] = {0, 0, L};
-  add_plane_lpc(w, b, o, ex, MICA_LPC_PLANE);
-  add_plane_lpc(w, b, o, ey, MICA_LPC_PLANE);
-  add_plane_lpc(w, b, o, ez, MICA_LPC_PLANE);
-  const double minus_ez[3] = {0, 0, -1};
-  const mica_lpc_id plate = add_plane_lpc(w, b, top, minus_ez, MICA_LPC_PLANE);  /* selects z >= L */
-  const snh p = snh_of(E, nu);
+  uniaxial_scene_def def = uniaxial_scene_def_default();
+  def.body.model = MICA_MODEL_NEO_HOOKEAN;
+  def.cells = cells;
+  const double L = def.side, E = def.body.youngs_modulus, nu = def.body.poisson_ratio;
+  uniaxial_scene sc;
+  OK(w, uniaxial_scene_create(w, &def, &sc));
   const double h = 1.0;
   int32_t warned = 0;
   *worst_error = 0;
@@ -148,38 +108,27 @@ static void compress_cube(int32_t cells, int32_t solver, double* worst_error) {
          cells, E, nu);
   for (int inc = 1; inc <= 6; ++inc) {
     const double v[3] = {0, 0, -0.05 * L / h};
-    OK(w, mica_lpc_set_velocity(w, plate, v));
+    OK(w, mica_lpc_set_velocity(w, sc.plate, v));
     mica_status st = mica_step(w, h);
     warned += st == MICA_WARN_NOT_CONVERGED;
     OK(w, st);
     const double still[3] = {0, 0, 0};
-    OK(w, mica_lpc_set_velocity(w, plate, still));
+    OK(w, mica_lpc_set_velocity(w, sc.plate, still));
     for (int k = 0; k < 6; ++k) {
       st = mica_step(w, h);
       warned += st == MICA_WARN_NOT_CONVERGED;
       OK(w, st);
     }
     /* The stretches the body reached: the top's height, the far side's width. */
-    int32_t n = 0;
-    double* x = positions(w, b, &n);
-    double height = 0, width = 0;
-    for (int32_t i = 0; i < n; ++i) {
-      height = fmax(height, x[3 * i + 2]);
-      width = fmax(width, x[3 * i]);
-    }
-    free(x);
-    const double s = height / L;
-    double t = 0;
-    const double want = uniaxial_nominal_stress(&p, s, &t);
-    double f[3];
-    OK(w, mica_lpc_get_reaction(w, plate, f));
-    const double got = -f[2] / (L * L); /* the plate feels the body push it up */
+    double s = 0, width = 0, got = 0, t = 0;
+    OK(w, uniaxial_scene_measure(w, &sc, &s, &width, &got));
+    const double want = uniaxial_neo_hookean_nominal_stress(E, nu, s, &t);
     const double err = fabs(got - want) / fabs(want);
     *worst_error = fmax(*worst_error, err);
-    printf("  %4.0f %%  %.5f  %12.4f  %16.4f  %.2e  %.6f / %.6f\n", 100 * (1 - s), s, got, want, err, width / L, t);
+    printf("  %4.0f %%  %.5f  %12.4f  %16.4f  %.2e  %.6f / %.6f\n", 100 * (1 - s), s, got, want, err, width, t);
     assert_true(fabs(s - (1 - 0.05 * inc)) < 1e-9);
     assert_true(err < 0.01);
-    assert_true(fabs(width / L - t) < 1e-3 * t);
+    assert_true(fabs(width - t) < 1e-3 * t);
   }
   printf("  steps that reported MICA_WARN_NOT_CONVERGED: %d of %d\n", warned, 6 * 7);
   mica_world_destroy(w);
