@@ -362,6 +362,8 @@ def anchors(rows, curve, out):
     fig, (ax_c, ax_f) = plt.subplots(1, 2, figsize=(13, 5), dpi=110)
     labels = []
     for test, model, colour, marker in (("hertz", "linear", "tab:red", "o"),
+                                        ("hertz", "corotational", "tab:orange", "D"),
+                                        ("hertz", "neo-hookean", "tab:brown", "P"),
                                         ("cantilever", "linear", "tab:blue", "s"),
                                         ("cantilever", "corotational", "tab:cyan", "^"),
                                         ("cantilever", "neo-hookean", "tab:purple", "v")):
@@ -370,7 +372,7 @@ def anchors(rows, curve, out):
         pts = [p for p in pts if fin(p[1])]
         if not pts:
             continue
-        label = ("Hertz force, h = cell size at the contact edge" if test == "hertz"
+        label = (f"Hertz force ({model}), h = cell size at the contact edge" if test == "hertz"
                  else f"cantilever tip ({model}), h = H / n")
         ax_c.loglog([p[0] for p in pts], [p[1] for p in pts], marker=marker, color=colour, label=label)
         for h, e, s in pts:
