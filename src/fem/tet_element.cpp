@@ -174,29 +174,11 @@ MICA_AVX2 void add_elements4_avx2(const TetElement* const e[4], const Lame* cons
                                    Mat3* K, Vec3List& f) {
   __m256d Rl[9], dm[9], g[4][3];
   load_matrices(R, Rl);
-  {
-    __m256d rows[12];  // grad's 12 entries (std::array<Vec3, 4>, contiguous) in three rows of 4
-    for (int q = 0; q < 3; ++q) {
-      const double* p[4];
-      for (int l = 0; l < 4; ++l) p[l] = e[l]->grad[0].data() + 4 * q;
-      load_lanes4(p, rows + 4 * q);
-    }
-    for (int a = 0; a < 4; ++a)
-      for (int i = 0; i < 3; ++i) g[a][i] = rows[3 * a + i];
-  }
+  load_gradients(e, g);
   for (int k = 0; k < 3; ++k)  // Dm^-1's rows are g_1, g_2, g_3 (make_tet_element): no loads of their own
     for (int j = 0; j < 3; ++j) dm[3 * j + k] = g[k + 1][j];
   __m256d ds[9];  // Ds = [x1 - x0, x2 - x0, x3 - x0]
-  for (int k = 0; k < 3; ++k) {
-    __m128d xy[4];  // element l's column k
-    double z[4];
-    for (int l = 0; l < 4; ++l) {
-      const double *xk = x[e[l]->nodes[k + 1]].data(), *x0 = x[e[l]->nodes[0]].data();
-      xy[l] = _mm_sub_pd(_mm_loadu_pd(xk), _mm_loadu_pd(x0));
-      z[l] = xk[2] - x0[2];
-    }
-    vectors_to_lanes(xy, z, ds + 3 * k);
-  }
+  edge_lanes(e, x, ds);
   const __m256d volume = _mm256_setr_pd(e[0]->volume, e[1]->volume, e[2]->volume, e[3]->volume);
   const __m256d lambda = _mm256_setr_pd(m[0]->lambda, m[1]->lambda, m[2]->lambda, m[3]->lambda);
   const __m256d mu = _mm256_setr_pd(m[0]->mu, m[1]->mu, m[2]->mu, m[3]->mu);
