@@ -8,11 +8,18 @@
 
 namespace mica {
 
+// How a sparse factor of a pattern orders its unknowns to limit fill (DirectSolver::analyze).
+enum class FillOrdering : uint8_t {
+  LeastFill,  // AMD or nested dissection (CHOLMOD's NESDIS over METIS), whichever fills less
+  Amd         // AMD alone: for a pattern that must be factored within a step (a body just cut)
+};
+
 struct BlockPattern {
   int32_t rows = 0;
   std::vector<int32_t> row_start;  // rows + 1 offsets into col
   std::vector<int32_t> col;        // block column of each stored block, sorted per row
   std::vector<int32_t> diag;       // index of block (i, i) per row
+  FillOrdering fill_ordering = FillOrdering::LeastFill;
 
   size_t block_count() const { return col.size(); }
   // Index of block (i, j) or -1 when it is not stored.

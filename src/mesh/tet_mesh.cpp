@@ -3,11 +3,51 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "core/error.hpp"
 
 namespace mica {
+
+namespace {
+
+// Outward faces of a positively oriented tet (a, b, c, d).
+constexpr int kFace[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
+
+struct TetFace {
+  Tri nodes;    // sorted: equal for the two tets that share the face
+  int32_t tet;
+  int32_t face;  // which of the tet's faces (kFace)
+};
+
+// Every tet's four faces, ordered by their sorted nodes and then by tet: the two sides of an
+// interior face side by side. Placed by first node (counting), then sorted within each node's few:
+// a sort of the whole took 2.6 ms on the nidus's 38672 faces, which a cut's rebuild does twice.
+std::vector<TetFace> sorted_faces(const TetMesh& mesh) {
+  std::vector<int32_t> start(mesh.nodes.size() + 1, 0);
+  for (const Tet& t : mesh.tets)
+    for (const auto& f : kFace) ++start[size_t(std::min({t[f[0]], t[f[1]], t[f[2]]})) + 1];
+  for (size_t i = 1; i < start.size(); ++i) start[i] += start[i - 1];
+  std::vector<TetFace> faces(4 * mesh.tets.size());
+  std::vector<int32_t> next(start.begin(), start.end() - 1);
+  for (size_t e = 0; e < mesh.tets.size(); ++e)
+    for (int32_t f = 0; f < 4; ++f) {
+      const Tet& t = mesh.tets[e];
+      TetFace face{{t[kFace[f][0]], t[kFace[f][1]], t[kFace[f][2]]}, int32_t(e), f};
+      std::sort(face.nodes.begin(), face.nodes.end());
+      faces[size_t(next[size_t(face.nodes[0])]++)] = face;
+    }
+  const auto before = [](const TetFace& a, const TetFace& b) {
+    return a.nodes != b.nodes ? a.nodes < b.nodes : a.tet != b.tet ? a.tet < b.tet : a.face < b.face;
+  };
+  for (size_t i = 0; i + 1 < start.size(); ++i) std::sort(faces.begin() + start[i], faces.begin() + start[i + 1], before);
+  return faces;
+}
+
+}  // namespace
 
 double signed_volume(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
   return (b - a).dot((c - a).cross(d - a)) / 6.0;
@@ -43,24 +83,7 @@ void validate_topology(const TetMesh& mesh, const std::string& source) {
   // Faces: in a valid mesh each is shared by at most two tets, and some belong to one (the
   // surface, which collision and contact need). A tet listed twice shares all four faces with
   // its copy and leaves no surface at all.
-  struct Face {
-    Tri nodes;    // sorted
-    int32_t tet;  // the first tet that has it
-  };
-  std::vector<Face> faces;
-  faces.reserve(4 * mesh.tets.size());
-  for (size_t e = 0; e < mesh.tets.size(); ++e) {
-    const Tet& t = mesh.tets[e];
-    for (int skip = 0; skip < 4; ++skip) {
-      Face f{{}, int32_t(e)};
-      for (int a = 0, k = 0; a < 4; ++a)
-        if (a != skip) f.nodes[k++] = t[a];
-      std::sort(f.nodes.begin(), f.nodes.end());
-      faces.push_back(f);
-    }
-  }
-  std::sort(faces.begin(), faces.end(),
-            [](const Face& a, const Face& b) { return a.nodes != b.nodes ? a.nodes < b.nodes : a.tet < b.tet; });
+  const std::vector<TetFace> faces = sorted_faces(mesh);
   bool boundary = false;
   for (size_t i = 0; i < faces.size();) {
     size_t j = i + 1;
@@ -111,27 +134,16 @@ QualityReport check_rest_quality(const TetMesh& mesh, const std::string& source,
 }
 
 std::vector<Tri> extract_surface(const TetMesh& mesh) {
-  // Outward faces of a positively oriented tet (a, b, c, d).
-  static const int kFace[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
-  struct Face {
-    Tri key;  // sorted nodes: equal for the two sides of an interior face
-    Tri tri;  // oriented nodes
-  };
-  std::vector<Face> faces;
-  faces.reserve(4 * mesh.tets.size());
-  for (const Tet& t : mesh.tets) {
-    for (const auto& f : kFace) {
-      Face face{{t[f[0]], t[f[1]], t[f[2]]}, {t[f[0]], t[f[1]], t[f[2]]}};
-      std::sort(face.key.begin(), face.key.end());
-      faces.push_back(face);
-    }
-  }
-  std::sort(faces.begin(), faces.end(), [](const Face& a, const Face& b) { return a.key < b.key; });
+  const std::vector<TetFace> faces = sorted_faces(mesh);
   std::vector<Tri> surface;
   for (size_t i = 0; i < faces.size();) {
     size_t j = i + 1;
-    while (j < faces.size() && faces[j].key == faces[i].key) ++j;
-    if (j - i == 1) surface.push_back(faces[i].tri);
+    while (j < faces.size() && faces[j].nodes == faces[i].nodes) ++j;
+    if (j - i == 1) {
+      const Tet& t = mesh.tets[size_t(faces[i].tet)];
+      const int* f = kFace[faces[i].face];
+      surface.push_back({t[f[0]], t[f[1]], t[f[2]]});
+    }
     i = j;
   }
   return surface;

@@ -127,13 +127,15 @@ void DirectSolver::analyze(const BlockPattern& pattern, const Projection* projec
   // where NESDIS has 10.5 % fewer nonzeros in L and 27 % fewer flops (bench_factor); on a
   // 35k-tet cube the memory after the first step fell 5073 -> 4775 B per tet (bench_nidus
   // --scaling). NESDIS takes ~20 ms on the nidus, so a new held set (a grasp) is analysed with
-  // this ordering given (~5 ms). All of it is deterministic: a restored state factors the same bits.
+  // this ordering given (~5 ms), and a pattern marked FillOrdering::Amd (a body just cut, whose
+  // next step must factor) skips it: that step's p99 on the nidus incision fell 47 -> 35 ms
+  // (bench_incision). All of it is deterministic: a restored state factors the same bits.
   const bool any_held = std::find(held_.begin(), held_.end(), 1) != held_.end();
   bool whole_analysed = false;
   if (ordering_.size() != size_t(3 * pattern.rows)) {
     whole_analysed = true;
     build_lower(pattern, false);
-    common.nmethods = 2;
+    common.nmethods = pattern.fill_ordering == FillOrdering::Amd ? 1 : 2;
     common.method[0].ordering = CHOLMOD_AMD;
     common.method[1].ordering = CHOLMOD_NESDIS;
     llt_.analyzePattern(lower_);

@@ -4,7 +4,15 @@
 namespace mica {
 
 BodyModel::BodyModel(const TetMesh& mesh, const BodySettings& s, const std::string& body_name, uint64_t body_key)
-    : settings(s), name(body_name), key(body_key), fem(build_fem_model(mesh, s.material, s.mass, body_name)),
+    : BodyModel(mesh, build_fem_model(mesh, s.material, s.mass, body_name), s, body_name, body_key) {}
+
+BodyModel::BodyModel(const TetMesh& mesh, const std::vector<Material>& materials, const BodySettings& s,
+                     const std::string& body_name, uint64_t body_key)
+    : BodyModel(mesh, build_fem_model(mesh, materials, s.mass, body_name), s, body_name, body_key) {}
+
+BodyModel::BodyModel(const TetMesh& mesh, FemModel&& model, const BodySettings& s, const std::string& body_name,
+                     uint64_t body_key)
+    : settings(s), name(body_name), key(body_key), fem(std::move(model)),
       tets(mesh.tets), regions(mesh.regions.empty() ? std::vector<int32_t>(mesh.tets.size(), 0) : mesh.regions),
       cutting_resistance(mesh.tets.size(), kDefaultCuttingResistance),
       surface(extract_surface(mesh)),
@@ -43,5 +51,9 @@ BodyScratch::BodyScratch(const BodyModel& model) {
 
 Body::Body(const TetMesh& mesh, const BodySettings& settings, const std::string& name, uint64_t key)
     : BodyModel(mesh, settings, name, key), BodyState(model()), BodyScratch(model()) {}
+
+Body::Body(const TetMesh& mesh, const std::vector<Material>& materials, const BodySettings& settings,
+           const std::string& name, uint64_t key)
+    : BodyModel(mesh, materials, settings, name, key), BodyState(model()), BodyScratch(model()) {}
 
 }  // namespace mica

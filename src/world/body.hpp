@@ -36,6 +36,9 @@ struct BodySettings {
 // What the body was made with.
 struct BodyModel {
   BodyModel(const TetMesh& mesh, const BodySettings& settings, const std::string& name, uint64_t key);
+  // With a material per tet (a body whose tets changed keeps each one's).
+  BodyModel(const TetMesh& mesh, const std::vector<Material>& materials, const BodySettings& settings,
+            const std::string& name, uint64_t key);
 
   BodySettings settings;
   std::string name;            // "body 0x..." in messages
@@ -54,6 +57,10 @@ struct BodyModel {
 
   bool is_dynamic() const { return !settings.is_static; }
   bool has_damping() const { return settings.rayleigh_alpha != 0 || settings.rayleigh_beta != 0; }
+
+ private:
+  BodyModel(const TetMesh& mesh, FemModel&& model, const BodySettings& settings, const std::string& name,
+            uint64_t key);
 };
 
 // What a step starts from and leaves.
@@ -124,6 +131,8 @@ struct BodyScratch {
 
 struct Body : BodyModel, BodyState, BodyScratch {
   Body(const TetMesh& mesh, const BodySettings& settings, const std::string& name, uint64_t key);
+  Body(const TetMesh& mesh, const std::vector<Material>& materials, const BodySettings& settings,
+       const std::string& name, uint64_t key);
   const BodyModel& model() const { return *this; }
   const std::vector<Mat3>& rotations() const {
     return rotations_in == RotationsIn::End ? end.R : rotations_in == RotationsIn::NextEnd ? next_end.R : own_R;
