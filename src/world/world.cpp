@@ -161,6 +161,7 @@ void World::set_body_materials(Id id, const std::vector<Material>& materials) {
   Body& b = body(id);
   TetMesh mesh{b.fem.rest, b.tets, b.regions};
   FemModel rebuilt = build_fem_model(mesh, materials, b.settings.mass, b.name);  // may throw: nothing changed yet
+  rebuilt.pattern.fill_ordering = b.fem.pattern.fill_ordering;  // a cut body's stays AMD's
   solver_->forget(b.key);  // its factors (one may be in the making on the body's pattern) first
   b.fem = std::move(rebuilt);
   b.matrix_current = false;  // A and everything factored from it belong to the old materials
