@@ -86,6 +86,17 @@ typedef struct {
 static double g_kappa = 4.0, g_W = HERTZ_W;
 static int g_trace = 0;
 
+/* A world with the exact solver and gravity gz along z (m/s^2). */
+static mica_world* direct_world(double gz) {
+  mica_world_def wd = mica_world_def_default();
+  wd.gravity[0] = wd.gravity[1] = 0;
+  wd.gravity[2] = gz;
+  wd.solver = MICA_SOLVER_DIRECT;
+  mica_world* w = NULL;
+  mica_world_create(&wd, &w);
+  return w;
+}
+
 static level_result hertz_level(int cells, int32_t model, FILE* curve) {
   level_result r;
   memset(&r, 0, sizeof r);
@@ -125,11 +136,7 @@ static level_result hertz_level(int cells, int32_t model, FILE* curve) {
           }
         }
       }
-  mica_world_def wd = mica_world_def_default();
-  wd.gravity[0] = wd.gravity[1] = wd.gravity[2] = 0;
-  wd.solver = MICA_SOLVER_DIRECT;
-  mica_world* w = NULL;
-  mica_world_create(&wd, &w);
+  mica_world* w = direct_world(0);
   mica_body_def bd = mica_body_def_default();
   bd.youngs_modulus = HERTZ_E;
   bd.poisson_ratio = HERTZ_NU;
@@ -218,12 +225,7 @@ static level_result beam_level(int n, int model) {
   level_result r;
   memset(&r, 0, sizeof r);
   const double L = 0.2, H = 0.02, E = 1e7, nu = 0.3, rho = 1000, g = 9.81;
-  mica_world_def wd = mica_world_def_default();
-  wd.gravity[0] = wd.gravity[1] = 0;
-  wd.gravity[2] = -g;
-  wd.solver = MICA_SOLVER_DIRECT;
-  mica_world* w = NULL;
-  mica_world_create(&wd, &w);
+  mica_world* w = direct_world(-g);
   mica_body_def bd = mica_body_def_default();
   bd.youngs_modulus = E;
   bd.poisson_ratio = nu;
@@ -276,11 +278,7 @@ static level_result beam_level(int n, int model) {
 /* The uniaxial compression of one model: a row of uniaxial.csv per increment. Returns the
  * largest |error| against the neo-Hookean closed form, NAN when a step failed. */
 static double uniaxial_run(int32_t model, int32_t cells, FILE* csv) {
-  mica_world_def wd = mica_world_def_default();
-  wd.gravity[0] = wd.gravity[1] = wd.gravity[2] = 0;
-  wd.solver = MICA_SOLVER_DIRECT;
-  mica_world* w = NULL;
-  mica_world_create(&wd, &w);
+  mica_world* w = direct_world(0);
   uniaxial_scene_def def = uniaxial_scene_def_default();
   def.body.model = model;
   def.cells = cells;
