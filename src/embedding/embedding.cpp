@@ -1,12 +1,14 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "embedding/embedding.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <string>
 
 #include "core/error.hpp"
 #include "embedding/surface_projection.hpp"
+#include "embedding/place_vertices.hpp"
 #include "embedding/tet_locator.hpp"
 #include "embedding/vertex_normals.hpp"
 #include "world/topology_change.hpp"
@@ -84,39 +86,53 @@ Embedding::Embedding(uint64_t body, const Vec3List& rest, const std::vector<Tet>
                      const int32_t* triangles, int32_t triangle_count, double radius)
     : body_(body), node_count_(int32_t(rest.size())), tet_count_(int32_t(tets.size())), radius_(radius) {
   check_input(xyz, vertex_count, triangles, triangle_count, radius);
+  plan_ = plan_normals(triangles, triangle_count, vertex_count);
   Binder binder(rest, tets, surface, radius);
   bindings_.resize(size_t(vertex_count));
   tet_.resize(size_t(vertex_count));
   kinds_.resize(size_t(vertex_count));
   rest_xyz_.assign(xyz, xyz + 3 * size_t(vertex_count));
-  for (int32_t i = 0; i < vertex_count; ++i) {
-    const Vec3 p(xyz[3 * size_t(i)], xyz[3 * size_t(i) + 1], xyz[3 * size_t(i) + 2]);
+  for (size_t j = 0; j < plan_.order.size(); ++j) {
+    const size_t i = size_t(plan_.order[j]);
+    const Vec3 p(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
     Weights w;
     VertexKind kind;
     const int32_t e = binder.bind(p, w, kind);
-    set_binding(bindings_[size_t(i)], e, tets, w);
-    tet_[size_t(i)] = e;
-    kinds_[size_t(i)] = int32_t(kind);
+    set_binding(bindings_[j], e, tets, w);
+    tet_[i] = e;
+    kinds_[i] = int32_t(kind);
     ++counts_[size_t(kind)];
   }
-  triangles_.assign(triangles, triangles + 3 * size_t(triangle_count));
 }
 
 void Embedding::update(const Vec3List& x, double* out_xyz, double* out_normals) const {
   if (int32_t(x.size()) != node_count_)
     fail(Errc::WrongState, "the body has " + std::to_string(x.size()) + " nodes, " + std::to_string(node_count_) +
                                " when the embedding was made");
-  const size_t n = bindings_.size();
-  for (size_t i = 0; i < n; ++i) {
-    const Binding& b = bindings_[i];
-    if (b.nodes[0] < 0) continue;  // unbound: the host's value stays
-    const double *x0 = x[size_t(b.nodes[0])].data(), *x1 = x[size_t(b.nodes[1])].data(),
-                 *x2 = x[size_t(b.nodes[2])].data(), *x3 = x[size_t(b.nodes[3])].data();
-    const double w0 = b.weights[0], w1 = b.weights[1], w2 = b.weights[2], w3 = b.weights[3];
-    double* out = out_xyz + 3 * i;
-    for (int a = 0; a < 3; ++a) out[a] = w0 * x0[a] + w1 * x1[a] + w2 * x2[a] + w3 * x3[a];
+  const NormalsPlan& p = plan_;
+  const int32_t* order = p.order.data();
+  if (!out_normals) return place_vertices(bindings_.data(), order, 0, vertex_count(), x, out_xyz, nullptr);
+  // Block by block (normals_plan.hpp): place what a block uses first and clear its normals, sum the
+  // block's triangles, normalise what it uses last. The vertices in no triangle come first.
+  place_vertices(bindings_.data(), order, 0, p.first_start[0], x, out_xyz, out_normals);
+  for (int32_t k = 0; k < p.blocks(); ++k) {
+    place_vertices(bindings_.data(), order, p.first_start[size_t(k)], p.first_start[size_t(k) + 1], x, out_xyz,
+                   out_normals);
+    // The triangles in parts, each part followed by a part of the next block's prefetch: the memory
+    // the next placing needs comes in while the sums here are computed.
+    const int32_t begin = p.block_start[size_t(k)], end = p.block_start[size_t(k) + 1];
+    const int32_t next = k + 1 < p.blocks() ? p.first_start[size_t(k) + 1] : 0;
+    const int32_t next_count = k + 1 < p.blocks() ? p.first_start[size_t(k) + 2] - next : 0;
+    constexpr int32_t kParts = 8;
+    for (int32_t part = 0; part < kParts; ++part) {
+      const int32_t t0 = begin + (end - begin) * part / kParts, t1 = begin + (end - begin) * (part + 1) / kParts;
+      add_triangle_normals(out_xyz, p.corners.data() + 3 * size_t(t0), t1 - t0, 3 * vertex_count(), out_normals);
+      prefetch_placement(bindings_.data(), order, next + next_count * part / kParts,
+                         next + next_count * (part + 1) / kParts, out_xyz, out_normals);
+    }
+    normalize_listed(out_normals, p.last.data() + p.last_start[size_t(k)],
+                     p.last_start[size_t(k) + 1] - p.last_start[size_t(k)]);
   }
-  if (out_normals) vertex_normals(out_xyz, vertex_count(), triangles_.data(), triangle_count(), out_normals);
 }
 
 Embedding::FollowReport Embedding::follow(const TopologyChange& change, const Vec3List& rest,
@@ -145,11 +161,12 @@ Embedding::FollowReport Embedding::follow(const TopologyChange& change, const Ve
   std::vector<int32_t> tet = tet_, kinds = kinds_;
   std::array<int32_t, 3> counts = counts_;
   std::unique_ptr<Binder> binder;  // made for the first vertex whose tet went
-  for (size_t i = 0; i < bindings.size(); ++i) {
+  for (size_t j = 0; j < bindings.size(); ++j) {
+    const size_t i = size_t(plan_.order[j]);  // binding j is vertex i's
     if (tet[i] < 0) continue;  // unbound stays unbound
     const int32_t e = now[size_t(tet[i])];
     if (e >= 0) {  // the tet stays: same weights (same rest shape, corners in the same order), new nodes
-      bindings[i].nodes = tets[size_t(e)];
+      bindings[j].nodes = tets[size_t(e)];
       tet[i] = e;
       ++report.followed;
       continue;
@@ -158,7 +175,7 @@ Embedding::FollowReport Embedding::follow(const TopologyChange& change, const Ve
     Weights w;
     VertexKind kind;
     const int32_t found = binder->bind(Vec3(rest_xyz_[3 * i], rest_xyz_[3 * i + 1], rest_xyz_[3 * i + 2]), w, kind);
-    set_binding(bindings[i], found, tets, w);
+    set_binding(bindings[j], found, tets, w);
     tet[i] = found;
     --counts[size_t(kinds[i])];
     kinds[i] = int32_t(kind);

@@ -10,6 +10,8 @@
 #include <vector>
 
 #include "core/types.hpp"
+#include "embedding/normals_plan.hpp"
+#include "embedding/place_vertices.hpp"
 
 namespace mica {
 
@@ -41,7 +43,7 @@ class Embedding {
   void set_topology_version(uint64_t version) { topology_version_ = version; }
   double radius() const { return radius_; }
   int32_t vertex_count() const { return int32_t(kinds_.size()); }
-  int32_t triangle_count() const { return int32_t(triangles_.size() / 3); }
+  int32_t triangle_count() const { return int32_t(plan_.corners.size() / 3); }
   const std::vector<int32_t>& kinds() const { return kinds_; }  // VertexKind values, per vertex
   int32_t count(VertexKind kind) const { return counts_[size_t(kind)]; }
   int32_t tet(int32_t vertex) const { return tet_[size_t(vertex)]; }  // -1: unbound
@@ -76,22 +78,19 @@ class Embedding {
   void unbind_all(int32_t node_count, uint64_t topology_version) noexcept;
 
  private:
-  struct Binding {
-    std::array<int32_t, 4> nodes;  // the tet's nodes; nodes[0] < 0: unbound
-    std::array<double, 4> weights;
-  };
+  using Binding = VertexBinding;
 
   uint64_t body_;
   int32_t node_count_;
   int32_t tet_count_;              // the body's, at binding or at the last follow
   uint64_t topology_version_ = 0;  // set by the owner (the C layer) from the body's
   double radius_;
-  std::vector<Binding> bindings_;  // per vertex: all the update reads of it, 48 bytes
+  std::vector<Binding> bindings_;  // vertex plan_.order[j]'s in j: all the update reads of it, 48 bytes
   std::vector<int32_t> tet_;       // per vertex: its tet (-1: unbound), for follow()
   std::vector<double> rest_xyz_;   // the vertices as given, for binding again in follow()
   std::vector<int32_t> kinds_;
   std::array<int32_t, 3> counts_{};
-  std::vector<int32_t> triangles_;
+  NormalsPlan plan_;  // the triangles, in the order update() sums them
 };
 
 }  // namespace mica

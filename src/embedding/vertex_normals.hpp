@@ -1,16 +1,20 @@
 // SPDX-License-Identifier: Apache-2.0
-// Area-weighted vertex normals of a triangle mesh.
+// The two kernels of area-weighted vertex normals (the embedding's update runs them block by
+// block: normals_plan.hpp). Triangles are counter-clockwise seen from the side the normals point to.
 #pragma once
 #include <cstdint>
 
 namespace mica {
 
-// Writes into normals (3 per vertex) the unit sum of the normals of each vertex's triangles, each
-// weighted by its area (the sum of the triangles' cross products, normalised); a vertex whose
-// triangles have no area, or that is in no triangle, gets (0, 0, 0). Triangles are counter-clockwise
-// seen from the side the normals point to. Indices are not checked; `normals` must not overlap the
-// other arrays. Allocates nothing.
-void vertex_normals(const double* xyz, int32_t vertex_count, const int32_t* triangles, int32_t triangle_count,
-                    double* normals);
+// Adds each triangle's cross product (twice its area times its unit normal) to the normals of its
+// three corners. A triangle is three offsets, 3 v for its vertices v: its corners' coordinates
+// start at xyz + 3 v, their normals at normals + 3 v; `end` is 3 times the vertex count. Offsets are
+// not checked; normals must not overlap xyz. Allocates nothing.
+void add_triangle_normals(const double* xyz, const int32_t* corners, int32_t triangle_count, int32_t end,
+                          double* normals);
+
+// Scales the normals (3 per vertex) of the `count` listed vertices to unit length (a zero normal
+// stays zero).
+void normalize_listed(double* normals, const int32_t* vertices, int32_t count);
 
 }  // namespace mica

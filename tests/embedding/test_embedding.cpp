@@ -7,7 +7,6 @@
 // and those of removed tets are bound again; after a cut every vertex follows its tet's copies.
 #include "embedding/embedding.hpp"
 #include "embedding/tet_locator.hpp"
-#include "embedding/vertex_normals.hpp"
 // malloc is counted too, except in a sanitizer build: the sanitizer owns malloc (replacing it
 // there aborts at start-up), and only operator new is counted.
 #if !defined(__SANITIZE_ADDRESS__) && !defined(__SANITIZE_THREAD__)
@@ -147,15 +146,13 @@ static void test_rigid_motion_moves_the_mesh_rigidly(void**) {
   Vec3List x = b.mesh.nodes;
   for (Vec3& p : x) p = R * p + t;
   std::vector<double> out = m.xyz, normals(m.xyz.size());
-  std::vector<double> rest_normals(m.xyz.size());
-  vertex_normals(m.xyz.data(), m.count(), m.triangles.data(), int32_t(m.triangles.size() / 3), rest_normals.data());
+  const Vec3List rest_normals = reference_normals(m.xyz, m.triangles);
   e.update(x, out.data(), normals.data());
   for (int32_t i = 0; i < m.inside + m.near; ++i) {
     const Vec3 p(out[3 * size_t(i)], out[3 * size_t(i) + 1], out[3 * size_t(i) + 2]);
     assert_near((p - (R * m.vertex(i) + t)).norm(), 0.0, 1e-12);
     const Vec3 n(normals[3 * size_t(i)], normals[3 * size_t(i) + 1], normals[3 * size_t(i) + 2]);
-    const Vec3 n0(rest_normals[3 * size_t(i)], rest_normals[3 * size_t(i) + 1], rest_normals[3 * size_t(i) + 2]);
-    assert_near((n - R * n0).norm(), 0.0, 1e-9);
+    assert_near((n - R * rest_normals[size_t(i)]).norm(), 0.0, 1e-9);
   }
 }
 

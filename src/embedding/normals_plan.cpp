@@ -1,0 +1,59 @@
+// SPDX-License-Identifier: Apache-2.0
+#include "embedding/normals_plan.hpp"
+
+#include <algorithm>
+
+namespace mica {
+
+namespace {
+
+// Lists per block (CSR) from each vertex's block (-1: none), ascending within a block.
+void bucket(const std::vector<int32_t>& block_of, int32_t blocks, std::vector<int32_t>& list,
+            std::vector<int32_t>& start) {
+  start.assign(size_t(blocks) + 1, 0);
+  for (int32_t b : block_of)
+    if (b >= 0) ++start[size_t(b) + 1];
+  for (int32_t k = 0; k < blocks; ++k) start[size_t(k) + 1] += start[size_t(k)];
+  list.resize(size_t(start.back()));
+  std::vector<int32_t> next(start.begin(), start.end() - 1);
+  for (size_t v = 0; v < block_of.size(); ++v)
+    if (block_of[v] >= 0) list[size_t(next[size_t(block_of[v])]++)] = int32_t(v);
+}
+
+}  // namespace
+
+NormalsPlan plan_normals(const int32_t* triangles, int32_t triangle_count, int32_t vertex_count,
+                         int32_t block_size) {
+  NormalsPlan plan;
+  const int32_t blocks = (triangle_count + block_size - 1) / block_size;
+  plan.corners.resize(3 * size_t(triangle_count));
+  plan.block_start.resize(size_t(blocks) + 1);
+  std::vector<int32_t> first(size_t(vertex_count), -1), last(size_t(vertex_count), -1);
+  int32_t out = 0;
+  for (int32_t k = 0; k < blocks; ++k) {
+    const int32_t begin = k * block_size, size = std::min(block_size, triangle_count - begin);
+    plan.block_start[size_t(k)] = begin;
+    const int32_t quarter = (size + 3) / 4;
+    for (int32_t i = 0; i < quarter; ++i)
+      for (int32_t q = 0; q < 4; ++q) {
+        const int32_t t = begin + q * quarter + i;
+        if (t >= begin + size) continue;
+        for (int c = 0; c < 3; ++c) {
+          const int32_t v = triangles[3 * size_t(t) + size_t(c)];
+          plan.corners[3 * size_t(out) + size_t(c)] = 3 * v;
+          if (first[size_t(v)] < 0) first[size_t(v)] = k;
+          last[size_t(v)] = k;
+        }
+        ++out;
+      }
+  }
+  plan.block_start[size_t(blocks)] = triangle_count;
+  // The vertices in no triangle as a block before the first.
+  for (int32_t& b : first) ++b;
+  bucket(first, blocks + 1, plan.order, plan.first_start);
+  plan.first_start.erase(plan.first_start.begin());
+  bucket(last, blocks, plan.last, plan.last_start);
+  return plan;
+}
+
+}  // namespace mica
