@@ -56,7 +56,7 @@ void follow_topology(mica_world* world, const mica::TopologyChange& change, cons
                   std::to_string(e.count(mica::VertexKind::Unbound)) + " of " + std::to_string(e.vertex_count()) +
                   " are unbound now, and mica_embedding_update leaves their positions as they are";
     } catch (...) {
-      e.unbind_all(int32_t(body.x.size()), change.topology_version);  // consistent, and says so
+      e.unbind_all(int32_t(body.x.size()), int32_t(body.tets.size()), change.topology_version);  // consistent, and says so
       try {
         message = "embedding " + decltype(world->embeddings)::hex(id) + " could not follow the change of its body's tets: all " +
                   std::to_string(e.vertex_count()) + " vertices are unbound (destroy it and embed again)";
@@ -169,7 +169,7 @@ MICA_API mica_status mica_embedding_update(const mica_world* world, mica_embeddi
       refuse(MICA_ERR_INTERNAL, "the embedding is of the body's tets at topology version " +
                                     std::to_string(e.topology_version()) + ", the body is at " +
                                     std::to_string(b.topology_version));
-    e.update(b.x, out_xyz, out_normals);
+    e.update(b.x, b.tets, out_xyz, out_normals);
     return MICA_OK;
   });
 }

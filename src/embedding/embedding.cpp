@@ -68,15 +68,19 @@ class Binder {
   std::unique_ptr<SurfaceProjection> projection_;
 };
 
-template <class B>
-void set_binding(B& b, int32_t e, const std::vector<Tet>& tets, const Weights& w) {
-  if (e < 0) {
-    b.nodes = {-1, -1, -1, -1};
-    b.weights = {0, 0, 0, 0};
-  } else {
-    b.nodes = tets[size_t(e)];
-    b.weights = {w[0], w[1], w[2], w[3]};
-  }
+bool holds_last_node(const Tet& t, int32_t node_count) {
+  return std::find(t.begin(), t.end(), node_count - 1) != t.end();
+}
+
+// Vertex `vertex` bound to tet e (-1: unbound) of `tets`, over nodes 0..node_count-1.
+VertexBinding binding(int32_t vertex, int32_t e, const Weights& w, const std::vector<Tet>& tets, int32_t node_count) {
+  if (e < 0) return {{0, 0, 0}, -1, vertex, 0};
+  return {{w[0], w[1], w[2]}, e, vertex, holds_last_node(tets[size_t(e)], node_count)};
+}
+
+// Asks the cache for `bytes` from `from` on.
+void prefetch(const void* from, size_t bytes) {
+  for (size_t at = 0; at < bytes; at += 64) __builtin_prefetch(static_cast<const char*>(from) + at, 0, 3);
 }
 
 }  // namespace
@@ -87,6 +91,7 @@ Embedding::Embedding(uint64_t body, const Vec3List& rest, const std::vector<Tet>
     : body_(body), node_count_(int32_t(rest.size())), tet_count_(int32_t(tets.size())), radius_(radius) {
   check_input(xyz, vertex_count, triangles, triangle_count, radius);
   plan_ = plan_normals(triangles, triangle_count, vertex_count);
+  scratch_.resize(size_t(plan_.slots));
   Binder binder(rest, tets, surface, radius);
   bindings_.resize(size_t(vertex_count));
   tet_.resize(size_t(vertex_count));
@@ -98,40 +103,42 @@ Embedding::Embedding(uint64_t body, const Vec3List& rest, const std::vector<Tet>
     Weights w;
     VertexKind kind;
     const int32_t e = binder.bind(p, w, kind);
-    set_binding(bindings_[j], e, tets, w);
+    bindings_[j] = binding(int32_t(i), e, w, tets, node_count_);
     tet_[i] = e;
     kinds_[i] = int32_t(kind);
     ++counts_[size_t(kind)];
   }
 }
 
-void Embedding::update(const Vec3List& x, double* out_xyz, double* out_normals) const {
-  if (int32_t(x.size()) != node_count_)
-    fail(Errc::WrongState, "the body has " + std::to_string(x.size()) + " nodes, " + std::to_string(node_count_) +
-                               " when the embedding was made");
+void Embedding::update(const Vec3List& x, const std::vector<Tet>& tets, double* out_xyz, double* out_normals) const {
+  if (int32_t(x.size()) != node_count_ || int32_t(tets.size()) != tet_count_)
+    fail(Errc::WrongState, "the body has " + std::to_string(x.size()) + " nodes and " + std::to_string(tets.size()) +
+                               " tets, " + std::to_string(node_count_) + " and " + std::to_string(tet_count_) +
+                               " when the embedding was made or last followed it");
   const NormalsPlan& p = plan_;
-  const int32_t* order = p.order.data();
-  if (!out_normals) return place_vertices(bindings_.data(), order, 0, vertex_count(), x, out_xyz, nullptr);
-  // Block by block (normals_plan.hpp): place what a block uses first and clear its normals, sum the
-  // block's triangles, normalise what it uses last. The vertices in no triangle come first.
-  place_vertices(bindings_.data(), order, 0, p.first_start[0], x, out_xyz, out_normals);
+  const VertexBinding* b = bindings_.data();
+  if (!out_normals) return place_vertices(b, vertex_count(), tets, x, out_xyz);
+  // The vertices in no triangle, then block by block (normals_plan.hpp): place what a block uses
+  // first, into the scratch too; sum the block's triangles there; write the normals it uses last.
+  place_vertices(b, p.first_start[0], tets, x, out_xyz);
+  for (int32_t j = 0; j < p.first_start[0]; ++j) std::fill_n(out_normals + 3 * size_t(b[j].vertex), 3, 0.0);
+  NormalSlot* scratch = scratch_.data();
   for (int32_t k = 0; k < p.blocks(); ++k) {
-    place_vertices(bindings_.data(), order, p.first_start[size_t(k)], p.first_start[size_t(k) + 1], x, out_xyz,
-                   out_normals);
-    // The triangles in parts, each part followed by a part of the next block's prefetch: the memory
-    // the next placing needs comes in while the sums here are computed.
+    const int32_t first = p.first_start[size_t(k)], next = p.first_start[size_t(k) + 1];
+    place_vertices(b + first, next - first, tets, x, out_xyz, p.slot.data() + first, scratch);
+    // The sums in parts, each followed by a part of the next block's bindings asked for: reading
+    // them, which bounds the placing, overlaps the sums' arithmetic.
     const int32_t begin = p.block_start[size_t(k)], end = p.block_start[size_t(k) + 1];
-    const int32_t next = k + 1 < p.blocks() ? p.first_start[size_t(k) + 1] : 0;
-    const int32_t next_count = k + 1 < p.blocks() ? p.first_start[size_t(k) + 2] - next : 0;
-    constexpr int32_t kParts = 8;
+    const size_t bytes = sizeof(VertexBinding) * size_t(k + 1 < p.blocks() ? p.first_start[size_t(k) + 2] - next : 0);
+    constexpr int32_t kParts = 16;
     for (int32_t part = 0; part < kParts; ++part) {
       const int32_t t0 = begin + (end - begin) * part / kParts, t1 = begin + (end - begin) * (part + 1) / kParts;
-      add_triangle_normals(out_xyz, p.corners.data() + 3 * size_t(t0), t1 - t0, 3 * vertex_count(), out_normals);
-      prefetch_placement(bindings_.data(), order, next + next_count * part / kParts,
-                         next + next_count * (part + 1) / kParts, out_xyz, out_normals);
+      add_triangle_normals(scratch, p.corners.data() + 3 * size_t(t0), t1 - t0);
+      if (bytes > 0) prefetch(reinterpret_cast<const char*>(b + next) + bytes * size_t(part) / kParts, bytes / kParts);
     }
-    normalize_listed(out_normals, p.last.data() + p.last_start[size_t(k)],
-                     p.last_start[size_t(k) + 1] - p.last_start[size_t(k)]);
+    const int32_t last = p.last_start[size_t(k)];
+    finish_normals(scratch, p.last.data() + last, p.last_slot.data() + last, p.last_start[size_t(k) + 1] - last,
+                   out_normals);
   }
 }
 
@@ -157,7 +164,7 @@ Embedding::FollowReport Embedding::follow(const TopologyChange& change, const Ve
     if (now[size_t(old)] < 0) now[size_t(old)] = int32_t(e);
   }
   FollowReport report;
-  std::vector<Binding> bindings = bindings_;
+  std::vector<VertexBinding> bindings = bindings_;
   std::vector<int32_t> tet = tet_, kinds = kinds_;
   std::array<int32_t, 3> counts = counts_;
   std::unique_ptr<Binder> binder;  // made for the first vertex whose tet went
@@ -166,7 +173,8 @@ Embedding::FollowReport Embedding::follow(const TopologyChange& change, const Ve
     if (tet[i] < 0) continue;  // unbound stays unbound
     const int32_t e = now[size_t(tet[i])];
     if (e >= 0) {  // the tet stays: same weights (same rest shape, corners in the same order), new nodes
-      bindings[j].nodes = tets[size_t(e)];
+      bindings[j].tet = e;
+      bindings[j].has_last_node = holds_last_node(tets[size_t(e)], int32_t(rest.size()));
       tet[i] = e;
       ++report.followed;
       continue;
@@ -175,7 +183,7 @@ Embedding::FollowReport Embedding::follow(const TopologyChange& change, const Ve
     Weights w;
     VertexKind kind;
     const int32_t found = binder->bind(Vec3(rest_xyz_[3 * i], rest_xyz_[3 * i + 1], rest_xyz_[3 * i + 2]), w, kind);
-    set_binding(bindings[j], found, tets, w);
+    bindings[j] = binding(int32_t(i), found, w, tets, int32_t(rest.size()));
     tet[i] = found;
     --counts[size_t(kinds[i])];
     kinds[i] = int32_t(kind);
@@ -193,16 +201,13 @@ Embedding::FollowReport Embedding::follow(const TopologyChange& change, const Ve
   return report;
 }
 
-void Embedding::unbind_all(int32_t node_count, uint64_t topology_version) noexcept {
-  for (Binding& b : bindings_) {
-    b.nodes = {-1, -1, -1, -1};
-    b.weights = {0, 0, 0, 0};
-  }
+void Embedding::unbind_all(int32_t node_count, int32_t tet_count, uint64_t topology_version) noexcept {
+  for (VertexBinding& b : bindings_) b = {{0, 0, 0}, -1, b.vertex, 0};
   for (int32_t& e : tet_) e = -1;
   for (int32_t& k : kinds_) k = int32_t(VertexKind::Unbound);
   counts_ = {0, 0, int32_t(kinds_.size())};
   node_count_ = node_count;
-  tet_count_ = 0;
+  tet_count_ = tet_count;
   topology_version_ = topology_version;
 }
 

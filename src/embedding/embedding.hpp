@@ -48,11 +48,13 @@ class Embedding {
   int32_t count(VertexKind kind) const { return counts_[size_t(kind)]; }
   int32_t tet(int32_t vertex) const { return tet_[size_t(vertex)]; }  // -1: unbound
 
-  // Writes each bound vertex's position, interpolated from the body's current node positions x, into
-  // out_xyz (3 per vertex); an unbound vertex's entries are left as they are. With out_normals,
-  // then the area-weighted normals of the triangles at out_xyz (3 per vertex), (vertex_normals()).
-  // Allocates nothing. Throws Error(WrongState) if x is not of the body's node count.
-  void update(const Vec3List& x, double* out_xyz, double* out_normals) const;
+  // Writes each bound vertex's position, interpolated from the body's current node positions x and
+  // tets, into out_xyz (3 per vertex); an unbound vertex's entries are left as they are. With
+  // out_normals, also the area-weighted normals of the triangles at those positions (3 per vertex;
+  // a vertex in no triangle, or whose triangles have no area, gets 0, 0, 0). out_normals must not
+  // overlap out_xyz. Allocates nothing; uses the embedding's scratch (one thread at a time). Throws
+  // Error(WrongState) if x or tets are not of the body's sizes at binding or the last follow().
+  void update(const Vec3List& x, const std::vector<Tet>& tets, double* out_xyz, double* out_normals) const;
 
   // What follow() did to the vertices whose tet the change removed.
   struct FollowReport {
@@ -72,25 +74,25 @@ class Embedding {
   FollowReport follow(const TopologyChange& change, const Vec3List& rest, const std::vector<Tet>& tets,
                       const std::vector<Tri>& surface);
 
-  // Every vertex unbound, for a body of `node_count` nodes at `topology_version` (after a change
+  // Every vertex unbound, for a body of `node_count` nodes and `tet_count` tets at `topology_version` (after a change
   // that could not be followed: the update then leaves the host's positions as they are).
   // Allocates nothing, never throws.
-  void unbind_all(int32_t node_count, uint64_t topology_version) noexcept;
+  void unbind_all(int32_t node_count, int32_t tet_count, uint64_t topology_version) noexcept;
 
  private:
-  using Binding = VertexBinding;
 
   uint64_t body_;
   int32_t node_count_;
   int32_t tet_count_;              // the body's, at binding or at the last follow
   uint64_t topology_version_ = 0;  // set by the owner (the C layer) from the body's
   double radius_;
-  std::vector<Binding> bindings_;  // vertex plan_.order[j]'s in j: all the update reads of it, 48 bytes
+  std::vector<VertexBinding> bindings_;  // in the plan's order (plan_.order[j]'s in j)
   std::vector<int32_t> tet_;       // per vertex: its tet (-1: unbound), for follow()
   std::vector<double> rest_xyz_;   // the vertices as given, for binding again in follow()
   std::vector<int32_t> kinds_;
   std::array<int32_t, 3> counts_{};
   NormalsPlan plan_;  // the triangles, in the order update() sums them
+  mutable std::vector<NormalSlot> scratch_;  // update()'s (one thread uses a world at a time)
 };
 
 }  // namespace mica

@@ -26,7 +26,7 @@ NormalsPlan plan_normals(const int32_t* triangles, int32_t triangle_count, int32
                          int32_t block_size) {
   NormalsPlan plan;
   const int32_t blocks = (triangle_count + block_size - 1) / block_size;
-  plan.corners.resize(3 * size_t(triangle_count));
+  std::vector<int32_t> sequence(3 * size_t(triangle_count));  // the triangles' vertices, interleaved
   plan.block_start.resize(size_t(blocks) + 1);
   std::vector<int32_t> first(size_t(vertex_count), -1), last(size_t(vertex_count), -1);
   int32_t out = 0;
@@ -40,7 +40,7 @@ NormalsPlan plan_normals(const int32_t* triangles, int32_t triangle_count, int32
         if (t >= begin + size) continue;
         for (int c = 0; c < 3; ++c) {
           const int32_t v = triangles[3 * size_t(t) + size_t(c)];
-          plan.corners[3 * size_t(out) + size_t(c)] = 3 * v;
+          sequence[3 * size_t(out) + size_t(c)] = v;
           if (first[size_t(v)] < 0) first[size_t(v)] = k;
           last[size_t(v)] = k;
         }
@@ -53,6 +53,26 @@ NormalsPlan plan_normals(const int32_t* triangles, int32_t triangle_count, int32
   bucket(first, blocks + 1, plan.order, plan.first_start);
   plan.first_start.erase(plan.first_start.begin());
   bucket(last, blocks, plan.last, plan.last_start);
+  // Slots given out block by block and taken back after each: the last freed is given first (its
+  // line is the likeliest to be in the cache).
+  std::vector<int32_t> slot_of(size_t(vertex_count), -1), free;
+  plan.slot.assign(plan.order.size(), -1);
+  plan.last_slot.resize(plan.last.size());
+  for (int32_t k = 0; k < blocks; ++k) {
+    for (int32_t j = plan.first_start[size_t(k)]; j < plan.first_start[size_t(k) + 1]; ++j) {
+      int32_t s = plan.slots;
+      if (free.empty()) ++plan.slots;
+      else s = free.back(), free.pop_back();
+      slot_of[size_t(plan.order[size_t(j)])] = s;
+      plan.slot[size_t(j)] = s;
+    }
+    for (int32_t j = plan.last_start[size_t(k)]; j < plan.last_start[size_t(k) + 1]; ++j) {
+      plan.last_slot[size_t(j)] = slot_of[size_t(plan.last[size_t(j)])];
+      free.push_back(plan.last_slot[size_t(j)]);
+    }
+  }
+  plan.corners.resize(sequence.size());
+  for (size_t c = 0; c < sequence.size(); ++c) plan.corners[c] = slot_of[size_t(sequence[c])];
   return plan;
 }
 

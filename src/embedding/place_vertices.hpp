@@ -3,26 +3,28 @@
 #pragma once
 #include <array>
 #include <cstdint>
+#include <vector>
 
 #include "core/types.hpp"
+#include "embedding/normals_plan.hpp"
 
 namespace mica {
 
-// A vertex's tet and barycentric weights: all the update reads of it, 48 bytes.
+// A vertex's tet and barycentric weights: all the update reads of it, 32 bytes (the update is bound
+// by reading these). The fourth weight is 1 minus the other three.
 struct VertexBinding {
-  std::array<int32_t, 4> nodes;  // the tet's nodes; nodes[0] < 0: unbound
-  std::array<double, 4> weights;
+  std::array<double, 3> weights;
+  int32_t tet;                // -1: unbound
+  int32_t vertex : 31;        // the host's index of the vertex
+  uint32_t has_last_node : 1;  // the tet holds the body's last node (reading past it would leave the array)
 };
+static_assert(sizeof(VertexBinding) == 32, "a binding is half a cache line");
 
-// For j in [begin, end): vertex order[j] (3 doubles at out_xyz + 3 order[j]) placed at the weighted
-// sum of the nodes x of bindings[j], or left as it is if unbound; with clear_normals, its 3 entries
-// there set to 0. Node indices are not checked. Allocates nothing.
-void place_vertices(const VertexBinding* bindings, const int32_t* order, int32_t begin, int32_t end,
-                    const Vec3List& x, double* out_xyz, double* clear_normals);
-
-// Asks the cache for what place_vertices() over [begin, end) will read and write (the bindings,
-// the vertices' positions and normals), so that fetching them overlaps other work.
-void prefetch_placement(const VertexBinding* bindings, const int32_t* order, int32_t begin, int32_t end,
-                        const double* out_xyz, const double* normals);
+// For each of the `count` bindings b: vertex b.vertex (3 doubles at out_xyz + 3 b.vertex) placed at
+// the weighted sum of the nodes x of its tet in tets, or left as it is if unbound. With `scratch`,
+// its position also copied into scratch[slot[k]] for the k-th binding (an unbound vertex's as the
+// host has it) and that slot's normal cleared. Indices are not checked. Allocates nothing.
+void place_vertices(const VertexBinding* bindings, int32_t count, const std::vector<Tet>& tets, const Vec3List& x,
+                    double* out_xyz, const int32_t* slot = nullptr, NormalSlot* scratch = nullptr);
 
 }  // namespace mica

@@ -3,8 +3,11 @@
 // and under a rigid motion every bound vertex lands where it should (1e-12 m); vertices outside
 // the body are projected within the radius and unbound beyond it, left as they were; the normals
 // are the area-weighted normals of the moved triangles; the update allocates nothing; bad input is
-// refused by name. After a resection the vertices of kept tets are placed as before, to the bit,
-// and those of removed tets are bound again; after a cut every vertex follows its tet's copies.
+// refused by name; arrays at any offset get the same bytes. After a resection the vertices of kept
+// tets are placed as before, to the bit, and those of removed tets are bound again; after a cut
+// every vertex follows its tet's copies.
+#include <cstring>
+
 #include "embedding/embedding.hpp"
 #include "embedding/tet_locator.hpp"
 // malloc is counted too, except in a sanitizer build: the sanitizer owns malloc (replacing it
@@ -127,7 +130,7 @@ static void test_rest_places_every_bound_vertex_where_it_was(void**) {
   assert_int_equal(e.count(VertexKind::Unbound), m.far);
 
   std::vector<double> out(m.xyz.size(), 42.0);  // unbound vertices keep this
-  e.update(b.mesh.nodes, out.data(), nullptr);
+  e.update(b.mesh.nodes, b.mesh.tets, out.data(), nullptr);
   for (int32_t i = 0; i < m.count(); ++i) {
     const Vec3 p(out[3 * size_t(i)], out[3 * size_t(i) + 1], out[3 * size_t(i) + 2]);
     if (kinds[size_t(i)] == int32_t(VertexKind::Unbound))
@@ -147,7 +150,7 @@ static void test_rigid_motion_moves_the_mesh_rigidly(void**) {
   for (Vec3& p : x) p = R * p + t;
   std::vector<double> out = m.xyz, normals(m.xyz.size());
   const Vec3List rest_normals = reference_normals(m.xyz, m.triangles);
-  e.update(x, out.data(), normals.data());
+  e.update(x, b.mesh.tets, out.data(), normals.data());
   for (int32_t i = 0; i < m.inside + m.near; ++i) {
     const Vec3 p(out[3 * size_t(i)], out[3 * size_t(i) + 1], out[3 * size_t(i) + 2]);
     assert_near((p - (R * m.vertex(i) + t)).norm(), 0.0, 1e-12);
@@ -164,7 +167,7 @@ static void test_normals_are_those_of_the_moved_triangles(void**) {
   Vec3List x = b.mesh.nodes;
   for (Vec3& p : x) p += Vec3(0, 0.3 * p.x() * p.x() + 0.1 * p.z() * p.x(), 0.2 * p.y() * p.x());
   std::vector<double> out = m.xyz, normals(m.xyz.size());
-  e.update(x, out.data(), normals.data());
+  e.update(x, b.mesh.tets, out.data(), normals.data());
   const Vec3List expected = reference_normals(out, m.triangles);
   const int32_t surface_vertices = int32_t(m.inside - 500);
   for (int32_t i = 0; i < surface_vertices; ++i) {
@@ -182,7 +185,7 @@ static void test_update_allocates_nothing(void**) {
   const Embedding e = embed(b, m);
   std::vector<double> out = m.xyz, normals(m.xyz.size());
   mica_test::start_counting_allocations();
-  e.update(b.mesh.nodes, out.data(), normals.data());
+  e.update(b.mesh.nodes, b.mesh.tets, out.data(), normals.data());
   assert_int_equal(mica_test::stop_counting_allocations(), 0);
 }
 
@@ -217,7 +220,7 @@ static void test_update_refuses_another_node_count(void**) {
   x.pop_back();
   std::vector<double> out(m.xyz.size());
   try {
-    e.update(x, out.data(), nullptr);
+    e.update(x, b.mesh.tets, out.data(), nullptr);
   } catch (const Error& error) {
     assert_int_equal(int(error.code()), int(Errc::WrongState));
     return;
@@ -280,7 +283,7 @@ static void test_resection_keeps_the_vertices_of_kept_tets_and_binds_the_others_
   Embedding e = embed(b, m);
   const Vec3List x = bent(b.mesh.nodes);
   std::vector<double> before(m.xyz.size(), 42.0), normals(m.xyz.size());
-  e.update(x, before.data(), normals.data());
+  e.update(x, b.mesh.tets, before.data(), normals.data());
   std::vector<int32_t> old_tet(size_t(m.count()));
   for (int32_t i = 0; i < m.count(); ++i) old_tet[size_t(i)] = e.tet(i);
 
@@ -294,9 +297,9 @@ static void test_resection_keeps_the_vertices_of_kept_tets_and_binds_the_others_
   Vec3List x_new(r.mesh.nodes.size());  // the same node positions, renumbered
   for (size_t i = 0; i < x_new.size(); ++i) x_new[i] = x[size_t(r.change.node_origin[i])];
   std::vector<double> after(m.xyz.size(), 42.0);
-  e.update(x_new, after.data(), normals.data());
+  e.update(x_new, r.mesh.tets, after.data(), normals.data());
   std::vector<double> at_rest(m.xyz.size(), 42.0);
-  e.update(r.mesh.nodes, at_rest.data(), nullptr);
+  e.update(r.mesh.nodes, r.mesh.tets, at_rest.data(), nullptr);
   int32_t followed = 0, gone = 0, unbound = 0;
   for (int32_t i = 0; i < m.count(); ++i) {
     const int32_t t = old_tet[size_t(i)];
@@ -382,7 +385,7 @@ static void test_cut_vertices_follow_their_tets_copies(void**) {
   for (size_t i = 0; i < x.size(); ++i)
     if (moved[i]) x[i] += d;
   std::vector<double> out(m.xyz.size(), 42.0);
-  e.update(x, out.data(), nullptr);
+  e.update(x, cut.tets, out.data(), nullptr);
   int32_t on_plus = 0;
   for (int32_t i = 0; i < m.count(); ++i) {
     if (e.tet(i) < 0) continue;
@@ -418,11 +421,32 @@ static void test_a_change_that_does_not_fit_is_refused_and_changes_nothing(void*
   assert_true(e.kinds() == kinds);
   assert_int_equal(e.node_count(), int32_t(b.mesh.nodes.size()));
   // What the C layer does when a follow fails: every vertex unbound, the update leaves them be.
-  e.unbind_all(int32_t(r.mesh.nodes.size()), 5);
+  e.unbind_all(int32_t(r.mesh.nodes.size()), int32_t(r.mesh.tets.size()), 5);
   assert_int_equal(e.count(VertexKind::Unbound), m.count());
   std::vector<double> out(m.xyz.size(), 42.0), normals(m.xyz.size());
-  e.update(r.mesh.nodes, out.data(), normals.data());
+  e.update(r.mesh.nodes, r.mesh.tets, out.data(), normals.data());
   for (double v : out) assert_true(v == 42.0);
+}
+
+// The host's arrays are written with streaming stores of 16 bytes where they allow it: arrays at
+// every offset from a 16-byte boundary (8 is what C guarantees; 4 is what a careless host may pass)
+// get the same bytes as aligned ones.
+static void test_arrays_at_any_offset_get_the_same_bytes(void**) {
+  const Box b = box();
+  const Mesh m = render_mesh(b);
+  const Embedding e = embed(b, m);
+  const Vec3List x = bent(b.mesh.nodes);
+  const size_t bytes = sizeof(double) * m.xyz.size();
+  std::vector<double> xyz = m.xyz, normals(m.xyz.size());
+  e.update(x, b.mesh.tets, xyz.data(), normals.data());
+  for (size_t offset : {0, 4, 8, 12}) {
+    std::vector<char> at(2 * bytes + 64);
+    char* base = at.data() + (16 - reinterpret_cast<uintptr_t>(at.data()) % 16) + offset;
+    std::memcpy(base, m.xyz.data(), bytes);  // the unbound vertices' values stay
+    e.update(x, b.mesh.tets, reinterpret_cast<double*>(base), reinterpret_cast<double*>(base + bytes));
+    assert_memory_equal(base, xyz.data(), bytes);
+    assert_memory_equal(base + bytes, normals.data(), bytes);
+  }
 }
 
 int main(void) {
@@ -430,6 +454,7 @@ int main(void) {
       cmocka_unit_test(test_grid_finds_the_tet_a_scan_finds),
       cmocka_unit_test(test_rest_places_every_bound_vertex_where_it_was),
       cmocka_unit_test(test_rigid_motion_moves_the_mesh_rigidly),
+      cmocka_unit_test(test_arrays_at_any_offset_get_the_same_bytes),
       cmocka_unit_test(test_normals_are_those_of_the_moved_triangles),
       cmocka_unit_test(test_update_allocates_nothing),
       cmocka_unit_test(test_bad_input_is_refused_by_name),
