@@ -128,14 +128,16 @@ void Embedding::update(const Vec3List& x, const std::vector<Tet>& tets, double* 
     place_vertices(b + first, next - first, tets, x, out_xyz, p.slot.data() + first, scratch);
     // The sums in parts, each followed by a part of the next block's bindings asked for: reading
     // them, which bounds the placing, overlaps the sums' arithmetic.
-    const int32_t begin = p.block_start[size_t(k)], end = p.block_start[size_t(k) + 1];
+    const int32_t begin = p.pair_start[size_t(k)], end = p.pair_start[size_t(k) + 1];
     const size_t bytes = sizeof(VertexBinding) * size_t(k + 1 < p.blocks() ? p.first_start[size_t(k) + 2] - next : 0);
     constexpr int32_t kParts = 16;
     for (int32_t part = 0; part < kParts; ++part) {
-      const int32_t t0 = begin + (end - begin) * part / kParts, t1 = begin + (end - begin) * (part + 1) / kParts;
-      add_triangle_normals(scratch, p.corners.data() + 3 * size_t(t0), t1 - t0);
+      const int32_t q0 = begin + (end - begin) * part / kParts, q1 = begin + (end - begin) * (part + 1) / kParts;
+      add_pair_normals(scratch, p.pairs.data() + 4 * size_t(q0), q1 - q0);
       if (bytes > 0) prefetch(reinterpret_cast<const char*>(b + next) + bytes * size_t(part) / kParts, bytes / kParts);
     }
+    const int32_t single = p.single_start[size_t(k)];
+    add_triangle_normals(scratch, p.singles.data() + 3 * size_t(single), p.single_start[size_t(k) + 1] - single);
     const int32_t last = p.last_start[size_t(k)];
     finish_normals(scratch, p.last.data() + last, p.last_slot.data() + last, p.last_start[size_t(k) + 1] - last,
                    out_normals);

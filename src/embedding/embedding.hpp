@@ -43,7 +43,7 @@ class Embedding {
   void set_topology_version(uint64_t version) { topology_version_ = version; }
   double radius() const { return radius_; }
   int32_t vertex_count() const { return int32_t(kinds_.size()); }
-  int32_t triangle_count() const { return int32_t(plan_.corners.size() / 3); }
+  int32_t triangle_count() const { return plan_.triangles; }
   const std::vector<int32_t>& kinds() const { return kinds_; }  // VertexKind values, per vertex
   int32_t count(VertexKind kind) const { return counts_[size_t(kind)]; }
   int32_t tet(int32_t vertex) const { return tet_[size_t(vertex)]; }  // -1: unbound

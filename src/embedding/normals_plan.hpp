@@ -14,7 +14,9 @@
 // block's worth and the few shared with far-away triangles; in the worst case (triangles in a random
 // order) every vertex.
 //
-// Within a block the triangles are interleaved from four quarters of it: neighbouring triangles
+// Within a block, two triangles that share an edge, (a, b, c) and (a, c, d), are summed as a pair:
+// a and c get both cross products at once, so a pair writes four sums where two triangles write
+// six. The triangles are taken interleaved from four quarters of the block: neighbouring triangles
 // share vertices, and the sums of one would wait on the last one's.
 #pragma once
 #include <cstdint>
@@ -36,12 +38,15 @@ struct NormalsPlan {
   std::vector<int32_t> order;
   std::vector<int32_t> first_start;  // block k's: order[first_start[k] .. first_start[k + 1])
   std::vector<int32_t> slot;         // per entry of order: its scratch slot (-1: in no triangle)
-  std::vector<int32_t> corners;      // per triangle, in the order they are summed: its 3 vertices' slots
-  std::vector<int32_t> block_start;  // block k's triangles: [block_start[k], block_start[k + 1])
+  // Per block, in the order they are summed: the pairs of triangles, 4 slots each (a, b, c, d for
+  // (a, b, c) and (a, c, d)), and the triangles left single, 3 slots each.
+  std::vector<int32_t> pairs, pair_start;      // block k's: [pair_start[k], pair_start[k + 1])
+  std::vector<int32_t> singles, single_start;  // block k's: [single_start[k], single_start[k + 1])
   // Per block, ascending: the vertices it uses last, and their slots.
   std::vector<int32_t> last, last_slot, last_start;
   int32_t slots = 0;  // the scratch's size
-  int32_t blocks() const { return int32_t(block_start.size()) - 1; }
+  int32_t triangles = 0;
+  int32_t blocks() const { return int32_t(pair_start.size()) - 1; }
 };
 
 // The plan for `triangle_count` triangles (3 vertex indices each) over `vertex_count` vertices

@@ -23,6 +23,12 @@ void add_one(NormalSlot* scratch, const int32_t* f) {
     for (int i = 0; i < 3; ++i) scratch[f[k]].normal[i] += n[i];
 }
 
+void add_pair(NormalSlot* scratch, const int32_t* q) {
+  const int32_t first[3] = {q[0], q[1], q[2]}, second[3] = {q[0], q[2], q[3]};
+  add_one(scratch, first);
+  add_one(scratch, second);
+}
+
 void finish_one(const double* sum, double* out) {
   const double length2 = sum[0] * sum[0] + sum[1] * sum[1] + sum[2] * sum[2];
   const double scale = length2 > 0 ? 1 / std::sqrt(length2) : 0;
@@ -50,6 +56,30 @@ __attribute__((target("avx2,fma"))) void add_avx2(NormalSlot* scratch, const int
     _mm256_store_pd(a + 4, _mm256_add_pd(_mm256_load_pd(a + 4), n));
     _mm256_store_pd(b + 4, _mm256_add_pd(_mm256_load_pd(b + 4), n));
     _mm256_store_pd(c + 4, _mm256_add_pd(_mm256_load_pd(c + 4), n));
+  }
+}
+
+// Two triangles (a, b, c) and (a, c, d): with u = a - b, v = a - c, w = a - d, their cross
+// products are u x v and v x w; a and c get their sum.
+__attribute__((target("avx2,fma"))) void add_pairs_avx2(NormalSlot* scratch, const int32_t* pairs, int32_t pair_count) {
+  constexpr int kYzx = _MM_SHUFFLE(3, 0, 2, 1);
+  for (int32_t k = 0; k < pair_count; ++k) {
+    double* const a = scratch[pairs[4 * size_t(k)]].xyz;
+    double* const b = scratch[pairs[4 * size_t(k) + 1]].xyz;
+    double* const c = scratch[pairs[4 * size_t(k) + 2]].xyz;
+    double* const d = scratch[pairs[4 * size_t(k) + 3]].xyz;
+    const __m256d p = _mm256_load_pd(a);
+    const __m256d u = _mm256_sub_pd(p, _mm256_load_pd(b)), v = _mm256_sub_pd(p, _mm256_load_pd(c)),
+                  w = _mm256_sub_pd(p, _mm256_load_pd(d));
+    const __m256d u_ = _mm256_permute4x64_pd(u, kYzx), v_ = _mm256_permute4x64_pd(v, kYzx),
+                  w_ = _mm256_permute4x64_pd(w, kYzx);
+    const __m256d m1 = _mm256_fmsub_pd(u, v_, _mm256_mul_pd(u_, v)), m2 = _mm256_fmsub_pd(v, w_, _mm256_mul_pd(v_, w));
+    const __m256d n1 = _mm256_permute4x64_pd(m1, kYzx), n2 = _mm256_permute4x64_pd(m2, kYzx);
+    const __m256d both = _mm256_add_pd(n1, n2);
+    _mm256_store_pd(a + 4, _mm256_add_pd(_mm256_load_pd(a + 4), both));
+    _mm256_store_pd(b + 4, _mm256_add_pd(_mm256_load_pd(b + 4), n1));
+    _mm256_store_pd(c + 4, _mm256_add_pd(_mm256_load_pd(c + 4), both));
+    _mm256_store_pd(d + 4, _mm256_add_pd(_mm256_load_pd(d + 4), n2));
   }
 }
 
@@ -89,6 +119,13 @@ void add_triangle_normals(NormalSlot* scratch, const int32_t* corners, int32_t t
   if (avx2_supported()) return add_avx2(scratch, corners, triangle_count);
 #endif
   for (int32_t t = 0; t < triangle_count; ++t) add_one(scratch, corners + 3 * size_t(t));
+}
+
+void add_pair_normals(NormalSlot* scratch, const int32_t* pairs, int32_t pair_count) {
+#if MICA_NORMALS_AVX2
+  if (avx2_supported()) return add_pairs_avx2(scratch, pairs, pair_count);
+#endif
+  for (int32_t k = 0; k < pair_count; ++k) add_pair(scratch, pairs + 4 * size_t(k));
 }
 
 void finish_normals(const NormalSlot* scratch, const int32_t* vertices, const int32_t* slots, int32_t count,

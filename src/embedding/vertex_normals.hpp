@@ -12,6 +12,10 @@ namespace mica {
 // its three corners; a triangle is the scratch slots of its three vertices. Allocates nothing.
 void add_triangle_normals(NormalSlot* scratch, const int32_t* corners, int32_t triangle_count);
 
+// The same for `pair_count` pairs of triangles sharing an edge, 4 slots each: a, b, c, d for the
+// triangles (a, b, c) and (a, c, d).
+void add_pair_normals(NormalSlot* scratch, const int32_t* pairs, int32_t pair_count);
+
 // Writes the unit normal of each of the `count` vertices listed, from the sum in its slot
 // (scratch[slots[k]]), to out_normals + 3 vertices[k] (a zero sum gives a zero normal).
 void finish_normals(const NormalSlot* scratch, const int32_t* vertices, const int32_t* slots, int32_t count,

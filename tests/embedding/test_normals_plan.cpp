@@ -2,8 +2,9 @@
 // The embedding update's plan (normals_plan.hpp) and its kernels: for triangles in a coherent order
 // (a grid's strips) and in a random order, in blocks from 1 triangle to more than the mesh has,
 // every vertex is placed once, before its first block; it is finished once, after its last; no two
-// vertices in use at once share a scratch slot; and the kernels run in the plan's order give the
-// normals of a plain sum over the triangles (1e-13).
+// vertices in use at once share a scratch slot; every triangle is summed once, in its orientation,
+// most in pairs sharing an edge where a block holds both; and the kernels run in the plan's order
+// give the normals of a plain sum over the triangles (1e-13).
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -47,6 +48,12 @@ Surface sheet(int32_t n, bool shuffled) {
   return s;
 }
 
+// A triangle turned to start at its least vertex (the same triangle, the same orientation).
+std::array<int32_t, 3> canonical(std::array<int32_t, 3> t) {
+  std::rotate(t.begin(), std::min_element(t.begin(), t.end()), t.end());
+  return t;
+}
+
 std::vector<double> plain_normals(const Surface& s) {
   std::vector<double> n(s.xyz.size(), 0.0);
   for (size_t t = 0; t < s.triangles.size(); t += 3) {
@@ -62,7 +69,7 @@ std::vector<double> plain_normals(const Surface& s) {
   return n;
 }
 
-void check(const Surface& s, int32_t block) {
+void check(const Surface& s, int32_t block, bool shuffled) {
   const int32_t n = s.vertices(), t = int32_t(s.triangles.size() / 3);
   const NormalsPlan p = plan_normals(s.triangles.data(), t, n, block);
   assert_int_equal(p.blocks(), (t + block - 1) / block);
@@ -82,7 +89,8 @@ void check(const Surface& s, int32_t block) {
   std::vector<int32_t> owner(size_t(p.slots), -1);
   std::vector<NormalSlot> scratch(size_t(p.slots));
   std::vector<double> normals(s.xyz.size(), -7.0);
-  std::multiset<std::array<int32_t, 3>> planned;  // the triangles the corners name, as the plan runs
+  std::multiset<std::array<int32_t, 3>> planned;  // the triangles the plan names, as it runs
+  int32_t pairs = 0;
   for (int32_t k = 0; k < p.blocks(); ++k) {
     for (int32_t j = p.first_start[size_t(k)]; j < p.first_start[size_t(k) + 1]; ++j) {
       const int32_t v = p.order[size_t(j)], slot = p.slot[size_t(j)];
@@ -92,14 +100,25 @@ void check(const Surface& s, int32_t block) {
       std::copy_n(&s.xyz[3 * size_t(v)], 3, scratch[size_t(slot)].xyz);
       std::fill_n(scratch[size_t(slot)].normal, 4, 0.0);
     }
-    for (int32_t c = 3 * p.block_start[size_t(k)]; c < 3 * p.block_start[size_t(k) + 1]; c += 3) {
-      const std::array<int32_t, 3> tri = {owner[size_t(p.corners[size_t(c)])], owner[size_t(p.corners[size_t(c) + 1])],
-                                          owner[size_t(p.corners[size_t(c) + 2])]};
-      for (int32_t v : tri) assert_true(v >= 0 && state[size_t(v)] == 1);
-      planned.insert(tri);
+    const auto named = [&](int32_t slot) {
+      const int32_t v = owner[size_t(slot)];
+      assert_true(v >= 0 && state[size_t(v)] == 1);
+      return v;
+    };
+    for (int32_t q = p.pair_start[size_t(k)]; q < p.pair_start[size_t(k) + 1]; ++q) {
+      const int32_t* c = &p.pairs[4 * size_t(q)];
+      planned.insert(canonical({named(c[0]), named(c[1]), named(c[2])}));
+      planned.insert(canonical({named(c[0]), named(c[2]), named(c[3])}));
     }
-    add_triangle_normals(scratch.data(), p.corners.data() + 3 * size_t(p.block_start[size_t(k)]),
-                         p.block_start[size_t(k) + 1] - p.block_start[size_t(k)]);
+    for (int32_t t = p.single_start[size_t(k)]; t < p.single_start[size_t(k) + 1]; ++t) {
+      const int32_t* c = &p.singles[3 * size_t(t)];
+      planned.insert(canonical({named(c[0]), named(c[1]), named(c[2])}));
+    }
+    pairs += p.pair_start[size_t(k) + 1] - p.pair_start[size_t(k)];
+    add_pair_normals(scratch.data(), p.pairs.data() + 4 * size_t(p.pair_start[size_t(k)]),
+                     p.pair_start[size_t(k) + 1] - p.pair_start[size_t(k)]);
+    add_triangle_normals(scratch.data(), p.singles.data() + 3 * size_t(p.single_start[size_t(k)]),
+                         p.single_start[size_t(k) + 1] - p.single_start[size_t(k)]);
     const int32_t first = p.last_start[size_t(k)], count = p.last_start[size_t(k) + 1] - first;
     for (int32_t j = first; j < first + count; ++j) {
       const int32_t v = p.last[size_t(j)], slot = p.last_slot[size_t(j)];
@@ -113,10 +132,14 @@ void check(const Surface& s, int32_t block) {
     }
   }
   for (int32_t v = 0; v + 1 < n; ++v) assert_int_equal(state[size_t(v)], 2);
-  // The corners named the given triangles, each once, corners in their order.
+  // The plan named the given triangles, each once, in their orientation; most of them in pairs
+  // (all but a few at the blocks' edges and the grid's border).
   std::multiset<std::array<int32_t, 3>> given;
-  for (size_t c = 0; c < s.triangles.size(); c += 3) given.insert({s.triangles[c], s.triangles[c + 1], s.triangles[c + 2]});
+  for (size_t c = 0; c < s.triangles.size(); c += 3)
+    given.insert(canonical({s.triangles[c], s.triangles[c + 1], s.triangles[c + 2]}));
   assert_true(planned == given);
+  assert_int_equal(p.triangles, t);
+  if (block >= 64 && (!shuffled || block >= t)) assert_true(2 * pairs > 9 * t / 10);
   const std::vector<double> expected = plain_normals(s);
   for (int32_t v = 0; v + 1 < n; ++v)
     for (int a = 0; a < 3; ++a) assert_near(normals[3 * size_t(v) + size_t(a)], expected[3 * size_t(v) + size_t(a)], 1e-13);
@@ -129,7 +152,7 @@ static void test_the_plan_places_sums_and_finishes_each_vertex_once(void**) {
     bool shuffled;
     int32_t block;
   } cases[] = {{false, 1}, {false, 5}, {false, 64}, {false, 2048}, {true, 1}, {true, 7}, {true, 64}, {true, 2048}};
-  for (const auto& c : cases) check(sheet(23, c.shuffled), c.block);
+  for (const auto& c : cases) check(sheet(23, c.shuffled), c.block, c.shuffled);
 }
 
 int main(void) {
