@@ -10,7 +10,10 @@
  * of the line lies more than 2 mm from its twin on the other side) and nothing flew off (no node
  * moved 3 cm), and exits 1 if not.
  *
- * usage: incision [output-folder]
+ * With --nidus the same incision goes into the nidus (data/nidus/nidus.msh, 9668 tets) instead,
+ * through the top of the lesion, with the same hook and the same checks.
+ *
+ * usage: incision [--nidus] [output-folder]
  */
 #include <math.h>
 #include <stdio.h>
@@ -23,26 +26,35 @@
 #include "incision_scene.h"
 
 static const char kUsage[] =
-    "usage: incision [output-folder]\n"
+    "usage: incision [--nidus] [output-folder]\n"
     "A blade cuts a 3 cm line, 8 mm deep, at 1 cm/s into the top of a soft 10 cm cube fixed at its\n"
-    "base, while a hook grasps one side and draws it back so the cut opens. Writes incision.csv (per\n"
+    "base (with --nidus: into the nidus, data/nidus/nidus.msh), while a hook grasps one side and\n"
+    "draws it back so the cut opens. Writes incision.csv (per\n"
     "step: time, phase, blade tip, blade force, topology version, nodes) and incision.vtk (the body\n"
     "at the end) into the output folder. Exits 1 if the blade did not cut, the force was not finite\n"
     "or did not push back, the cut did not open, or a node moved 3 cm (a piece flew off).\n"
     "  output-folder  where the files go (default .)\n"
+    "  --nidus        cut the nidus instead of the cube (run from the repository root)\n"
     "  --help         this text\n";
 
 int main(int argc, char** argv) {
-  const int cli = cli_check(argc, argv, kUsage, NULL);
+  static const char* const options[] = {"--nidus", NULL};
+  const int cli = cli_check(argc, argv, kUsage, options);
   if (cli >= 0) return cli;
   const char* out_dir = ".";
   incision_scene_def def = incision_scene_def_default();
   def.cells = 20; /* 5 mm cells: the cut follows element faces */
-  if (argc > 2) {
-    fprintf(stderr, "%s: bad arguments\n\n%s", argv[0], kUsage);
-    return 2;
+  int positional = 0;
+  for (int i = 1; i < argc; ++i) {
+    if (strcmp(argv[i], "--nidus") == 0) {
+      def.cells = 0; /* the nidus at def.mesh */
+    } else if (positional++ == 0) {
+      out_dir = argv[i];
+    } else {
+      fprintf(stderr, "%s: bad arguments\n\n%s", argv[0], kUsage);
+      return 2;
+    }
   }
-  if (argc > 1) out_dir = argv[1];
   if (!cli_make_folder(argv[0], out_dir)) return 2;
 
   incision_scene s;

@@ -10,7 +10,7 @@
 #   3. haptic_loop: a 60 Hz simulation thread and a 1 kHz servo thread.
 #   4. nidus_press: the nidus (a lesion-like blob) pressed by a forceps tip, drawn as it is at the end.
 #   5. incision: a blade cuts 3 cm into the cube while a hook draws one side back; the blade force
-#      along the cut and the opened cut.
+#      along the cut and the opened cut. The same into the nidus (incision --nidus).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 out="$root/out/demo"
@@ -38,6 +38,9 @@ mkdir -p "$out"
 "$root/build/examples_c/incision" "$out"
 /usr/bin/python3 "$root/scripts/plot_incision.py" "$out/incision.csv" "$out/incision.vtk" "$out/incision.png" \
   --title "A blade cuts 3 cm into a soft cube while a hook draws one side back (libmica)"
+(cd "$root" && build/examples_c/incision --nidus "$out/incision_nidus")
+/usr/bin/python3 "$root/scripts/plot_incision.py" "$out/incision_nidus/incision.csv" "$out/incision_nidus/incision.vtk" \
+  "$out/incision_nidus.png" --title "A blade cuts 3 cm into the nidus while a hook draws one side back (libmica)"
 
 echo "demo: pictures in $out"
 echo "  sphere_indent.png  (tool force over time and against depth; sphere_indent_*.vtk open in ParaView)"
@@ -46,3 +49,4 @@ echo "  haptic_loop.png    (raw and rendered device force at 1 kHz over a press 
 echo "  sphere_indent_tissue.png  (the cube at the sphere's deepest, cut through it, von Mises stress)"
 echo "  nidus_press.png    (the nidus under the forceps tip, von Mises stress; nidus_press.vtk opens in ParaView)"
 echo "  incision.png       (the blade force along a 3 cm incision, and the opened cut; incision.vtk opens in ParaView)"
+echo "  incision_nidus.png (the same incision into the nidus; incision_nidus/ holds its CSV and VTK)"

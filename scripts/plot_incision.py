@@ -2,7 +2,7 @@
 # SPDX-License-Identifier: Apache-2.0
 """Draws an incision (examples_c/incision.c): the force the tissue puts against the blade's cut
 along the incision, each cut marked, next to a close-up of the cut body at the end, its surface
-(the cut faces too) coloured by von Mises stress.
+coloured by von Mises stress and the faces the cut opened in blue.
 
 usage: plot_incision.py incision.csv incision.vtk out.png [--title text]
 """
@@ -19,8 +19,20 @@ from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # noqa: E402
 from plot_tissue import read_vtk, surface, to_plot, unit  # noqa: E402
 
 
-def draw_cut(ax, cax, nodes, tets, von_mises, window, elev, azim):
-    """The body's surface within `window` (lo, hi corners, m), lit, coloured by its tets' stress."""
+def cut_nodes(vtk, nodes):
+    """Which nodes the cut made or split: those with a twin at the same rest position (the VTK's
+    positions less its displacements)."""
+    with open(vtk) as f:
+        tokens = f.read().split()
+    at = tokens.index("displacement") + 2
+    rest = nodes - np.array(tokens[at:at + 3 * len(nodes)], dtype=float).reshape(-1, 3)
+    _, inverse, count = np.unique(np.round(rest, 12), axis=0, return_inverse=True, return_counts=True)
+    return count[inverse.ravel()] > 1
+
+
+def draw_cut(ax, cax, nodes, tets, von_mises, window, elev, azim, split):
+    """The body's surface within `window` (lo, hi corners, m), lit, coloured by its tets' stress;
+    a face whose three nodes are all `split` (a cut face) in blue."""
     centroid = nodes[tets].mean(axis=1)
     kept = np.flatnonzero(np.all((centroid > window[0]) & (centroid < window[1]), axis=1))
     faces, owner = surface(nodes, tets[kept])
@@ -32,9 +44,11 @@ def draw_cut(ax, cax, nodes, tets, von_mises, window, elev, azim):
     light = unit(eye + np.array([0, 0, 0.8]))
     front = normal @ eye > 0
     tri, normal, stress = tri[front], normal[front], 1e-3 * von_mises[owner[front]]
+    opened = split[faces[front]].all(axis=1)
     norm = matplotlib.colors.Normalize(0, float(np.percentile(stress, 99)))
     cmap = matplotlib.colormaps["YlOrRd"]
     colours = cmap(norm(stress))
+    colours[opened] = matplotlib.colors.to_rgba("#3b6fb6")
     colours[:, :3] *= (0.5 + 0.5 * np.clip(normal @ light, 0, 1))[:, None]
     ax.add_collection3d(Poly3DCollection(tri, facecolors=colours, edgecolors=colours, linewidths=0.3))
     lo, hi = to_plot(np.array(window[0])), to_plot(np.array(window[1]))
@@ -49,7 +63,8 @@ def draw_cut(ax, cax, nodes, tets, von_mises, window, elev, azim):
     bar = plt.colorbar(matplotlib.cm.ScalarMappable(norm=norm, cmap=cmap), cax=cax, extend="max")
     bar.set_label("von Mises stress (kPa), per tet")
     span = hi - lo
-    ax.text2D(0.02, 0.02, f"close-up {span[0]:.0f} x {span[1]:.0f} x {span[2]:.0f} mm around the cut",
+    ax.text2D(0.02, 0.02, f"close-up {span[0]:.0f} x {span[1]:.0f} x {span[2]:.0f} mm around the cut; "
+              "the faces it opened in blue",
               transform=ax.transAxes, fontsize=8)
 
 
@@ -86,7 +101,8 @@ def main():
     half = np.array([0.5 * np.ptp(tip[:, 0]) + 0.01, 0.012, 0.015])
     window = (middle - half, middle + np.array([half[0], 0.01, half[2]]))
     ax3 = fig.add_subplot(grid[1], projection="3d")
-    draw_cut(ax3, fig.add_subplot(grid[2]), nodes, tets, von_mises, window, elev=62, azim=-75)
+    draw_cut(ax3, fig.add_subplot(grid[2]), nodes, tets, von_mises, window, elev=62, azim=-75,
+             split=cut_nodes(args.vtk, nodes))
     if args.title:
         fig.suptitle(args.title)
     fig.savefig(args.png, dpi=110, bbox_inches="tight")

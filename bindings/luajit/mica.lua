@@ -302,8 +302,9 @@ end
 
 -- Incision (since 0.8): separates the body along a cut surface, triangles in world space (m) where
 -- the body is now: a Lua table of 9 numbers a triangle (its three corners), flat or nested.
--- Returns faces_cut, nodes_added; node copies are numbered after the body's nodes, tet indices
--- stay (see topology_version).
+-- Returns faces_cut, nodes_added; a cut frees no piece of fewer than 8 tets (such a sliver stays
+-- joined); node copies are numbered after the body's nodes, tet indices stay (see
+-- topology_version).
 function World:cut(body, triangles)
   local flat = flatten(triangles, {})
   if #flat % 9 ~= 0 then

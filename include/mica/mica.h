@@ -727,8 +727,10 @@ MICA_API mica_status mica_body_remove_tets(mica_world* world, mica_body_id body,
 
 /** Incision (since 0.8): separates a body along a cut surface, given as triangles where the body
  *  is now (world space; a blade's sweep between two poses is two triangles). A face shared by two
- *  tets is cut when the segment between the two tets' centroids crosses a triangle; the nodes of
- *  the cut faces are then duplicated so that the tets on either side no longer share them (a node
+ *  tets is cut when the segment between the two tets' centroids crosses a triangle, except that a
+ *  cut frees no piece of fewer than 8 tets (since 0.8.3: such a sliver stays joined across one of
+ *  its faces; remove its tets to take it out); the nodes of the cut faces are then duplicated so
+ *  that the tets on either side no longer share them (a node
  *  at the cut's edge, whose tets stay joined around it, is kept whole: the cut stops there). No tet
  *  is added, removed or changed in shape: the mass and every tet's quality stay, and the cut
  *  follows the element faces (within one element of the triangles; docs/cutting.md). Node copies
@@ -743,7 +745,8 @@ MICA_API mica_status mica_body_remove_tets(mica_world* world, mica_body_id body,
  *  @param triangles 9 * `triangle_count` coordinates, m: each triangle's three corners (NULL when
  *         `triangle_count` is 0).
  *  @param triangle_count the number of triangles, >= 0.
- *  @param out_faces_cut receives the number of faces the triangles crossed; may be NULL.
+ *  @param out_faces_cut receives the number of faces cut (those the triangles crossed, less those
+ *         that stayed joined so as to free no sliver); may be NULL.
  *  @param out_nodes_added receives the number of node copies made; may be NULL.
  *  @return MICA_OK, or MICA_ERR_NULL_ARGUMENT (`world` NULL, or `triangles` NULL with a count
  *          above 0); MICA_ERR_STALE_ID (`body` is null, of another kind or destroyed);

@@ -171,7 +171,7 @@ Embedding::FollowReport Embedding::follow(const TopologyChange& change, const Ve
   std::array<int32_t, 3> counts = counts_;
   std::unique_ptr<Binder> binder;  // made for the first vertex whose tet went
   for (size_t j = 0; j < bindings.size(); ++j) {
-    const size_t i = size_t(plan_.order[j]);  // binding j is vertex i's
+    const size_t i = size_t(bindings[j].vertex);
     if (tet[i] < 0) continue;  // unbound stays unbound
     const int32_t e = now[size_t(tet[i])];
     if (e >= 0) {  // the tet stays: same weights (same rest shape, corners in the same order), new nodes

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
-// The two kernels of area-weighted vertex normals, over the scratch slots of normals_plan.hpp.
+// The kernels of area-weighted vertex normals (sum the triangles, normalise), over the scratch
+// slots of normals_plan.hpp.
 // Triangles are counter-clockwise seen from the side the normals point to.
 #pragma once
 #include <cstdint>

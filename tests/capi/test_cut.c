@@ -5,6 +5,7 @@
  *   fixed half's support carries only its own weight; the mass stays (1e-12).
  * - A cut off the element faces still parts the bar (the faces nearest the triangles); a cut
  *   that stops inside the bar leaves it whole, opened up to where it stops.
+ * - A cut frees no sliver (a piece of fewer than 8 tets), and frees a larger piece.
  * - A cut body steps as a fresh body made from its exported mesh and state would (exact and
  *   default solvers, one and two threads).
  * - A grasp across the cut holds both copies of each node it held.
@@ -195,6 +196,66 @@ static void test_cuts_off_the_faces_and_partial_cuts(void** state) {
   mica_world_destroy(w);
 }
 
+/* The 12 triangles of the closed box [lo, hi]. */
+static void closed_box(const double lo[3], const double hi[3], double out[108]) {
+  static const int quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  double corner[8][3];
+  for (int k = 0; k < 8; ++k)
+    for (int a = 0; a < 3; ++a) corner[k][a] = (k >> a) & 1 ? hi[a] : lo[a];
+  for (int q = 0; q < 6; ++q) {
+    const int t[6] = {quads[q][0], quads[q][1], quads[q][2], quads[q][0], quads[q][2], quads[q][3]};
+    for (int k = 0; k < 6; ++k) memcpy(out + 18 * q + 3 * k, corner[t[k]], sizeof corner[0]);
+  }
+}
+
+/* The fewest tets in a piece. */
+static int32_t smallest_piece(const pieces* p) {
+  int32_t smallest = p->m.tets;
+  for (int32_t k = 0; k < p->pieces; ++k) {
+    int32_t count = 0;
+    for (int32_t e = 0; e < p->m.tets; ++e) count += p->piece[p->m.tet[4 * e]] == k;
+    if (count < smallest) smallest = count;
+  }
+  return smallest;
+}
+
+/* A cut frees no piece of fewer than 8 tets (docs/cutting.md): a closed box around one tet's
+ * centroid crosses the faces it shares, and the tet stays joined across one of them (without the
+ * rule it is a piece of its own); a box around two cells' length of the bar (about 40 tets) frees
+ * them. */
+static void test_a_cut_frees_no_sliver(void** state) {
+  (void)state;
+  mica_world* w = make_world(MICA_SOLVER_DIRECT, 1);
+  const mica_body_id body = fixed_bar(w, NULL);
+  const double mass = total_mass(w, body);
+  mesh m = get_mesh(w, body);
+  const int32_t e = m.tets / 2;
+  double c[3] = {0, 0, 0};
+  for (int k = 0; k < 4; ++k)
+    for (int a = 0; a < 3; ++a) c[a] += 0.25 * m.rest[3 * m.tet[4 * e + k] + a];
+  free_mesh(&m);
+  double box[108];
+  const double lo[3] = {c[0] - 1e-3, c[1] - 1e-3, c[2] - 1e-3}, hi[3] = {c[0] + 1e-3, c[1] + 1e-3, c[2] + 1e-3};
+  closed_box(lo, hi, box);
+  int32_t faces = 0, added = 0;
+  OK(w, mica_body_cut(w, body, box, 12, &faces, &added));
+  assert_true(faces > 0); /* it opens, but stays joined across one face */
+  pieces p = get_pieces(w, body);
+  assert_int_equal(p.pieces, 1);
+  free_pieces(&p);
+
+  const double around_lo[3] = {0.035, -0.01, -0.01}, around_hi[3] = {0.055, 0.03, 0.03};
+  closed_box(around_lo, around_hi, box);
+  OK(w, mica_body_cut(w, body, box, 12, &faces, &added));
+  p = get_pieces(w, body);
+  assert_int_equal(p.pieces, 3);
+  assert_true(smallest_piece(&p) >= 8);
+  free_pieces(&p);
+  assert_true(fabs(total_mass(w, body) - mass) <= 1e-12 * mass);
+  step_n(w, 5);
+  mica_world_destroy(w);
+}
+
 /* The cut body against a fresh one made from its mesh, state and constraint: one step each. */
 static void check_cut_steps_as_fresh(int32_t solver, int32_t threads) {
   mica_world* a = make_world(solver, threads);
@@ -337,6 +398,7 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_a_bar_cut_through_parts_in_two),
       cmocka_unit_test(test_cuts_off_the_faces_and_partial_cuts),
+      cmocka_unit_test(test_a_cut_frees_no_sliver),
       cmocka_unit_test(test_cut_body_steps_as_a_fresh_one),
       cmocka_unit_test(test_a_grasp_across_the_cut_holds_both_sides),
       cmocka_unit_test(test_bad_input_changes_nothing),

@@ -731,8 +731,9 @@ class Body(_Object):
     def cut(self, triangles: ArrayLike) -> Tuple[int, int]:
         """Incision (since 0.8): separates the body along a cut surface, triangles in world space
         (m) where the body is now: (k, 3, 3) corners, (k, 9) rows or a flat multiple of 9 values.
-        Returns (faces_cut, nodes_added); node copies are numbered after the body's nodes, tet
-        indices stay (see topology_version, which a cut that separates no node leaves alone)."""
+        Returns (faces_cut, nodes_added); a cut frees no piece of fewer than 8 tets (such a sliver
+        stays joined); node copies are numbered after the body's nodes, tet indices stay (see
+        topology_version, which a cut that separates no node leaves alone)."""
         t = np.ascontiguousarray(triangles, dtype=np.float64)
         if not ((t.ndim == 3 and t.shape[1:] == (3, 3)) or (t.ndim == 2 and t.shape[1] == 9)
                 or (t.ndim == 1 and t.size % 9 == 0)):

@@ -563,7 +563,8 @@ namespace LibMica
 
         /// <summary>Incision (since 0.8): separates the body along a cut surface given as triangles
         /// in world space (m) where the body is now, 9 values a triangle (its three corners).
-        /// facesCut: the faces the triangles crossed; nodesAdded: the node copies made, numbered
+        /// facesCut: the faces cut (those the triangles crossed, less any that stayed joined so as
+        /// to free no piece of fewer than 8 tets); nodesAdded: the node copies made, numbered
         /// after the body's nodes (tet indices stay; see TopologyVersion).</summary>
         public void Cut(double[] triangles, out int facesCut, out int nodesAdded)
         {
