@@ -60,7 +60,7 @@ extern "C" {
 /** Minor version: compatible additions. */
 #define MICA_VERSION_MINOR 8
 /** Patch version: fixes. */
-#define MICA_VERSION_PATCH 2
+#define MICA_VERSION_PATCH 3
 /** major * 10000 + minor * 100 + patch */
 #define MICA_VERSION_NUMBER (MICA_VERSION_MAJOR * 10000 + MICA_VERSION_MINOR * 100 + MICA_VERSION_PATCH)
 

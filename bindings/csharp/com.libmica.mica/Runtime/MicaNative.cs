@@ -17,7 +17,7 @@ namespace LibMica
         // --- Constants (mica.h)
         public const int MICA_VERSION_MAJOR = 0;
         public const int MICA_VERSION_MINOR = 8;
-        public const int MICA_VERSION_PATCH = 2;
+        public const int MICA_VERSION_PATCH = 3;
         public const int MICA_VERSION_NUMBER = MICA_VERSION_MAJOR * 10000 + MICA_VERSION_MINOR * 100 + MICA_VERSION_PATCH;
 
         public const int MICA_OK = 0;
