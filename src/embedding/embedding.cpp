@@ -75,7 +75,7 @@ bool holds_last_node(const Tet& t, int32_t node_count) {
 // Vertex `vertex` bound to tet e (-1: unbound) of `tets`, over nodes 0..node_count-1.
 VertexBinding binding(int32_t vertex, int32_t e, const Weights& w, const std::vector<Tet>& tets, int32_t node_count) {
   if (e < 0) return {{0, 0, 0}, -1, vertex, 0};
-  return {{w[0], w[1], w[2]}, e, vertex, holds_last_node(tets[size_t(e)], node_count)};
+  return {{w[1], w[2], w[3]}, e, vertex, holds_last_node(tets[size_t(e)], node_count)};
 }
 
 // Asks the cache for `bytes` from `from` on.
@@ -87,10 +87,10 @@ void prefetch(const void* from, size_t bytes) {
 
 Embedding::Embedding(uint64_t body, const Vec3List& rest, const std::vector<Tet>& tets,
                      const std::vector<Tri>& surface, const double* xyz, int32_t vertex_count,
-                     const int32_t* triangles, int32_t triangle_count, double radius)
+                     const int32_t* triangles, int32_t triangle_count, double radius, int32_t block_size)
     : body_(body), node_count_(int32_t(rest.size())), tet_count_(int32_t(tets.size())), radius_(radius) {
   check_input(xyz, vertex_count, triangles, triangle_count, radius);
-  plan_ = plan_normals(triangles, triangle_count, vertex_count);
+  plan_ = plan_normals(triangles, triangle_count, vertex_count, block_size);
   scratch_.resize(size_t(plan_.slots));
   Binder binder(rest, tets, surface, radius);
   bindings_.resize(size_t(vertex_count));

@@ -30,12 +30,13 @@ class Embedding {
   // Binds `vertex_count` vertices (3 doubles each, m, in the body's rest frame) to the tets of a
   // body (its rest positions, tets and surface); vertices outside it within `radius` (m) of its
   // surface are projected, the others unbound. `triangles` (3 vertex indices each, may be null
-  // when triangle_count is 0) are copied for the normals. Throws Error(InvalidArgument) for a
-  // vertex that is not finite (naming it) or a radius not finite or negative, Error(OutOfRange)
-  // for a triangle naming a vertex outside 0..vertex_count-1 (naming the triangle).
+  // when triangle_count is 0) are copied for the normals, summed in blocks of `block_size`
+  // (normals_plan.hpp). Throws Error(InvalidArgument) for a vertex that is not finite (naming it)
+  // or a radius not finite or negative, Error(OutOfRange) for a triangle naming a vertex outside
+  // 0..vertex_count-1 (naming the triangle).
   Embedding(uint64_t body, const Vec3List& rest, const std::vector<Tet>& tets, const std::vector<Tri>& surface,
             const double* xyz, int32_t vertex_count, const int32_t* triangles, int32_t triangle_count,
-            double radius);
+            double radius, int32_t block_size = 2048);
 
   uint64_t body() const { return body_; }
   int32_t node_count() const { return node_count_; }  // the body's, at binding or at the last follow

@@ -45,10 +45,12 @@ void pair_up(const std::vector<int32_t>& sequence, int32_t vertex_count, int32_t
       bool paired = false;
       for (int32_t r = 0; r < 3 && !paired; ++r) {
         const int32_t a = corner(t, r), b = corner(t, r + 1), c = corner(t, r + 2);
-        // The neighbour across c -> a runs a -> c: (a, c, d).
-        for (int32_t j = start[size_t(a)]; j < start[size_t(a) + 1] && !paired; ++j) {
-          const int32_t u = at[size_t(j)] / 3, from = at[size_t(j)] % 3;
-          if (u < begin || u >= end || used[size_t(u)] || corner(u, from + 1) != c) continue;
+        // The neighbour across c -> a runs a -> c: (a, c, d). a's corners are in the sequence's
+        // order: those of this block are a run of them.
+        const auto first = at.begin() + start[size_t(a)], last = at.begin() + start[size_t(a) + 1];
+        for (auto j = std::lower_bound(first, last, 3 * begin); j != last && *j < 3 * end && !paired; ++j) {
+          const int32_t u = *j / 3, from = *j % 3;
+          if (used[size_t(u)] || corner(u, from + 1) != c) continue;
           const int32_t d = corner(u, from + 2);
           if (a == b || a == c || a == d || b == c || b == d || c == d) continue;
           used[size_t(u)] = 1;

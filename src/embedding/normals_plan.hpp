@@ -5,9 +5,10 @@
 // slot of a small scratch (one cache line: the position and the normal's sum). The block's triangles
 // then read and add only scratch slots. After the block, the vertices it is the last to use are
 // normalised from their slots into the host's array, and their slots are free for the next blocks.
-// The host's arrays are written once each, in order; a whole-mesh pass for each of placing,
-// clearing, summing and normalising moved every vertex through memory four times, and on a
-// 114k-vertex mesh the passes cost more than the arithmetic.
+// The host's arrays are written once each (a position when its vertex is placed, a normal when it
+// is normalised); a whole-mesh pass for each of placing, clearing, summing and normalising moved
+// every vertex through memory four times, and on a 114k-vertex mesh the passes cost more than the
+// arithmetic.
 //
 // The scratch holds the vertices in use at once: on a mesh whose triangles come in a coherent
 // order (neighbours near each other in the list, as meshing tools and subdivision write them) a

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 
+#include "core/cpu_features.hpp"
 #include "embedding/stream_store.hpp"
 
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
@@ -17,7 +18,7 @@ namespace {
 void place(const VertexBinding& b, const Tet& t, const Vec3List& x, double* out) {
   const double *x0 = x[size_t(t[0])].data(), *x1 = x[size_t(t[1])].data(), *x2 = x[size_t(t[2])].data(),
                *x3 = x[size_t(t[3])].data();
-  const double w0 = b.weights[0], w1 = b.weights[1], w2 = b.weights[2], w3 = 1 - w0 - w1 - w2;
+  const double w1 = b.weights[0], w2 = b.weights[1], w3 = b.weights[2], w0 = 1 - (w1 + w2 + w3);
   for (int a = 0; a < 3; ++a) out[a] = w0 * x0[a] + w1 * x1[a] + w2 * x2[a] + w3 * x3[a];
 }
 
@@ -48,11 +49,11 @@ __attribute__((target("avx2,fma"))) inline __m256d node(const double* base, int3
 template <bool kSafe>
 __attribute__((target("avx2,fma"))) inline __m256d weighted_sum(const double* base, const Tet& t,
                                                                 const VertexBinding& b) {
-  const double w3 = 1 - b.weights[0] - b.weights[1] - b.weights[2];
-  __m256d p = _mm256_mul_pd(_mm256_broadcast_sd(&b.weights[0]), node<kSafe>(base, t[0]));
-  p = _mm256_fmadd_pd(_mm256_broadcast_sd(&b.weights[1]), node<kSafe>(base, t[1]), p);
-  p = _mm256_fmadd_pd(_mm256_broadcast_sd(&b.weights[2]), node<kSafe>(base, t[2]), p);
-  return _mm256_fmadd_pd(_mm256_set1_pd(w3), node<kSafe>(base, t[3]), p);
+  const double w0 = 1 - (b.weights[0] + b.weights[1] + b.weights[2]);
+  __m256d p = _mm256_mul_pd(_mm256_set1_pd(w0), node<kSafe>(base, t[0]));
+  p = _mm256_fmadd_pd(_mm256_broadcast_sd(&b.weights[0]), node<kSafe>(base, t[1]), p);
+  p = _mm256_fmadd_pd(_mm256_broadcast_sd(&b.weights[1]), node<kSafe>(base, t[2]), p);
+  return _mm256_fmadd_pd(_mm256_broadcast_sd(&b.weights[2]), node<kSafe>(base, t[3]), p);
 }
 
 // Each node read as four doubles, four FMAs a vertex where the generic loop takes twelve multiplies
@@ -83,10 +84,7 @@ __attribute__((target("avx2,fma"))) void place_avx2(const VertexBinding* binding
   _mm_sfence();  // the streamed positions ordered before what the caller writes next
 }
 
-bool avx2_supported() {
-  static const bool supported = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
-  return supported;
-}
+bool avx2_supported() { return cpu::avx2_fma(); }
 #endif
 
 }  // namespace

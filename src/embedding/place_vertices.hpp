@@ -11,9 +11,10 @@
 namespace mica {
 
 // A vertex's tet and barycentric weights: all the update reads of it, 32 bytes (the update is bound
-// by reading these). The fourth weight is 1 minus the other three.
+// by reading these). The weights are of the tet's last three nodes; the first node's is
+// 1 - (w1 + w2 + w3), as TetLocator::weights makes it.
 struct VertexBinding {
-  std::array<double, 3> weights;
+  std::array<double, 3> weights;  // of nodes 1, 2, 3
   int32_t tet;                // -1: unbound
   int32_t vertex : 31;        // the host's index of the vertex
   uint32_t has_last_node : 1;  // the tet holds the body's last node (reading past it would leave the array)

@@ -72,7 +72,7 @@ int32_t TetLocator::cell(double c, int a) const {
 
 Weights TetLocator::weights(int32_t e, const Vec3& p) const {
   const Vec3 w = tets_[size_t(e)].inverse * (p - tets_[size_t(e)].origin);
-  return {1 - w.sum(), w[0], w[1], w[2]};
+  return {1 - (w[0] + w[1] + w[2]), w[0], w[1], w[2]};  // the first as VertexBinding makes it
 }
 
 int32_t TetLocator::locate(const Vec3& p, double tolerance, Weights& w) const {

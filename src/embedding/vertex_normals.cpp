@@ -3,6 +3,7 @@
 
 #include <cmath>
 
+#include "core/cpu_features.hpp"
 #include "embedding/stream_store.hpp"
 
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
@@ -106,10 +107,7 @@ __attribute__((target("avx2,fma"))) void finish_avx2(const NormalSlot* scratch, 
   _mm_sfence();  // the streamed normals ordered before what the caller writes next
 }
 
-bool avx2_supported() {
-  static const bool supported = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
-  return supported;
-}
+bool avx2_supported() { return cpu::avx2_fma(); }
 #endif
 
 }  // namespace

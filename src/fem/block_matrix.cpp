@@ -3,6 +3,8 @@
 
 #include <algorithm>
 
+#include "core/cpu_features.hpp"
+
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
 #include <immintrin.h>
 #endif
@@ -103,10 +105,7 @@ __attribute__((target("avx2,fma"))) void block_multiply_avx2(const BlockPattern&
   }
 }
 
-bool avx2_supported() {
-  static const bool supported = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
-  return supported;
-}
+bool avx2_supported() { return cpu::avx2_fma(); }
 #endif
 
 }  // namespace

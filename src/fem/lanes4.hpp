@@ -5,6 +5,7 @@
 // AVX2 + FMA and called only where the CPU has them (lanes4::supported()). Matrices are lane
 // vectors in column-major order, as Mat3 stores them: M[3j + i] holds the four entries (i, j).
 #pragma once
+#include "core/cpu_features.hpp"
 #include "core/types.hpp"
 #include "fem/tet_element.hpp"
 
@@ -16,10 +17,7 @@
 
 namespace mica::lanes4 {
 
-inline bool supported() {
-  static const bool supported = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
-  return supported;
-}
+inline bool supported() { return cpu::avx2_fma(); }
 
 // The 4x4 transpose of rows v[0..3]: afterwards v[i] holds the old rows' entries i.
 MICA_AVX2 inline void transpose4(__m256d v[4]) {

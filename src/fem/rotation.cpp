@@ -4,6 +4,8 @@
 #include <Eigen/SVD>
 #include <cmath>
 
+#include "core/cpu_features.hpp"
+
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
 #include <immintrin.h>
 #endif
@@ -172,10 +174,7 @@ MICA_AVX2 void proper_rotations_avx2(const Mat3 F[4], Mat3 R[4]) {
 
 #undef MICA_AVX2
 
-bool avx2_supported() {
-  static const bool supported = __builtin_cpu_supports("avx2");
-  return supported;
-}
+bool avx2_supported() { return cpu::avx2(); }
 
 }  // namespace
 #endif

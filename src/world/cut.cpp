@@ -130,7 +130,8 @@ std::vector<int32_t> small_piece(const Body& b, int32_t e, const Joined& joined)
 
 // Step 2: a piece the crossed faces would free with fewer than kSmallestPiece tets is joined again
 // across one of its crossed faces (the first to a piece that is not small, else the first), until
-// it is not small or has no crossed face left (it was as small before: a removal's leftover).
+// it is not small or has no crossed face left (it was as small before: a removal's leftover). Pieces
+// are joined by faces: one that hangs on by an edge or a node comes free when step 3 splits it.
 // Along element faces, a blade that passes close to a face, or a sliver that lies across its path,
 // frees one tet or a few that no real blade would (an 8 mm deep incision through the nidus freed
 // 56 such pieces of 1 to 6 tets, and the blade then knocked them away).

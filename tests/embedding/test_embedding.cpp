@@ -428,6 +428,43 @@ static void test_a_change_that_does_not_fit_is_refused_and_changes_nothing(void*
   for (double v : out) assert_true(v == 42.0);
 }
 
+// The update's normals come block by block (normals_plan.hpp): in blocks of 16 triangles, with
+// triangles that also join the interior, projected and unbound vertices (an unbound corner counts
+// where the host put it), they are the moved triangles' normals, and the positions are the bits
+// the whole-mesh block gives.
+static void test_normals_in_many_blocks_with_every_kind_of_corner(void**) {
+  const Box b = box();
+  Mesh m = render_mesh(b);
+  const int32_t surface_triangles = int32_t(m.triangles.size() / 3);
+  for (int32_t k = 0; k < 40; ++k)  // interior, projected and unbound vertices in triangles too
+    m.triangles.insert(m.triangles.end(), {m.inside - 1 - k, m.inside + k, m.inside + m.near + k % m.far});
+  const int32_t t = int32_t(m.triangles.size() / 3);
+  assert_true(t > 4 * 16 && surface_triangles < t);
+  const auto embedding = [&](int32_t block) {
+    return Embedding(7, b.mesh.nodes, b.mesh.tets, b.surface, m.xyz.data(), m.count(), m.triangles.data(), t,
+                     0.003, block);
+  };
+  const Embedding small = embedding(16), whole = embedding(1 << 20);
+  const Vec3List x = bent(b.mesh.nodes);
+  std::vector<double> out = m.xyz, normals(m.xyz.size(), 7.0), out_whole = m.xyz, normals_whole(m.xyz.size());
+  small.update(x, b.mesh.tets, out.data(), normals.data());
+  whole.update(x, b.mesh.tets, out_whole.data(), normals_whole.data());
+  assert_memory_equal(out.data(), out_whole.data(), sizeof(double) * out.size());
+  const Vec3List expected = reference_normals(out, m.triangles);
+  std::vector<uint8_t> used(size_t(m.count()), 0);
+  for (int32_t v : m.triangles) used[size_t(v)] = 1;
+  for (int32_t i = 0; i < m.count(); ++i) {
+    const Vec3 n(&normals[3 * size_t(i)]), n_whole(&normals_whole[3 * size_t(i)]);
+    assert_near((n - n_whole).norm(), 0.0, 1e-12);
+    if (!used[size_t(i)]) {
+      assert_true(n == Vec3::Zero());
+      continue;
+    }
+    assert_near(n.norm(), 1.0, 1e-12);
+    assert_le(angle_degrees(n, expected[size_t(i)]), 1e-6);
+  }
+}
+
 // The host's arrays are written with streaming stores of 16 bytes where they allow it: arrays at
 // every offset from a 16-byte boundary (8 is what C guarantees; 4 is what a careless host may pass)
 // get the same bytes as aligned ones.
@@ -455,6 +492,7 @@ int main(void) {
       cmocka_unit_test(test_rest_places_every_bound_vertex_where_it_was),
       cmocka_unit_test(test_rigid_motion_moves_the_mesh_rigidly),
       cmocka_unit_test(test_arrays_at_any_offset_get_the_same_bytes),
+      cmocka_unit_test(test_normals_in_many_blocks_with_every_kind_of_corner),
       cmocka_unit_test(test_normals_are_those_of_the_moved_triangles),
       cmocka_unit_test(test_update_allocates_nothing),
       cmocka_unit_test(test_bad_input_is_refused_by_name),
