@@ -81,7 +81,7 @@ int main(int argc, char** argv) {
     failed |= incision_scene_step(&cut, k) < 0;
     t_cut[k - 1] = thread_cpu_ms() - start;
     mica_world_get_stats(cut.press.world, &stats);
-    if (k > 1 && stats.factorizations > 0) ++waited;
+    if (k > 1 && stats.factor_waits > 0) ++waited;
     double f[3], along = 0;
     incision_scene_blade_force(&cut, f, &along);
     const double magnitude = sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);

@@ -196,6 +196,7 @@ MICA_API mica_status mica_world_get_stats(const mica_world* world, mica_world_st
     r.solver_iterations = s.solver_iterations;
     r.solves = s.solver_solves;
     r.factorizations = s.factorizations;
+    r.factor_waits = s.factor_waits;
     r.solver_residual = s.solver_residual;
     r.ms_last_step = s.ms_last_step;
     for (int k = 0; k < MICA_STAGE_COUNT; ++k) {

@@ -58,9 +58,9 @@ extern "C" {
 /** Major version: incompatible ABI changes. */
 #define MICA_VERSION_MAJOR 0
 /** Minor version: compatible additions. */
-#define MICA_VERSION_MINOR 8
+#define MICA_VERSION_MINOR 9
 /** Patch version: fixes. */
-#define MICA_VERSION_PATCH 3
+#define MICA_VERSION_PATCH 0
 /** major * 10000 + minor * 100 + patch */
 #define MICA_VERSION_NUMBER (MICA_VERSION_MAJOR * 10000 + MICA_VERSION_MINOR * 100 + MICA_VERSION_PATCH)
 
@@ -728,7 +728,7 @@ MICA_API mica_status mica_body_remove_tets(mica_world* world, mica_body_id body,
 /** Incision (since 0.8): separates a body along a cut surface, given as triangles where the body
  *  is now (world space; a blade's sweep between two poses is two triangles). A face shared by two
  *  tets is cut when the segment between the two tets' centroids crosses a triangle, except that a
- *  cut frees no piece of fewer than 8 tets (since 0.8.3: such a sliver stays joined across one of
+ *  cut frees no piece of fewer than 12 tets (since 0.8.3; 8 before 0.9: such a piece stays joined across one of
  *  its faces; remove its tets to take it out); the nodes of the cut faces are then duplicated so
  *  that the tets on either side no longer share them (a node
  *  at the cut's edge, whose tets stay joined around it, is kept whole: the cut stops there). No tet
@@ -1363,6 +1363,11 @@ typedef struct mica_world_stats {
   /** Numeric factorizations the last step made, or started in the background
    *  (mica_world_def.refactor_interval), summed over bodies: the steps that paid for one. */
   int32_t factorizations;
+  /* Since 0.9: */
+  /** Of those, the factorizations the last step waited for: made on the stepping thread, or
+   *  adopted from the background thread before it was done (0 in a step whose factor stayed
+   *  ahead; after a cut the factor is made in the background: docs/cutting.md). */
+  int32_t factor_waits;
 } mica_world_stats;
 
 /** Copies the statistics of the last step and since creation into `out`, writing at most

@@ -34,6 +34,11 @@ void BackgroundThread::wait() {
   changed_.wait(lock, [this] { return job_ == nullptr; });
 }
 
+bool BackgroundThread::busy() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return job_ != nullptr;
+}
+
 void BackgroundThread::run() {
   std::unique_lock<std::mutex> lock(mutex_);
   for (;;) {

@@ -25,6 +25,8 @@ class BackgroundThread {
   void start(void (*job)(void*), void* context);
   // Blocks until the last job started is over (at once if none is running).
   void wait();
+  // Whether the last job started is still running (a look, not a wait).
+  bool busy();
   // What the last job threw (null: it returned, or none ran); kept until the next start().
   std::exception_ptr error() const { return error_; }
 

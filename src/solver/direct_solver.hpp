@@ -58,6 +58,18 @@ class DirectSolver : public LinearSolver {
   // The hand-written solve bound to the last factorization (its halves and half columns), or
   // null when CHOLMOD made a factor of another kind.
   const SupernodalSolve* by_hand() const { return by_hand_.bound() ? &by_hand_ : nullptr; }
+  // The hand-written solve's bridge to a changed body's nodes (SupernodalSolve::bridge).
+  bool bridge(const std::vector<int32_t>& factor_node, const std::vector<std::pair<int32_t, int32_t>>& copy,
+              const Eigen::MatrixXd& B, const Eigen::MatrixXd& C) {
+    return by_hand_.bridge(factor_node, copy, B, C);
+  }
+  // Forgets the analysed pattern and its ordering: the next analyze() is of another body's
+  // pattern (a body whose topology changed), as in a new solver.
+  void forget_pattern() {
+    by_hand_.unbind();
+    ordering_.clear();
+    analyzed_ = false;
+  }
 
  private:
   // lower_ over the block pattern, without the couplings of held_ nodes when `leave_out_held`.

@@ -34,7 +34,8 @@ void FactoredMicaSolver::update_factors(const std::vector<SolverBody>& bodies) {
       compute_node_rotations(*b.fem, *b.rotation, cache.node_rotation);
       rotation = &cache.node_rotation;
     }
-    cache.factor.update(*b.fem, LaggedFactor::Key{b.system, b.constraint_version}, *b.A, *b.projection, rotation,
+    cache.factor.set_bridgeable(b.may_be_cut);
+    cache.factor.update(*b.fem, LaggedFactor::Key{b.system, b.constraint_version}, *b.A, *b.projection, rotation, b.rotation,
                         rotation ? settings_.refactor_interval : 0, b.extra_stiffness);
     FactoredBody& f = factored_[k];
     f.factor = &cache.factor;
@@ -374,7 +375,7 @@ void FactoredMicaSolver::refactor_now(const std::vector<SolverBody>& bodies, con
   for (size_t bi = 0; bi < bodies.size(); ++bi)
     if (factored_[bi].node_rotation)
       factored_[bi].factor->refactor_now(bodies[bi].pattern(), *bodies[bi].A, *bodies[bi].projection,
-                                         factored_[bi].node_rotation, bodies[bi].extra_stiffness);
+                                         factored_[bi].node_rotation, bodies[bi].rotation, bodies[bi].extra_stiffness);
   for (FactoredBody& f : factored_) f.warp.bind(f.factor, f.node_rotation);
   start_compliance(bodies, rows, lambda);
 }
@@ -570,6 +571,16 @@ bool FactoredMicaSolver::settled(const std::vector<SolverBody>& bodies, const Co
   return report.converged;
 }
 
+void FactoredMicaSolver::remap(uint64_t key, const BodyRemap& change) {
+  FactoredBodyCache* cache = find_cache(key);
+  bool kept = false;
+  try {
+    kept = cache && cache->factor.remap(change);
+  } catch (...) {  // out of memory: nothing changed, and a dropped cache is made again
+  }
+  if (!kept) forget(key);
+}
+
 void FactoredMicaSolver::save_body(uint64_t key, ByteWriter& out) const {
   const FactoredBodyCache* cache = find_cache(key);
   out.put(uint8_t(cache != nullptr));
@@ -583,7 +594,7 @@ void FactoredMicaSolver::restore_bodies(const std::vector<SavedBody>& bodies) {
     std::unique_ptr<FactoredBodyCache> cache;
     if (in.get<uint8_t>("a body's factor flag")) {
       cache = std::make_unique<FactoredBodyCache>();
-      cache->factor.load(in, b.fem->pattern);
+      cache->factor.load(in, *b.fem);
     }
     if (in.remaining()) fail(Errc::Parse, "a body's solver state is longer than its factor: corrupt state");
     made.emplace_back(b.key, std::move(cache));

@@ -53,6 +53,7 @@ struct FactoredBodyCache {
     uint64_t columns = 0;  // 0: none
   } products, products_next;
   int64_t factorizations() const { return factor.factorizations(); }
+  int64_t factor_waits() const { return factor.waits(); }
 };
 
 // Each body's factor is updated once per solve for its SystemKey and constraint version
@@ -91,6 +92,12 @@ class FactoredMicaSolver : public CachingVelocitySolver<FactoredBodyCache> {
   // round solves to the tolerance; the tests compare both).
   void set_check_residual(double residual) { set_check_residual_ = residual; }
   static constexpr double kSetCheckResidual = 1e-2;
+  // A body's lagged factor goes on across a topology change as a bridge (LaggedFactor::remap).
+  void remap(uint64_t key, const BodyRemap& change) override;
+  int64_t factor_waits(uint64_t key) const override {
+    const FactoredBodyCache* cache = find_cache(key);
+    return cache ? cache->factor_waits() : 0;
+  }
   // Each body's lagged factor (LaggedFactor::save, load).
   void save_body(uint64_t key, ByteWriter& out) const override;
   void restore_bodies(const std::vector<SavedBody>& bodies) override;

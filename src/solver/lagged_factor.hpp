@@ -18,6 +18,11 @@
 // step on the nidus); adoption stops it after the column in hand and makes the rest itself (a
 // column is the same bits whoever makes it), so a late worker costs the step no more than it
 // did without this.
+//
+// After a change of the body's topology (a cut, a resection: remap()), the factor in use goes on
+// as a bridge to the new nodes while the new system's factor, its analysis included, is made on
+// the worker and adopted in lockstep kBridgeSteps steps later: no step factors because of a cut
+// (Courtecuisse et al. 2014 precondition with the factor made before a cut in the same way).
 #pragma once
 #include <Eigen/Dense>
 #include <atomic>
@@ -52,14 +57,17 @@ class LaggedFactor {
   // key changed; otherwise adopts and launches background factorizations every `interval` steps
   // (0: never). What A holds of `extra` (the contacts' stiffness, which changes every step) is
   // left out of what is factored: the solver adds the current one back (factored_mica.hpp).
+  // `element_rotation`: the element rotations A was assembled with (null: the linear model), kept
+  // with the factor for a bridge after a topology change (remap()).
   void update(const FemModel& fem, const Key& key, const BlockValues& A, const Projection& projection,
-              const std::vector<Mat3>* node_rotation, int32_t interval,
+              const std::vector<Mat3>* node_rotation, const std::vector<Mat3>* element_rotation, int32_t interval,
               const std::vector<TriangleStiffness>* extra = nullptr);
   // Factors the given system now, on the calling thread (the factored sweep's remedy when a solve
   // with the current factor drags on). A background factorization in flight goes on, and is
   // dropped at adoption as older than this one.
   void refactor_now(const BlockPattern& pattern, const BlockValues& A, const Projection& projection,
-                    const std::vector<Mat3>* node_rotation, const std::vector<TriangleStiffness>* extra = nullptr);
+                    const std::vector<Mat3>* node_rotation, const std::vector<Mat3>* element_rotation,
+                    const std::vector<TriangleStiffness>* extra = nullptr);
   // Computes the half columns (SupernodalSolve::HalfColumns) of all these nodes not yet cached.
   void prepare_columns(const std::vector<int32_t>& nodes);
   // A prepared node's half columns H = L^-1 P E (E its unit columns; K_f = P^T L L^T P), kept
@@ -70,9 +78,36 @@ class LaggedFactor {
   // Q_i = R_i R_f,i^T: how far node i turned since the factor's step (R_i: now).
   Mat3 turn(const std::vector<Mat3>* node_rotation, int32_t i) const {
     if (!node_rotation) return Mat3::Identity();
-    return active_->rotation.empty() ? (*node_rotation)[i] : Mat3((*node_rotation)[i] * active_->rotation[i].transpose());
+    const std::vector<Mat3>& R_f = bridge_.on ? bridge_.rotation : active_->rotation;
+    return R_f.empty() ? (*node_rotation)[i] : Mat3((*node_rotation)[i] * R_f[i].transpose());
   }
   int64_t factorizations() const { return factorizations_; }
+  // Factors the stepping thread waited for: made by update() or refactor_now(), or adopted from a
+  // worker that was not done yet.
+  int64_t waits() const { return waits_; }
+
+  // After a change of the body's topology (a cut, a resection), between steps. The factor in use
+  // becomes a bridge to the new system (SupernodalSolve::bridge): its nodes serve the nodes that
+  // came from them, and each copy of a cut node moves against its node in a mode of its own,
+  // coupled to the rest through B and C, the cut mesh's system as of the factor (its elements
+  // at the factor's rotations, its mass and damping): so the bridge is as near the cut body's
+  // system as the factor was to the uncut one. The next update() launches the new system's
+  // factorization, analysis included, on the worker, adopted max(interval, kBridgeSteps)
+  // updates later in lockstep (results do not depend on timing). A factor in flight is not
+  // waited for: adopted on its schedule, it bridges the changes made since its launch (a blade
+  // that cuts every step goes on with a factor a few steps old). A bridged factor bridges
+  // further changes from its own topology. False when there is no factor to bridge (none yet, or
+  // one of a model whose elements are not linear or co-rotational): the caller drops the cache
+  // and the next step factors. Throws (std::bad_alloc) with nothing changed.
+  bool remap(const BodyRemap& change);
+  // Whether the factors made from now on keep what a bridge needs: the double factor, beside the
+  // half copy the solves read (on the nidus about 8.6 MB more than the copy alone). Off by
+  // default; the factored sweep turns it on for a body that may be cut (SolverBody::may_be_cut).
+  void set_bridgeable(bool on) { bridgeable_ = on; }
+  // kBridgeSteps steps give the worker the analysis and factorization of the nidus (about 35 ms
+  // of CPU) while the stepping thread shares its core.
+  static constexpr int32_t kBridgeSteps = 4;
+  bool bridged() const { return bridge_.on; }
   // The mark of the factor in use's half columns: another mark, other columns.
   uint64_t columns_id() const { return columns_id_; }
   // Whether a background refresh also makes half columns (on; a test turns it off to compare),
@@ -100,12 +135,16 @@ class LaggedFactor {
   // same matrix factors to the same bits); it throws Error(Parse) on a state that does not fit
   // `pattern`.
   void save(ByteWriter& out) const;
-  void load(ByteReader& in, const BlockPattern& pattern);
+  void load(ByteReader& in, const FemModel& fem);
 
  private:
   struct Slot {
-    // The preconditioner's solves: half or single, and only the copy kept (see set_copy).
+    // The preconditioner's solves: half or single, and only the copy kept, unless the factor is
+    // to serve a bridge (set_bridgeable), whose Schur complement is a small difference of large
+    // terms that needs the double factor (remap()).
     Slot() { direct.set_copy(SupernodalSolve::Copy::Half, false); }
+    void keep_double(bool on) { direct.set_copy(SupernodalSolve::Copy::Half, on); kept_double = on; }
+    bool kept_double = false;
     DirectSolver direct;
     BlockValues A;            // the system factored (a copy: the worker factors it; a saved state keeps it)
     Projection projection;
@@ -116,23 +155,47 @@ class LaggedFactor {
     std::vector<int32_t> prepare;
     std::vector<SupernodalSolve::HalfColumns> prepared;
     size_t prepared_count = 0;
+    uint64_t generation = 0;  // the topology (LaggedFactor::generation_) its analysis is of
+    std::vector<Mat3> element_rotation;  // what A was assembled with (empty: the linear model)
+    BlockPattern pattern;                // A's (the worker reads it: the body's changes with its topology)
   };
+  // The bridge after a topology change (remap()), until the new system's factor is adopted.
+  struct Bridge {
+    bool on = false;
+    std::vector<int32_t> factor_node, factor_tet;   // per node and tet now: the factor's
+    std::vector<std::pair<int32_t, int32_t>> copy;  // (copy, its group's first node)
+    std::vector<Mat3> rotation;                     // per node now: the factor's node rotation (turn())
+    Eigen::MatrixXd B, C;                           // SupernodalSolve::bridge's
+  };
+  // The bridge from `slot`'s factor to the nodes and tets of `fem` (maps into the slot's own).
+  Bridge make_bridge(const Slot& slot, const FemModel& fem, std::vector<int32_t> factor_node,
+                     std::vector<int32_t> factor_tet) const;
+  // Keeps the bridge for a rollback before a step first changes it; ends it.
+  void keep_bridge();
+  void end_bridge();
+  // Readies `slot` to be analysed for the current topology (forgets an older one's analysis).
+  void renew(Slot& slot) const;
+  // B and C of the bridge (SupernodalSolve::bridge), from the slot's system.
+  void bridge_blocks(const Slot& slot, const FemModel& fem, Bridge& bridge) const;
+  static void read_slot(Slot& slot, ByteReader& in);
+  // Checks a slot read against the pattern it factors, then analyses and factors it.
+  static void factor_read_slot(Slot& slot, const BlockPattern& pattern);
   void factor(Slot& slot, const BlockPattern& pattern, const BlockValues& A, const Projection& projection,
-              const std::vector<Mat3>* node_rotation, const std::vector<TriangleStiffness>* extra);
+              const std::vector<Mat3>* node_rotation, const std::vector<Mat3>* element_rotation,
+              const std::vector<TriangleStiffness>* extra);
   // Throws Error(Unsupported) unless the slot's factor can be solved in halves (halves()).
   static void require_halves(const Slot& slot);
   // slot.A = A - extra.
   static void copy_system(Slot& slot, const BlockPattern& pattern, const BlockValues& A,
                           const std::vector<TriangleStiffness>* extra);
-  void adopt();
-  void launch(const BlockPattern& pattern);  // the background factorization of *pending_
+  void adopt(const FemModel& fem);  // fem: the body's now (a bridge to it)
+  void launch();  // the background factorization of *pending_
   static void factor_pending(void* self);      // the worker's job
   // `slot` (active_ or pending_), or, in a step between begin() and its end, a spare in its place
   // when begin() saw it in use or in flight: rollback() puts that one back as it was.
   Slot& writable(std::unique_ptr<Slot>& slot);
   void clear_columns();
   static void save_slot(const Slot& slot, ByteWriter& out);
-  static void load_slot(Slot& slot, ByteReader& in, const BlockPattern& pattern);
 
   Key key_;
   std::unique_ptr<Slot> active_, pending_;
@@ -141,8 +204,9 @@ class LaggedFactor {
   bool background_columns_ = true;
   std::vector<int32_t> recent_nodes_;  // the nodes with columns of the factor adopt() replaced
   int64_t columns_from_worker_ = 0;
-  Slot* job_slot_ = nullptr;  // the worker's job: the slot and pattern it factors
-  const BlockPattern* job_pattern_ = nullptr;
+  Slot* job_slot_ = nullptr;  // the worker's job: the slot it factors
+  // The changes since the job's launch (remap()): per node and tet now, the job's (empty: none).
+  std::vector<int32_t> job_node_, job_tet_;
   // begin() .. commit() / rollback().
   struct Saved {
     Key key;
@@ -151,18 +215,22 @@ class LaggedFactor {
     const Slot* pending = nullptr;
     bool in_flight = false;
     uint64_t columns_id = 0;
+    int64_t waits = 0;
   } saved_;
   bool open_ = false;
   std::unique_ptr<Slot> kept_[2], spare_;  // slots of begin() replaced in the step; a free one
   bool launch_staged_ = false;             // a refresh to launch at commit()
-  const BlockPattern* staged_pattern_ = nullptr;
   std::vector<Mat3> staged_rotation_;
   int64_t staged_born_ = -1;
   bool columns_cleared_ = false;
   std::vector<int32_t> columns_added_;
   int64_t step_ = 0, launched_at_ = -1;
-  int64_t factorizations_ = 0;
+  int64_t factorizations_ = 0, waits_ = 0;
   int32_t node_count_ = 0;
+  bool bridgeable_ = false;
+  Bridge bridge_, kept_bridge_;
+  bool bridge_kept_ = false;  // kept_bridge_ is the one at begin()
+  uint64_t generation_ = 0;  // topology changes so far (remap())
   // The half columns, each marked with the factor it was made from: a new factor marks them all
   // stale instead of freeing them, and prepare_columns() makes them again in the same buffers (a
   // refresh adopted allocates nothing). In a step that may be undone, the first new factor swaps

@@ -13,6 +13,10 @@ bool SupernodalSolve::bind(const cholmod_factor* L, Copy copy, const Multiply& m
   L_ = nullptr;
   values_single_.clear();
   values_half_.clear();
+  factor_inverse_perm_.clear();  // a new factor ends a bridge
+  bridge_copy_.clear();
+  bridge_H_.resize(0, 0);
+  bridge_LS_.resize(0, 0);
   if (!L || !L->is_super || !L->is_ll || L->xtype != CHOLMOD_REAL || L->dtype != CHOLMOD_DOUBLE ||
       L->itype != CHOLMOD_INT || !L->x)
     return false;
@@ -315,9 +319,145 @@ void SupernodalSolve::backward_double() const {
   }
 }
 
+bool SupernodalSolve::bridge(const std::vector<int32_t>& factor_node,
+                             const std::vector<std::pair<int32_t, int32_t>>& copy, const Eigen::MatrixXd& B,
+                             const Eigen::MatrixXd& C) {
+  MICA_ASSERT(bound(), "a bridge needs a factor");
+  const Eigen::Index n = factor_rows(), m = 3 * Eigen::Index(copy.size());
+  MICA_ASSERT(B.rows() == n && B.cols() == m && C.rows() == m && C.cols() == m, "B and C fit the factor and copies");
+  if (!double_kept()) return false;
+  if (factor_inverse_perm_.empty()) factor_inverse_perm_ = inverse_perm_;
+  // H = L^-1 P B, in double, each column by the forward pass (w_ is the double halves' workspace).
+  Eigen::MatrixXd H(n, m);
+  for (Eigen::Index k = 0; k < m; ++k) {
+    for (Eigen::Index r = 0; r < n; ++r) w_[factor_inverse_perm_[size_t(r)]] = B(r, k);
+    forward_double();
+    H.col(k) = w_.head(n);
+  }
+  // S = C - H^T H: positive definite as Q^T A Q is; its eigenvalues are kept above round-off's
+  // reach (the factor's K and the B, C given agree to round-off, not exactly).
+  Eigen::MatrixXd S = C - H.transpose() * H;
+  S = 0.5 * (S + S.transpose()).eval();
+  Eigen::LLT<Eigen::MatrixXd> llt(S);
+  if (llt.info() != Eigen::Success) {
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(S);
+    const double floor = 1e-12 * std::max(C.diagonal().maxCoeff(), 0.0) + 1e-300;
+    S = eig.eigenvectors() * eig.eigenvalues().cwiseMax(floor).asDiagonal() * eig.eigenvectors().transpose();
+    llt.compute(0.5 * (S + S.transpose()));
+  }
+  std::vector<int32_t> permuted(3 * factor_node.size());
+  for (size_t i = 0; i < factor_node.size(); ++i) {
+    const int32_t f = factor_node[i];
+    MICA_ASSERT(f >= 0 && f < n / 3, "a bridged node maps past the factor");
+    for (int c = 0; c < 3; ++c) permuted[3 * i + size_t(c)] = factor_inverse_perm_[size_t(3 * f + c)];
+  }
+  std::vector<int32_t> start(factor_node.size() + 1, 0);
+  for (const auto& [c, p] : copy) ++start[size_t(c) + 1], ++start[size_t(p) + 1];
+  for (size_t i = 1; i < start.size(); ++i) start[i] += start[i - 1];
+  std::vector<std::pair<int32_t, double>> mode(size_t(start.back()));
+  {
+    std::vector<int32_t> fill(start.begin(), start.end() - 1);
+    for (size_t k = 0; k < copy.size(); ++k) {
+      mode[size_t(fill[size_t(copy[k].second)]++)] = {int32_t(k), M_SQRT1_2};
+      mode[size_t(fill[size_t(copy[k].first)]++)] = {int32_t(k), -M_SQRT1_2};
+    }
+  }
+  inverse_perm_.swap(permuted);
+  bridge_copy_ = copy;
+  bridge_H_.swap(H);
+  bridge_LS_ = llt.matrixL();
+  bridge_t_.resize(m);
+  mode_start_.swap(start);
+  mode_.swap(mode);
+  w_.resize(n + m);
+  if (single()) w_single_.resize(n + m);
+  return true;
+}
+
+template <class T>
+void SupernodalSolve::bridge_gather(const double* b, const Mat3* turn, T* w) const {
+  std::fill(w, w + factor_rows(), T(0));
+  for (size_t i = 0; i < inverse_perm_.size() / 3; ++i) {
+    const Eigen::Map<const Vec3> bi(b + 3 * i);
+    const Vec3 v = turn ? Vec3(turn[i].transpose() * bi) : Vec3(bi);
+    for (int c = 0; c < 3; ++c) w[inverse_perm_[3 * i + size_t(c)]] += T(v[c]);
+  }
+}
+
+template <class T>
+void SupernodalSolve::bridge_modes_forward(const double* b, const Mat3* turn, T* w) const {
+  const auto turned = [&](int32_t i) {
+    const Eigen::Map<const Vec3> bi(b + 3 * i);
+    return turn ? Vec3(turn[i].transpose() * bi) : Vec3(bi);
+  };
+  const Eigen::Index n = factor_rows();
+  Eigen::VectorXd& t = bridge_t_;
+  for (size_t k = 0; k < bridge_copy_.size(); ++k) {
+    const auto [c, p] = bridge_copy_[k];
+    t.segment<3>(3 * Eigen::Index(k)) = M_SQRT1_2 * (turned(p) - turned(c));
+  }
+  for (Eigen::Index k = 0; k < t.size(); ++k) {  // t -= H^T w
+    double d = 0;
+    const double* h = bridge_H_.col(k).data();
+    for (Eigen::Index r = 0; r < n; ++r) d += h[r] * double(w[r]);
+    t[k] -= d;
+  }
+  bridge_LS_.triangularView<Eigen::Lower>().solveInPlace(t);
+  for (Eigen::Index k = 0; k < t.size(); ++k) w[n + k] = T(t[k]);
+}
+
+template <class T>
+void SupernodalSolve::bridge_modes_backward(T* w) const {
+  const Eigen::Index n = factor_rows();
+  Eigen::VectorXd& z = bridge_t_;
+  for (Eigen::Index k = 0; k < z.size(); ++k) z[k] = double(w[n + k]);
+  bridge_LS_.triangularView<Eigen::Lower>().transpose().solveInPlace(z);
+  for (Eigen::Index k = 0; k < z.size(); ++k) w[n + k] = T(z[k]);
+  for (Eigen::Index k = 0; k < z.size(); ++k) {  // w -= H z
+    const double* h = bridge_H_.col(k).data();
+    const double zk = z[k];
+    for (Eigen::Index r = 0; r < n; ++r) w[r] -= T(h[r] * zk);
+  }
+}
+
+template <class T>
+void SupernodalSolve::bridge_scatter(const T* w, const Mat3* turn, double* x) const {
+  const T* z = w + factor_rows();
+  for (size_t i = 0; i < inverse_perm_.size() / 3; ++i) {
+    const int32_t* at = &inverse_perm_[3 * i];
+    Vec3 v(double(w[at[0]]), double(w[at[1]]), double(w[at[2]]));
+    for (int32_t m = mode_start_[i]; m < mode_start_[i + 1]; ++m) {
+      const auto [k, sign] = mode_[size_t(m)];
+      const T* zk = z + 3 * k;
+      v += sign * Vec3(double(zk[0]), double(zk[1]), double(zk[2]));
+    }
+    Eigen::Map<Vec3>(x + 3 * i) = turn ? Vec3(turn[i] * v) : v;
+  }
+}
+
 void SupernodalSolve::half_columns(int32_t first, HalfColumns& out) const {
-  if (single()) return half_columns_copy(first, out);
-  half_columns_double(first, out);
+  if (single()) half_columns_copy(first, out);
+  else half_columns_double(first, out);
+  if (!bridged()) return;
+  // A bridged node's column of [L 0; H^T L_S]^-1 Q^T: the factor's, then in the modes' rows
+  // L_S^-1 (V^T e - H^T h), h the factor's part.
+  const size_t node = size_t(first / 3);
+  const Eigen::Index m = bridge_LS_.rows(), n = factor_rows();
+  Eigen::MatrixXd t = Eigen::MatrixXd::Zero(m, 3);
+  for (int32_t q = mode_start_[node]; q < mode_start_[node + 1]; ++q) {
+    const auto [k, sign] = mode_[size_t(q)];
+    t.middleRows(3 * Eigen::Index(k), 3) += sign * Mat3::Identity();
+  }
+  Eigen::Index at = 0;
+  for (size_t q = 0; q < out.start.size(); ++q) {
+    t.noalias() -= bridge_H_.middleRows(out.start[q], out.length[q]).transpose() * out.values.middleRows(at, out.length[q]);
+    at += out.length[q];
+  }
+  bridge_LS_.triangularView<Eigen::Lower>().solveInPlace(t);
+  out.values.conservativeResize(at + m, 3);
+  out.values.bottomRows(m) = t;
+  out.start.push_back(int32_t(n));
+  out.length.push_back(int32_t(m));
 }
 
 void SupernodalSolve::half_columns_copy(int32_t first, HalfColumns& out) const {
@@ -475,11 +615,21 @@ void scatter(const T* w, const Mat3* turn, const std::vector<int32_t>& permuted,
 void SupernodalSolve::forward(const double* b, bool single, const Mat3* turn) const {
   halves_single_ = (single || !values_) && this->single();
   if (!halves_single_) {
-    gather(b, turn, inverse_perm_, w_.data());
-    return forward_double();
+    if (!bridged()) {
+      gather(b, turn, inverse_perm_, w_.data());
+      return forward_double();
+    }
+    bridge_gather(b, turn, w_.data());
+    forward_double();
+    return bridge_modes_forward(b, turn, w_.data());
   }
-  gather(b, turn, inverse_perm_, w_single_.data());
+  if (!bridged()) {
+    gather(b, turn, inverse_perm_, w_single_.data());
+    return forward_single();
+  }
+  bridge_gather(b, turn, w_single_.data());
   forward_single();
+  bridge_modes_forward(b, turn, w_single_.data());
 }
 
 Vec3 SupernodalSolve::dot(const HalfColumns& h) const {
@@ -534,11 +684,21 @@ void SupernodalSolve::add(const HalfColumns& h, const Vec3& f) const {
 
 void SupernodalSolve::backward(double* x, const Mat3* turn) const {
   if (halves_single_) {
+    if (!bridged()) {
+      backward_single();
+      return scatter(w_single_.data(), turn, inverse_perm_, x);
+    }
+    bridge_modes_backward(w_single_.data());
     backward_single();
-    return scatter(w_single_.data(), turn, inverse_perm_, x);
+    return bridge_scatter(w_single_.data(), turn, x);
   }
+  if (!bridged()) {
+    backward_double();
+    return scatter(w_.data(), turn, inverse_perm_, x);
+  }
+  bridge_modes_backward(w_.data());
   backward_double();
-  scatter(w_.data(), turn, inverse_perm_, x);
+  bridge_scatter(w_.data(), turn, x);
 }
 
 }  // namespace mica

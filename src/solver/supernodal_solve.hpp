@@ -69,6 +69,7 @@ class SupernodalSolve {
   int32_t widest_supernode() const;
   void unbind() { L_ = nullptr; }
   bool bound() const { return L_ != nullptr; }
+  int64_t rows() const { return bound() ? int64_t(L_->n) : 0; }  // of the factor (3 per node)
   bool single() const { return bound() && (!values_single_.empty() || !values_half_.empty()); }
   bool half() const { return bound() && !values_half_.empty(); }
   // Forgets L's values (bound, with a copy kept): the owner frees them, keeping L's structure, and
@@ -113,6 +114,24 @@ class SupernodalSolve {
   }
   void backward(double* x, const Mat3* turn = nullptr) const;
 
+  // A bridge (LaggedFactor::remap): the factor of K serves the system of a body whose topology
+  // changed since (a cut), until that system's own factor is ready. Node i of the new numbering
+  // is served by the factor's node factor_node[i]; a cut node's copies share their node's. In the
+  // basis Q = [T^T, V] (T^T y gives each node its factor node's value, the coarse part; V's columns
+  // d_k = (e_p - e_c) / sqrt 2 move a copy c = copy[k].first against its node p = copy[k].second)
+  // the new system is Q^T A Q = [K B; B^T C]: its coarse block is the factor's own (T A T^T = K
+  // when A is the cut mesh's system as of the factor: LaggedFactor::remap), and B (3 rows per
+  // factor node, in its order, 3 columns per copy) and C (3 per copy) are given. Its Cholesky
+  // factor is [L 0; H^T L_S] with H = L^-1 P B (made here, with the double factor, which must be
+  // kept) and L_S L_S^T = C - H^T H (the Schur complement: the copies' modes with everything else
+  // free); the halves solve with it, A^-1 = Q (Q^T A Q)^-1 Q^T. So the bridged preconditioner is
+  // as near the cut body's system as the factor was to the uncut one. Factor nodes no node maps
+  // to (a resection) get no input. Every solve, half and half column follows the bridge; the
+  // next bind() ends it. False (no bridge) when the double factor was not kept.
+  bool bridge(const std::vector<int32_t>& factor_node, const std::vector<std::pair<int32_t, int32_t>>& copy,
+              const Eigen::MatrixXd& B, const Eigen::MatrixXd& C);
+  bool bridged() const { return !factor_inverse_perm_.empty(); }
+
  private:
   // The panels of L's supernodes (kInvertedWidth).
   void make_panels();
@@ -154,6 +173,26 @@ class SupernodalSolve {
   mutable Eigen::Matrix<double, Eigen::Dynamic, 3> w3_, t3_;  // half_columns' (w3_ zero between calls)
   mutable Eigen::Matrix<float, Eigen::Dynamic, 3> w3_single_;  // the copy's half columns' (zero between calls)
   mutable bool halves_single_ = false;                       // forward() left w in w_single_
+  // The bridge (bridge()): the factor's own inverse_perm_ (empty: none), the copies' modes, H
+  // (rows permuted as w's), L_S, and each node's modes (k, and the sign of its part in d_k).
+  std::vector<int32_t> factor_inverse_perm_;
+  std::vector<std::pair<int32_t, int32_t>> bridge_copy_;
+  Eigen::MatrixXd bridge_H_, bridge_LS_;
+  mutable Eigen::VectorXd bridge_t_;  // a mode vector's scratch
+  std::vector<int32_t> mode_start_;
+  std::vector<std::pair<int32_t, double>> mode_;
+  Eigen::Index factor_rows() const { return Eigen::Index(L_->n); }
+  // The bridged halves around the factor's: T b into w's factor rows; after the forward pass, the
+  // modes' rows L_S^-1 (V^T b - H^T w); before the backward pass, z = L_S^-T (modes' rows) and
+  // w -= H z; after it, x = T^T w + V z.
+  template <class T>
+  void bridge_gather(const double* b, const Mat3* turn, T* w) const;
+  template <class T>
+  void bridge_modes_forward(const double* b, const Mat3* turn, T* w) const;
+  template <class T>
+  void bridge_modes_backward(T* w) const;
+  template <class T>
+  void bridge_scatter(const T* w, const Mat3* turn, double* x) const;
 };
 
 }  // namespace mica

@@ -89,10 +89,23 @@ struct SolverBody {
   SystemKey system;
   uint64_t matrix_version = 0;      // changes whenever the values of A change
   uint64_t constraint_version = 0;  // changes whenever the body's constraint set changes
+  // The body may be cut (a blade in the world, or a change of its tets before): a solver keeps
+  // what carries its caches across a change (remap), at a cost in memory.
+  bool may_be_cut = false;
 
   const BlockPattern& pattern() const { return fem->pattern; }
   int32_t node_count() const { return fem->node_count(); }
   ProjectedSystem projected() const { return {fem->pattern, *A, *projection}; }
+};
+
+// A change of a body's topology, as a solver sees it (World::adopt_topology).
+struct BodyRemap {
+  const FemModel& before;                   // the body's model before the change
+  const FemModel& after;                    // and after
+  const std::vector<int32_t>& node_origin;  // per node after, its node before
+  const std::vector<int32_t>& tet_origin;   // per tet after, its tet before
+  uint64_t constraint_version;              // the body's constraint set after (bumped by a change)
+  bool elements_linear;                     // its stiffness is the linear or co-rotational model's
 };
 
 class VelocitySolver {
@@ -107,8 +120,15 @@ class VelocitySolver {
   virtual const std::vector<double>& row_diagonal() const = 0;
   // Drops what the solver keeps for a body (before the body goes).
   virtual void forget(uint64_t /*key*/) {}
+  // After a change of a body's topology (World::adopt_topology), between steps. A solver that can
+  // go on with what it keeps (a lagged factor: LaggedFactor::remap) carries it over; by default it
+  // is dropped, as by forget(). Never throws.
+  virtual void remap(uint64_t key, const BodyRemap& /*change*/) { forget(key); }
   // Numeric factorizations made for a body so far (0 for a solver that does not factor).
   virtual int64_t factorizations(uint64_t /*key*/) const { return 0; }
+  // Of them, those the stepping thread waited for (made in the step, or adopted from a background
+  // thread that was not done).
+  virtual int64_t factor_waits(uint64_t key) const { return factorizations(key); }
   // A step that may fail (World::step): begin_step() before it, then commit_step() when it is
   // kept or rollback_step() when it is undone, which puts back what the solver keeps across steps
   // as it was at begin_step() (a failed step leaves no trace in later ones).
@@ -152,6 +172,10 @@ class CachingVelocitySolver : public VelocitySolver {
     for (auto& [key, cache] : caches_) f(*cache);
   }
   const Cache* find_cache(uint64_t key) const {
+    const auto it = caches_.find(key);
+    return it == caches_.end() ? nullptr : it->second.get();
+  }
+  Cache* find_cache(uint64_t key) {
     const auto it = caches_.find(key);
     return it == caches_.end() ? nullptr : it->second.get();
   }

@@ -29,7 +29,8 @@ struct WorldStats {
   int32_t solver_iterations = 0;
   bool converged = true;
   bool out_of_time = false;  // a solve stopped at WorldSettings::time_budget_ms
-  uint8_t unused[2] = {};
+  uint8_t factor_waits = 0;  // of the factorizations, those the step waited for (at most 255)
+  uint8_t unused = 0;
   int32_t solver_solves = 0;    // velocity solves (SolveReport::solves, at least 1 per solve)
   int32_t factorizations = 0;   // numeric factorizations made or started in the background
 };

@@ -156,10 +156,11 @@ void World::advance(double h) {
   stage.run(Stage::Constraints, plan.constraints, [&] {
     for (Body* b : ctx.dynamic) build_projection(ctx, *b);
   });
-  const int64_t factored_before = factorizations(ctx);
+  const int64_t factored_before = factorizations(ctx), waited_before = factor_waits(ctx);
   stage.run(Stage::Solve, plan.solve, [&] { solve(ctx); });
   if (plan.newton && plan.solve) relinearise(ctx, stage);
   stats.factorizations = int32_t(factorizations(ctx) - factored_before);
+  stats.factor_waits = uint8_t(std::min<int64_t>(factor_waits(ctx) - waited_before, 255));
   stage.run(Stage::Integrate, plan.integrate, [&] {
     for (Body* b : ctx.dynamic)
       for (size_t i = 0; i < b->x.size(); ++i) b->x_next[i] = b->x[i] + h * b->v_next[i];
@@ -386,6 +387,7 @@ bool World::bounds_overlap(const SurfaceView& a, const SurfaceView& b) const {
 
 void World::solve(const StepContext& ctx) {
   solver_bodies_.resize(ctx.dynamic.size());
+  const bool blades = std::any_of(ctx.tools.begin(), ctx.tools.end(), [](const Tool* t) { return t->blade; });
   for (size_t k = 0; k < ctx.dynamic.size(); ++k) {
     Body& b = *ctx.dynamic[k];
     form_rhs(ctx, b);
@@ -408,6 +410,7 @@ void World::solve(const StepContext& ctx) {
     sb.system = b.matrix_key;
     sb.matrix_version = b.matrix_version;
     sb.constraint_version = b.lpc_version;
+    sb.may_be_cut = blades || b.topology_version > 0;
   }
   // The impulses of contact rows that persist from the last step are the warm start.
   ContactRows& rows = next_.rows;
@@ -518,6 +521,12 @@ void World::constraint_reactions(const StepContext& ctx) {
 int64_t World::factorizations(const StepContext& ctx) const {
   int64_t n = 0;
   for (const Body* b : ctx.dynamic) n += solver_->factorizations(b->key);
+  return n;
+}
+
+int64_t World::factor_waits(const StepContext& ctx) const {
+  int64_t n = 0;
+  for (const Body* b : ctx.dynamic) n += solver_->factor_waits(b->key);
   return n;
 }
 

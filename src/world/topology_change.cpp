@@ -63,7 +63,10 @@ void World::adopt_topology(Id id, NewTopology& t) {
 
   // The new body: its model from the new mesh, the state carried over, fresh scratch.
   auto fresh = std::make_unique<Body>(t.mesh, t.materials, b.settings, b.name, b.key);
-  fresh->fem.pattern.fill_ordering = FillOrdering::Amd;  // its next step factors: no 20 ms of nested dissection
+  // Its factor is made in the background within a few steps (LaggedFactor::kBridgeSteps), and
+  // without a factor to bridge (the exact solver, a body not stepped yet) by its next step: AMD
+  // alone, no 20 ms of nested dissection.
+  fresh->fem.pattern.fill_ordering = FillOrdering::Amd;
   colour_for_threads(*fresh);
   for (size_t i = 0; i < origin.size(); ++i) {
     const size_t o = size_t(origin[i]);
@@ -85,7 +88,9 @@ void World::adopt_topology(Id id, NewTopology& t) {
   lpcs_.reserve_free();  // so that erase below allocates nothing
 
   // Nothing below throws.
-  solver_->forget(b.key);  // its factors (one may be in the making on the body's pattern) first
+  // Its factors go on as a bridge to the new nodes (one in the making on the old pattern is waited for).
+  solver_->remap(b.key, BodyRemap{b.fem, fresh->fem, origin, t.change.tet_origin, fresh->lpc_version,
+                                 !b.settings.neo_hookean()});
   for (uint64_t key : stale) warm_start_.erase(key);
   for (RenumberedLpc& r : kept) {
     Lpc& c = lpcs_.get(r.id, "constraint");

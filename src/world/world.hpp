@@ -283,6 +283,7 @@ class World {
   void add_to_stats(const SolveReport& report);
   // Numeric factorizations the solver has made of the step's bodies so far (the stats' per step).
   int64_t factorizations(const StepContext& ctx) const;
+  int64_t factor_waits(const StepContext& ctx) const;  // of them, those the stepping thread waited for
   void check_finite(const StepContext& ctx) const;
   void compute_forces(const StepContext& ctx);  // the three below
   void tool_forces(const StepContext& ctx);

@@ -131,6 +131,7 @@ static readout read_world(scene* s, int with_timings) {
     stats.ms_last_step = 0;
     for (int k = 0; k < MICA_STAGE_COUNT; ++k) stats.stages[k].ms_last_step = stats.stages[k].ms_total = 0;
     stats.factorizations = 0;
+    stats.factor_waits = 0;
   }
   put(&r, &stats, sizeof stats);
   double f[3], t[3];

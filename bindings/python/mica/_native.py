@@ -12,8 +12,8 @@ from ctypes import (CFUNCTYPE, POINTER, Structure, c_char, c_char_p, c_double, c
 
 # --- Constants (mica.h)
 MICA_VERSION_MAJOR = 0
-MICA_VERSION_MINOR = 8
-MICA_VERSION_PATCH = 3
+MICA_VERSION_MINOR = 9
+MICA_VERSION_PATCH = 0
 MICA_VERSION_NUMBER = MICA_VERSION_MAJOR * 10000 + MICA_VERSION_MINOR * 100 + MICA_VERSION_PATCH
 
 MICA_OK = 0
@@ -235,6 +235,7 @@ class mica_world_stats(Structure):
         ("body_contacts", c_int32),
         ("solves", c_int32),  # since 0.6
         ("factorizations", c_int32),
+        ("factor_waits", c_int32),
     ]
 
 

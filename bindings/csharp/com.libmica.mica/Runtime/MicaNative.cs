@@ -16,8 +16,8 @@ namespace LibMica
 
         // --- Constants (mica.h)
         public const int MICA_VERSION_MAJOR = 0;
-        public const int MICA_VERSION_MINOR = 8;
-        public const int MICA_VERSION_PATCH = 3;
+        public const int MICA_VERSION_MINOR = 9;
+        public const int MICA_VERSION_PATCH = 0;
         public const int MICA_VERSION_NUMBER = MICA_VERSION_MAJOR * 10000 + MICA_VERSION_MINOR * 100 + MICA_VERSION_PATCH;
 
         public const int MICA_OK = 0;
@@ -280,6 +280,7 @@ namespace LibMica
             public int body_contacts;
             public int solves;          // since 0.6
             public int factorizations;
+            public int factor_waits;    // since 0.9
 
             public mica_stage_stats Stage(int stage)
             {
