@@ -107,6 +107,7 @@ void LaggedFactor::adopt(const FemModel& fem) {
   if (stale) {
     bridge = make_bridge(*pending_, fem, job_node_, job_tet_);
     if (!pending_->direct.bridge(bridge->factor_node, bridge->copy, bridge->B, bridge->C)) return;
+    bridge->drop_blocks();
   }
   // The next launch asks the worker for these too (which columns it makes does not change
   // results, so a rollback leaves this list as it is).
@@ -189,8 +190,10 @@ void LaggedFactor::update(const FemModel& fem, const Key& key, const BlockValues
     clear_columns();
     return;
   }
-  // A bridge's own factor is made on the worker whatever the refresh interval.
-  const int64_t due = bridge_.on ? std::max<int64_t>(interval, kBridgeSteps) : interval;
+  // A bridge's own factor is made on the worker whatever the refresh interval (and one still in
+  // flight when the bridge ended, refactored in a step, is adopted on its schedule: dropped).
+  const bool bridge_job = bridge_.on || (in_flight_ && interval <= 0);
+  const int64_t due = bridge_job ? std::max<int64_t>(interval, kBridgeSteps) : interval;
   if (due <= 0) return;
   if (in_flight_ && step_ - launched_at_ >= due) adopt(fem);
   if (!in_flight_ && !launch_staged_ && step_ > launched_at_ && (interval > 0 || bridge_.on)) {
@@ -253,6 +256,7 @@ bool LaggedFactor::remap(const BodyRemap& change) {
     job_tet = compose(job_tet_, change.tet_origin);
   }
   if (!active_->direct.bridge(bridge.factor_node, bridge.copy, bridge.B, bridge.C)) return false;
+  bridge.drop_blocks();
   bridge_ = std::move(bridge);
   job_node_.swap(job_node);
   job_tet_.swap(job_tet);
@@ -503,6 +507,7 @@ void get_pattern(BlockPattern& p, ByteReader& in) {
   bool fits = p.rows >= 0 && p.row_start.size() == size_t(p.rows) + 1 && p.diag.size() == size_t(p.rows) &&
               p.row_start.front() == 0 && size_t(p.row_start.back()) == p.col.size() &&
               ordering <= uint8_t(FillOrdering::Amd);
+  for (size_t r = 0; fits && r < size_t(p.rows); ++r) fits = p.row_start[r] <= p.row_start[r + 1];  // all of it first
   for (size_t r = 0; fits && r < size_t(p.rows); ++r) {
     fits = p.row_start[r] <= p.row_start[r + 1] && p.diag[r] >= p.row_start[r] && p.diag[r] < p.row_start[r + 1] &&
            p.col[size_t(p.diag[r])] == int32_t(r);
@@ -591,6 +596,8 @@ void LaggedFactor::load(ByteReader& in, const FemModel& fem) {
     slot->element_rotation.clear();
     if (!since_09) continue;
     in.get_vector(slot->element_rotation, "a factor's element rotations");
+    for (const Mat3& R : slot->element_rotation)
+      if (!R.allFinite()) fail(Errc::Parse, "a saved factor's element rotation is not finite: corrupt state");
     slot->keep_double(in.get<uint8_t>("a factor's double flag") != 0);
     if (in.get<uint8_t>("a factor's pattern flag") == 0) continue;
     slot->generation = 0;
@@ -626,6 +633,14 @@ void LaggedFactor::load(ByteReader& in, const FemModel& fem) {
   } else {
     ok = false;
   }
+  if (ok && bridge_.on) {  // a cut's copies start where their node was at rest: a group of others is no bridge's
+    std::vector<int32_t> first(size_t(active_->pattern.rows), -1);
+    for (size_t i = 0; ok && i < factor_node.size(); ++i) {
+      int32_t& f = first[size_t(factor_node[i])];
+      if (f < 0) f = int32_t(i);
+      else ok = fem.rest[i] == fem.rest[size_t(f)];
+    }
+  }
   if (!ok) fail(Errc::Parse, "a saved factor's bridge does not fit its body: corrupt state");
   // The slots' factors, now that the pattern of each is known; the bridge made again (the same bits).
   if (active) factor_read_slot(*active_, active_->pattern);
@@ -637,6 +652,7 @@ void LaggedFactor::load(ByteReader& in, const FemModel& fem) {
     bridge_ = make_bridge(*active_, fem, std::move(factor_node), std::move(factor_tet));
     if (!active_->direct.bridge(bridge_.factor_node, bridge_.copy, bridge_.B, bridge_.C))
       fail(Errc::Parse, "a saved factor's bridge needs its double factor: corrupt state");
+    bridge_.drop_blocks();
   }
 }
 

@@ -165,7 +165,11 @@ class LaggedFactor {
     std::vector<int32_t> factor_node, factor_tet;   // per node and tet now: the factor's
     std::vector<std::pair<int32_t, int32_t>> copy;  // (copy, its group's first node)
     std::vector<Mat3> rotation;                     // per node now: the factor's node rotation (turn())
-    Eigen::MatrixXd B, C;                           // SupernodalSolve::bridge's
+    Eigen::MatrixXd B, C;                           // SupernodalSolve::bridge's, until it has them
+    void drop_blocks() {
+      B.resize(0, 0);
+      C.resize(0, 0);
+    }
   };
   // The bridge from `slot`'s factor to the nodes and tets of `fem` (maps into the slot's own).
   Bridge make_bridge(const Slot& slot, const FemModel& fem, std::vector<int32_t> factor_node,

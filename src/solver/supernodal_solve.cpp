@@ -326,30 +326,35 @@ bool SupernodalSolve::bridge(const std::vector<int32_t>& factor_node,
   const Eigen::Index n = factor_rows(), m = 3 * Eigen::Index(copy.size());
   MICA_ASSERT(B.rows() == n && B.cols() == m && C.rows() == m && C.cols() == m, "B and C fit the factor and copies");
   if (!double_kept()) return false;
-  if (factor_inverse_perm_.empty()) factor_inverse_perm_ = inverse_perm_;
+  // Everything new first (this may throw), then swapped in.
+  std::vector<int32_t> base = bridged() ? factor_inverse_perm_ : inverse_perm_;  // the factor's own
   // H = L^-1 P B, in double, each column by the forward pass (w_ is the double halves' workspace).
   Eigen::MatrixXd H(n, m);
+  w_.resize(n + m);
   for (Eigen::Index k = 0; k < m; ++k) {
-    for (Eigen::Index r = 0; r < n; ++r) w_[factor_inverse_perm_[size_t(r)]] = B(r, k);
+    for (Eigen::Index r = 0; r < n; ++r) w_[base[size_t(r)]] = B(r, k);
     forward_double();
     H.col(k) = w_.head(n);
   }
+  if (single()) w_single_.resize(n + m);
   // S = C - H^T H: positive definite as Q^T A Q is; its eigenvalues are kept above round-off's
   // reach (the factor's K and the B, C given agree to round-off, not exactly).
   Eigen::MatrixXd S = C - H.transpose() * H;
   S = 0.5 * (S + S.transpose()).eval();
+  const double floor = 1e-12 * std::max(C.diagonal().maxCoeff(), 0.0) + 1e-300;
   Eigen::LLT<Eigen::MatrixXd> llt(S);
-  if (llt.info() != Eigen::Success) {
+  if (llt.info() != Eigen::Success || !llt.matrixLLT().allFinite() ||
+      (m > 0 && llt.matrixLLT().diagonal().array().square().minCoeff() < floor)) {
     Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(S);
-    const double floor = 1e-12 * std::max(C.diagonal().maxCoeff(), 0.0) + 1e-300;
     S = eig.eigenvectors() * eig.eigenvalues().cwiseMax(floor).asDiagonal() * eig.eigenvectors().transpose();
     llt.compute(0.5 * (S + S.transpose()));
   }
+  Eigen::MatrixXd LS = llt.matrixL();
   std::vector<int32_t> permuted(3 * factor_node.size());
   for (size_t i = 0; i < factor_node.size(); ++i) {
     const int32_t f = factor_node[i];
     MICA_ASSERT(f >= 0 && f < n / 3, "a bridged node maps past the factor");
-    for (int c = 0; c < 3; ++c) permuted[3 * i + size_t(c)] = factor_inverse_perm_[size_t(3 * f + c)];
+    for (int c = 0; c < 3; ++c) permuted[3 * i + size_t(c)] = base[size_t(3 * f + c)];
   }
   std::vector<int32_t> start(factor_node.size() + 1, 0);
   for (const auto& [c, p] : copy) ++start[size_t(c) + 1], ++start[size_t(p) + 1];
@@ -362,15 +367,17 @@ bool SupernodalSolve::bridge(const std::vector<int32_t>& factor_node,
       mode[size_t(fill[size_t(copy[k].first)]++)] = {int32_t(k), -M_SQRT1_2};
     }
   }
+  std::vector<std::pair<int32_t, int32_t>> copies(copy);
+  Eigen::VectorXd t(m);
+  // Nothing below throws.
+  factor_inverse_perm_.swap(base);
   inverse_perm_.swap(permuted);
-  bridge_copy_ = copy;
+  bridge_copy_.swap(copies);
   bridge_H_.swap(H);
-  bridge_LS_ = llt.matrixL();
-  bridge_t_.resize(m);
+  bridge_LS_.swap(LS);
+  bridge_t_.swap(t);
   mode_start_.swap(start);
   mode_.swap(mode);
-  w_.resize(n + m);
-  if (single()) w_single_.resize(n + m);
   return true;
 }
 
