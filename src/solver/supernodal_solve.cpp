@@ -341,7 +341,7 @@ bool SupernodalSolve::bridge(const std::vector<int32_t>& factor_node,
   // reach (the factor's K and the B, C given agree to round-off, not exactly).
   Eigen::MatrixXd S = C - H.transpose() * H;
   S = 0.5 * (S + S.transpose()).eval();
-  const double floor = 1e-12 * std::max(C.diagonal().maxCoeff(), 0.0) + 1e-300;
+  const double floor = 1e-12 * (m > 0 ? std::max(C.diagonal().maxCoeff(), 0.0) : 0.0) + 1e-300;  // m = 0: a resection
   Eigen::LLT<Eigen::MatrixXd> llt(S);
   if (llt.info() != Eigen::Success || !llt.matrixLLT().allFinite() ||
       (m > 0 && llt.matrixLLT().diagonal().array().square().minCoeff() < floor)) {
