@@ -432,7 +432,7 @@ void SupernodalSolve::bridge_scatter(const T* w, const Mat3* turn, double* x) co
   const T* z = w + factor_rows();
   for (size_t i = 0; i < inverse_perm_.size() / 3; ++i) {
     const int32_t* at = &inverse_perm_[3 * i];
-    Vec3 v(double(w[at[0]]), double(w[at[1]]), double(w[at[2]]));
+    Vec3 v(static_cast<double>(w[at[0]]), static_cast<double>(w[at[1]]), static_cast<double>(w[at[2]]));
     for (int32_t m = mode_start_[i]; m < mode_start_[i + 1]; ++m) {
       const auto [k, sign] = mode_[size_t(m)];
       const T* zk = z + 3 * k;
