@@ -107,7 +107,6 @@ class LaggedFactor {
   // kBridgeSteps steps give the worker the analysis and factorization of the nidus (about 35 ms
   // of CPU) while the stepping thread shares its core.
   static constexpr int32_t kBridgeSteps = 4;
-  bool bridged() const { return bridge_.on; }
   // The mark of the factor in use's half columns: another mark, other columns.
   uint64_t columns_id() const { return columns_id_; }
   // Whether a background refresh also makes half columns (on; a test turns it off to compare),
